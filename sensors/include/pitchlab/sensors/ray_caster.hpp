@@ -1,0 +1,43 @@
+#pragma once
+// Ray casting against a MuJoCo model's geoms: the virtual laser's physics. Two implementations:
+// Embree (fast, the default) and MuJoCo's own mj_ray (the reference the tests compare against).
+
+#include <cstddef>
+#include <memory>
+#include <string>
+
+struct mjModel_;
+struct mjData_;
+
+namespace pitchlab::sensors {
+
+/// Which geoms a caster sees.
+struct RayCasterOptions {
+  /// Every geom of this body and its descendants is invisible to the rays (the robot itself).
+  /// Empty or absent from the model: nothing is excluded.
+  std::string exclude_subtree_of_body = "robot";
+};
+
+/// Casts batches of rays in the world frame against the model's geoms.
+class RayCaster {
+ public:
+  virtual ~RayCaster() = default;
+  /// Casts `n` rays; `origins` and unit `directions` hold 3 floats per ray (world frame [m]).
+  /// Writes the distance to the first hit [m] (+inf when nothing within `max_range_m`) and the
+  /// MuJoCo geom id hit (-1 on a miss); `geom_id` may be null.
+  virtual void Cast(const float* origins, const float* directions, std::size_t n,
+                    float max_range_m, float* range_m, int* geom_id) const = 0;
+  /// Re-reads the poses of geoms on moving bodies from the mjData given at construction.
+  virtual void Refresh() = 0;
+};
+
+/// Embree scene built from the model's planes, boxes, spheres, capsules, cylinders, ellipsoids,
+/// meshes and heightfields. `data` must outlive the caster. Throws std::runtime_error on failure.
+std::unique_ptr<RayCaster> MakeEmbreeRayCaster(const mjModel_* model, const mjData_* data,
+                                               const RayCasterOptions& options = {});
+
+/// Reference caster: one mj_ray call per ray. Same contract as the Embree caster.
+std::unique_ptr<RayCaster> MakeMujocoRayCaster(const mjModel_* model, const mjData_* data,
+                                               const RayCasterOptions& options = {});
+
+}  // namespace pitchlab::sensors

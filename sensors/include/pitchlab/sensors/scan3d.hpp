@@ -1,0 +1,55 @@
+#pragma once
+// A 3D scan from one pitch sweep, and Eq. 1: how a reading becomes a point in base_link.
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "pitchlab/sensors/laser_line.hpp"
+
+namespace pitchlab::sensors {
+
+/// Where the laser sits on the robot (calibratable). Frames: base_link -> laser_mount (the pitch
+/// axis, parallel to base_link's y at pitch 0) -> laser (mirror centre).
+struct MountConfig {
+  Eigen::Vector3d t_base_mount_m{0.10, 0.0, 0.45};   ///< pitch axis position in base_link [m]
+  Eigen::Vector3d t_mount_laser_m{0.0, 0.0, 0.09};   ///< mirror centre from the pitch axis [m]
+  Eigen::Vector3d misalignment_rpy_rad{0.0, 0.0, 0.0};  ///< scan plane vs mount, roll/pitch/yaw [rad]
+
+  /// T_mount_laser at zero pitch: the misalignment rotation and the mirror offset.
+  Eigen::Isometry3d MountToLaser() const;
+  /// T_base_laser at pitch `gamma_rad`.
+  Eigen::Isometry3d BaseToLaser(double gamma_rad) const;
+};
+
+/// Eq. 1 plus the mount: a reading of range `rho_m` at beam angle `theta_rad` with the mount at
+/// pitch `gamma_rad`, as a point in base_link [m].
+Eigen::Vector3d BeamPointInBase(double rho_m, double theta_rad, double gamma_rad,
+                                const MountConfig& mount);
+
+/// One point of a 3D scan, in base_link.
+struct ScanPoint {
+  float x = 0, y = 0, z = 0;  ///< [m]
+  float range_m = 0;          ///< measured range [m]
+  std::uint16_t line = 0;     ///< index of the line (pitch step) it came from
+  std::uint16_t beam = 0;     ///< index of the reading within its line
+  double stamp_s = 0;         ///< its line's stamp [s]
+};
+
+/// A full 3D scan: valid returns as points in base_link, the raw lines, and (in simulation) truth.
+struct Scan3D {
+  double stamp_s = 0.0;                  ///< first line's stamp [s]
+  double duration_s = 0.0;               ///< first line's start to last line's end [s]
+  std::vector<ScanPoint> points;         ///< valid returns, line-major
+  std::vector<LaserLine> lines;          ///< what the scanner delivered, with encoder pitch
+  std::size_t no_returns = 0;            ///< readings flagged no-return
+  std::size_t over_ranges = 0;           ///< readings flagged over-range
+  bool has_truth = false;                ///< T_world_base below is the simulator's ground truth
+  Eigen::Isometry3d T_world_base = Eigen::Isometry3d::Identity();  ///< pose during the scan
+};
+
+/// Builds the 3D scan from lines by Eq. 1 (each line's encoder pitch and the mount).
+Scan3D AssembleScan(std::vector<LaserLine> lines, const MountConfig& mount);
+
+}  // namespace pitchlab::sensors

@@ -1,0 +1,32 @@
+#pragma once
+// The sim/hw seam for the laser: what the simulated LMS200 + servo and the serial drivers implement.
+// A runtime choice made once at start-up, called once per line: virtual interfaces are right here.
+
+#include <chrono>
+
+#include "pitchlab/sensors/laser_line.hpp"
+#include "pitchlab/sensors/result.hpp"
+
+namespace pitchlab::sensors {
+
+/// A 2D line scanner (LMS200). Implemented by the simulator and by the serial driver.
+class LineScanner {
+ public:
+  virtual ~LineScanner() = default;
+  /// Next full sweep at the scanner's current pitch (pitch_rad left 0: the caller fills it from
+  /// the encoder), or an error (timeout, device fault) after `timeout`.
+  [[nodiscard]] virtual Result<LaserLine> NextLine(std::chrono::milliseconds timeout) = 0;
+};
+
+/// The pitching mount: a position-controlled servo with an encoder.
+class PitchAxis {
+ public:
+  virtual ~PitchAxis() = default;
+  /// Moves to the servo step nearest `pitch_rad`, waits until it has settled, and returns the
+  /// encoder angle actually reached [rad]; an error on timeout or device fault.
+  [[nodiscard]] virtual Result<double> MoveTo(double pitch_rad, std::chrono::milliseconds timeout) = 0;
+  /// Current encoder angle [rad].
+  [[nodiscard]] virtual Result<double> ReadEncoder() = 0;
+};
+
+}  // namespace pitchlab::sensors
