@@ -1,0 +1,69 @@
+#include "pitchlab/sensors/scan3d.hpp"
+
+#include <cmath>
+
+namespace pitchlab::sensors {
+
+Eigen::Isometry3d MountConfig::MountToLaser() const {
+  const Eigen::Vector3d& rpy = misalignment_rpy_rad;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translate(t_mount_laser_m);
+  T.rotate(Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
+           Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
+           Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()));
+  return T;
+}
+
+Eigen::Isometry3d MountConfig::BaseToLaser(double gamma_rad) const {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translate(t_base_mount_m);
+  T.rotate(Eigen::AngleAxisd(gamma_rad, Eigen::Vector3d::UnitY()));  // R_y(gamma) of Eq. 1
+  return T * MountToLaser();
+}
+
+Eigen::Vector3d BeamPointInBase(double rho_m, double theta_rad, double gamma_rad,
+                                const MountConfig& mount) {
+  // Eq. 1: p = R_y(gamma) [rho cos(theta), rho sin(theta), 0]^T, with the mirror offset and the
+  // misalignment inside the pitching frame and the mount's translation outside it.
+  const Eigen::Vector3d in_plane(rho_m * std::cos(theta_rad), rho_m * std::sin(theta_rad), 0.0);
+  return mount.BaseToLaser(gamma_rad) * in_plane;
+}
+
+Scan3D AssembleScan(std::vector<LaserLine> lines, const MountConfig& mount) {
+  Scan3D scan;
+  if (!lines.empty()) {
+    scan.stamp_s = lines.front().stamp_s;
+    const LaserLine& last = lines.back();
+    scan.duration_s = last.stamp_s + last.duration_s - scan.stamp_s;
+  }
+  std::size_t readings = 0;
+  for (const LaserLine& line : lines) readings += line.ranges_m.size();
+  scan.points.reserve(readings);
+  for (std::size_t l = 0; l < lines.size(); ++l) {
+    const LaserLine& line = lines[l];
+    const Eigen::Isometry3d T_base_laser = mount.BaseToLaser(line.pitch_rad);
+    for (std::size_t i = 0; i < line.ranges_m.size(); ++i) {
+      switch (line.status[i]) {
+        case ReadingStatus::kValid: break;
+        case ReadingStatus::kOverRange: ++scan.over_ranges; continue;
+        default: ++scan.no_returns; continue;
+      }
+      const double rho = line.ranges_m[i];
+      const double theta = line.Angle(i);
+      const Eigen::Vector3d p =
+          T_base_laser * Eigen::Vector3d(rho * std::cos(theta), rho * std::sin(theta), 0.0);
+      ScanPoint& q = scan.points.emplace_back();
+      q.x = static_cast<float>(p.x());
+      q.y = static_cast<float>(p.y());
+      q.z = static_cast<float>(p.z());
+      q.range_m = line.ranges_m[i];
+      q.line = static_cast<std::uint16_t>(l);
+      q.beam = static_cast<std::uint16_t>(i);
+      q.stamp_s = line.stamp_s;
+    }
+  }
+  scan.lines = std::move(lines);
+  return scan;
+}
+
+}  // namespace pitchlab::sensors

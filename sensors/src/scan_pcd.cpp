@@ -1,0 +1,154 @@
+#include "pitchlab/sensors/scan_pcd.hpp"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/io/pcd_io.h>
+
+namespace pitchlab::sensors {
+namespace {
+
+// One PCD record, packed: PCL would otherwise write the alignment gap as a field named "_".
+struct __attribute__((packed)) PackedPoint {
+  float x, y, z, range;
+  std::uint16_t ring, beam;
+  double stamp;
+};
+static_assert(sizeof(PackedPoint) == 28, "PCD record must have no padding");
+
+pcl::PCLPointField Field(const char* name, std::uint32_t offset, std::uint8_t type) {
+  pcl::PCLPointField f;
+  f.name = name;
+  f.offset = offset;
+  f.datatype = type;
+  f.count = 1;
+  return f;
+}
+
+pcl::PCLPointCloud2 ToCloud2(const Scan3D& scan) {
+  using F = pcl::PCLPointField;
+  pcl::PCLPointCloud2 cloud;
+  cloud.fields = {Field("x", offsetof(PackedPoint, x), F::FLOAT32),
+                  Field("y", offsetof(PackedPoint, y), F::FLOAT32),
+                  Field("z", offsetof(PackedPoint, z), F::FLOAT32),
+                  Field("range", offsetof(PackedPoint, range), F::FLOAT32),
+                  Field("ring", offsetof(PackedPoint, ring), F::UINT16),
+                  Field("beam", offsetof(PackedPoint, beam), F::UINT16),
+                  Field("stamp", offsetof(PackedPoint, stamp), F::FLOAT64)};
+  cloud.height = 1;
+  cloud.width = static_cast<std::uint32_t>(scan.points.size());
+  cloud.point_step = sizeof(PackedPoint);
+  cloud.row_step = cloud.point_step * cloud.width;
+  cloud.is_dense = true;
+  cloud.data.resize(cloud.row_step);
+  std::uint8_t* out = cloud.data.data();
+  for (const ScanPoint& p : scan.points) {
+    const PackedPoint record{p.x, p.y, p.z, p.range_m, p.line, p.beam, p.stamp_s};
+    std::memcpy(out, &record, sizeof(record));
+    out += sizeof(record);
+  }
+  return cloud;
+}
+
+}  // namespace
+
+Result<void> WriteScanPcd(const Scan3D& scan, const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  const fs::path tmp = target.parent_path() / ("." + target.filename().string() + ".tmp" +
+                                               std::to_string(::getpid()));
+  const Eigen::Vector3d t = scan.T_world_base.translation();
+  const Eigen::Quaterniond q(scan.T_world_base.rotation());
+  const Eigen::Vector4f origin(float(t.x()), float(t.y()), float(t.z()), 0.0f);
+  pcl::PCDWriter writer;
+  if (writer.writeBinary(tmp.string(), ToCloud2(scan), origin, q.cast<float>()) != 0) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    return Fail(Error::Code::kFailed, "cannot write PCD '" + path + "'");
+  }
+  std::error_code ec;
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    return Fail(Error::Code::kFailed, "cannot write PCD '" + path + "': " + ec.message());
+  }
+  return {};
+}
+
+Result<Scan3D> ReadScanPcd(const std::string& path) {
+  pcl::PCLPointCloud2 cloud;
+  Eigen::Vector4f origin;
+  Eigen::Quaternionf orientation;
+  int pcd_version = 0;
+  pcl::PCDReader reader;
+  if (!std::filesystem::is_regular_file(path)) {
+    return Fail(Error::Code::kNotFound, "no such PCD file '" + path + "'");
+  }
+  // PCL's reader trusts the header (it crashes on a file without fields): check it first.
+  int data_type = 0;
+  unsigned int data_idx = 0;
+  if (reader.readHeader(path, cloud, origin, orientation, pcd_version, data_type, data_idx) != 0 ||
+      cloud.fields.empty() || cloud.point_step == 0) {
+    return Fail(Error::Code::kInvalidArgument, "'" + path + "' is not a readable PCD file");
+  }
+  const std::uintmax_t points = std::uintmax_t(cloud.width) * cloud.height;
+  constexpr int kBinary = 1;  // PCL's data_type: 0 ascii, 1 binary, 2 binary_compressed
+  if (data_type == kBinary &&
+      std::filesystem::file_size(path) < data_idx + points * cloud.point_step) {
+    return Fail(Error::Code::kInvalidArgument,
+                "PCD '" + path + "' is truncated: the header promises " + std::to_string(points) +
+                    " points");
+  }
+  if (reader.read(path, cloud, origin, orientation, pcd_version) != 0) {
+    return Fail(Error::Code::kInvalidArgument, "'" + path + "' is not a readable PCD file");
+  }
+  auto offset_of = [&](const char* name, std::uint8_t type) -> int {
+    for (const auto& f : cloud.fields) {
+      if (f.name == name && f.datatype == type) return static_cast<int>(f.offset);
+    }
+    return -1;
+  };
+  using F = pcl::PCLPointField;
+  const int ox = offset_of("x", F::FLOAT32), oy = offset_of("y", F::FLOAT32),
+            oz = offset_of("z", F::FLOAT32);
+  if (ox < 0 || oy < 0 || oz < 0) {
+    return Fail(Error::Code::kInvalidArgument, "PCD '" + path + "' has no float x y z fields");
+  }
+  const int orange = offset_of("range", F::FLOAT32), oring = offset_of("ring", F::UINT16),
+            obeam = offset_of("beam", F::UINT16), ostamp = offset_of("stamp", F::FLOAT64);
+  Scan3D scan;
+  const std::size_t n = std::size_t(cloud.width) * cloud.height;
+  scan.points.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint8_t* rec = cloud.data.data() + i * cloud.point_step;
+    auto get = [rec](int off, auto& value) {
+      if (off >= 0) std::memcpy(&value, rec + off, sizeof(value));
+    };
+    ScanPoint p;
+    get(ox, p.x);
+    get(oy, p.y);
+    get(oz, p.z);
+    get(orange, p.range_m);
+    get(oring, p.line);
+    get(obeam, p.beam);
+    get(ostamp, p.stamp_s);
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      ++scan.no_returns;  // NaN points are how PCL marks missing returns
+      continue;
+    }
+    scan.points.push_back(p);
+  }
+  if (!scan.points.empty()) scan.stamp_s = scan.points.front().stamp_s;
+  scan.T_world_base = Eigen::Isometry3d::Identity();
+  scan.T_world_base.translate(origin.head<3>().cast<double>());
+  scan.T_world_base.rotate(orientation.cast<double>().normalized());
+  scan.has_truth = !scan.T_world_base.isApprox(Eigen::Isometry3d::Identity());
+  return scan;
+}
+
+}  // namespace pitchlab::sensors

@@ -1,0 +1,92 @@
+#include "pitchlab/sensors/pitching_scanner.hpp"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "pitchlab/sensors/lms200.hpp"
+#include "pitchlab/sensors/pitch_unit.hpp"
+
+namespace pitchlab::sensors {
+namespace {
+
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+// A pitch axis that goes to the servo step and reports the encoder, as the device would.
+class FakeAxis : public PitchAxis {
+ public:
+  explicit FakeAxis(int fail_at_move = -1) : fail_at_move_(fail_at_move) {}
+  Result<double> MoveTo(double pitch_rad, std::chrono::milliseconds) override {
+    if (moves_++ == fail_at_move_) return Fail(Error::Code::kTimeout, "no answer");
+    angle_rad_ = unit_.StepAngle(unit_.StepFor(pitch_rad));
+    return unit_.EncoderAngle(angle_rad_);
+  }
+  Result<double> ReadEncoder() override { return unit_.EncoderAngle(angle_rad_); }
+  double angle_rad_ = 0;
+
+ private:
+  PitchUnitModel unit_{PitchUnitConfig{}};
+  int fail_at_move_;
+  int moves_ = 0;
+};
+
+// A line scanner facing a wall 4 m ahead of the mirror at every pitch.
+class FakeScanner : public LineScanner {
+ public:
+  Result<LaserLine> NextLine(std::chrono::milliseconds) override {
+    std::vector<float> truth(static_cast<std::size_t>(model_.readings()), 4.0f);
+    LaserLine line;
+    model_.Measure(truth.data(), nullptr, nullptr, line);
+    line.stamp_s = clock_s_;
+    clock_s_ += model_.line_period_s();
+    return line;
+  }
+  double clock_s_ = 0;
+
+ private:
+  Lms200Model model_{Lms200Config{}};
+};
+
+TEST(PitchingScanSource, SeedPatternGives200LinesAtEncoderPitch) {
+  FakeAxis axis;
+  FakeScanner scanner;
+  PitchingScanSource source(scanner, axis, ScanPatternConfig{}, MountConfig{});
+  int last_progress = 0;
+  source.set_progress([&](int done, int total) {
+    EXPECT_EQ(total, 200);
+    last_progress = done;
+  });
+  Result<Scan3D> scan = source.Acquire();
+  ASSERT_TRUE(scan) << scan.error().message;
+  EXPECT_EQ(last_progress, 200);
+  ASSERT_EQ(scan->lines.size(), 200u);
+  EXPECT_EQ(scan->points.size() + scan->no_returns + scan->over_ranges, 200u * 361u);
+  // First line: -40 deg commanded is step -89 (-40.05 deg), read to the encoder's 0.01 deg.
+  EXPECT_NEAR(scan->lines.front().pitch_rad, -40.05 * kDeg, 0.005 * kDeg);
+  EXPECT_NEAR(scan->lines.back().pitch_rad, 59.85 * kDeg, 0.005 * kDeg);  // step 133
+  for (const LaserLine& line : scan->lines) {
+    const double steps = line.pitch_rad / (0.45 * kDeg);
+    EXPECT_NEAR(steps, std::round(steps), 0.02);  // every line sits on a servo step
+  }
+}
+
+TEST(PitchingScanSource, ADeviceErrorNamesTheLineAndStopsTheScan) {
+  FakeAxis axis(/*fail_at_move=*/17);
+  FakeScanner scanner;
+  PitchingScanSource source(scanner, axis, ScanPatternConfig{}, MountConfig{});
+  Result<Scan3D> scan = source.Acquire();
+  ASSERT_FALSE(scan);
+  EXPECT_EQ(scan.error().code, Error::Code::kTimeout);
+  EXPECT_NE(scan.error().message.find("line 17"), std::string::npos) << scan.error().message;
+}
+
+TEST(PitchingScanSource, RejectsAPatternWithoutLines) {
+  FakeAxis axis;
+  FakeScanner scanner;
+  ScanPatternConfig pattern;
+  pattern.lines = 0;
+  EXPECT_THROW(PitchingScanSource(scanner, axis, pattern, MountConfig{}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace pitchlab::sensors

@@ -1,0 +1,67 @@
+#include "pitchlab/sensors/sensor_config.hpp"
+
+#include <gtest/gtest.h>
+
+namespace pitchlab::sensors {
+namespace {
+
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+TEST(SensorConfig, EmptyDocumentGivesTheSeedDefaults) {
+  const SensorConfig c = ParseSensorConfig("", "test.yaml");
+  EXPECT_EQ(c.lms200.fov_deg, 180.0);
+  EXPECT_EQ(c.lms200.resolution_deg, 0.5);
+  EXPECT_EQ(c.scan.lines, 200);
+  EXPECT_EQ(c.scan.pitch_end_deg - c.scan.pitch_start_deg, 100.0);
+}
+
+TEST(SensorConfig, ReadsEverySectionInUserUnits) {
+  const SensorConfig c = ParseSensorConfig(R"(
+lms200: {fov_deg: 100, resolution_deg: 0.25, range_mode: mm, noise_sigma_m: 0, baud: 38400}
+pitch_unit: {step_deg: 0.9}
+scan: {pitch_start_deg: -10, pitch_end_deg: 30, lines: 50}
+mount: {t_base_mount_m: [0.2, 0, 0.5], misalignment_rpy_deg: [0, 0.5, 0]}
+robot: {model: p3dx}   # another module's section: left alone
+)",
+                                           "test.yaml");
+  EXPECT_EQ(c.lms200.range_mode, Lms200RangeMode::kMm);
+  EXPECT_EQ(c.lms200.baud, 38400);
+  EXPECT_EQ(c.pitch_unit.step_deg, 0.9);
+  EXPECT_EQ(c.scan.lines, 50);
+  EXPECT_DOUBLE_EQ(c.mount.t_base_mount_m.x(), 0.2);
+  EXPECT_NEAR(c.mount.misalignment_rpy_rad.y(), 0.5 * kDeg, 1e-15);
+}
+
+TEST(SensorConfig, ErrorsNameTheFileTheFieldAndTheValue) {
+  auto message = [](const char* yaml) {
+    try {
+      ParseSensorConfig(yaml, "my.yaml");
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message("lms200: {fov_deg: 270}").find("my.yaml: lms200.fov_deg = 270"),
+            std::string::npos);
+  EXPECT_NE(message("lms200: {fov: 180}").find("lms200.fov is not a known setting"),
+            std::string::npos);
+  EXPECT_NE(message("scan: {lines: many}").find("scan.lines has the wrong type ('many')"),
+            std::string::npos);
+  EXPECT_NE(message("lms200: {range_mode: km}").find("lms200.range_mode"), std::string::npos);
+  EXPECT_NE(message("[1, 2").find("not valid YAML"), std::string::npos);
+}
+
+TEST(SensorConfig, WrittenYamlReadsBackTheSame) {
+  SensorConfig c;
+  c.lms200.seed = 1234567890123ULL;
+  c.lms200.range_mode = Lms200RangeMode::kMm;
+  c.mount.misalignment_rpy_rad = {0.001, -0.002, 0.003};
+  const SensorConfig back = ParseSensorConfig(SensorConfigToYaml(c), "roundtrip");
+  EXPECT_EQ(back.lms200.seed, c.lms200.seed);
+  EXPECT_EQ(back.lms200.range_mode, c.lms200.range_mode);
+  EXPECT_TRUE(back.mount.misalignment_rpy_rad.isApprox(c.mount.misalignment_rpy_rad, 1e-14));
+  EXPECT_EQ(SensorConfigToYaml(back), SensorConfigToYaml(c));
+}
+
+}  // namespace
+}  // namespace pitchlab::sensors
