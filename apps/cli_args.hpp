@@ -1,0 +1,58 @@
+#pragma once
+// A small command-line parser for pitchlab's subcommands: `--name value`, `--flag`, positionals,
+// and a generated --help. Errors throw CliError with a message for the user.
+
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace pitchlab::apps {
+
+/// A user mistake on the command line; main prints it with the subcommand's usage, exits 2.
+struct CliError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Declares the options of one subcommand, then parses argv against them.
+class CliArgs {
+ public:
+  CliArgs(std::string command, std::string summary);
+
+  /// An option taking a value; `placeholder` is shown in --help (e.g. "x,y,yaw").
+  CliArgs& Option(const std::string& name, const std::string& placeholder, const std::string& help,
+                  std::optional<std::string> default_value = std::nullopt);
+  /// A boolean switch.
+  CliArgs& Flag(const std::string& name, const std::string& help);
+  /// Positional arguments: `name` shown in --help; min..max of them accepted.
+  CliArgs& Positionals(const std::string& name, const std::string& help, int min, int max);
+
+  /// Parses argv (after the subcommand). Returns false when --help was asked (usage printed).
+  bool Parse(int argc, char** argv);
+
+  std::string Usage() const;
+  bool Has(const std::string& name) const;               ///< given or defaulted
+  std::string Get(const std::string& name) const;        ///< throws CliError when missing
+  bool Flagged(const std::string& name) const;
+  const std::vector<std::string>& positionals() const { return positionals_; }
+
+  /// "1.5,-2,90" -> {1.5, -2, 90}; exactly `count` finite numbers or CliError naming the option.
+  std::vector<double> GetNumbers(const std::string& name, std::size_t count) const;
+
+ private:
+  struct Spec {
+    std::string placeholder, help;
+    std::optional<std::string> default_value;
+    bool is_flag = false;
+  };
+  std::string command_, summary_;
+  std::vector<std::string> order_;
+  std::map<std::string, Spec> specs_;
+  std::map<std::string, std::string> values_;
+  std::string positional_name_, positional_help_;
+  int positional_min_ = 0, positional_max_ = 0;
+  std::vector<std::string> positionals_;
+};
+
+}  // namespace pitchlab::apps
