@@ -36,7 +36,9 @@ class RayCaster {
 };
 
 /// Embree scene built from the model's planes, boxes, spheres, capsules, cylinders, ellipsoids,
-/// meshes and heightfields. `data` must outlive the caster. Throws std::runtime_error on failure.
+/// meshes and heightfields. `data` must outlive the caster and hold a forward pass (mj_forward):
+/// static geoms are posed from it once, here. Throws std::runtime_error on failure (Embree's
+/// message included).
 std::unique_ptr<RayCaster> MakeEmbreeRayCaster(const mjModel_* model, const mjData_* data,
                                                const RayCasterOptions& options = {});
 
