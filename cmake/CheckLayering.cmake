@@ -1,4 +1,5 @@
 # Fails when a module includes a pitchlab module that DESIGN.md's dependency direction forbids.
+cmake_minimum_required(VERSION 3.22)
 # Run as: cmake -DSOURCE_DIR=<repo> -P CheckLayering.cmake
 set(allowed_sensors sensors)
 set(allowed_sim sim sensors)

@@ -1,0 +1,72 @@
+#pragma once
+
+#include <mujoco/mujoco.h>
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <random>
+#include <string>
+
+namespace pitchlab::worlds::test {
+
+/// Owning handles for MuJoCo's C objects.
+struct ModelDeleter {
+  void operator()(mjModel* m) const { mj_deleteModel(m); }
+};
+struct DataDeleter {
+  void operator()(mjData* d) const { mj_deleteData(d); }
+};
+using ModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
+using DataPtr = std::unique_ptr<mjData, DataDeleter>;
+
+/// Loads an MJCF file; fails the test with MuJoCo's message if it does not compile.
+inline ModelPtr LoadModel(const std::filesystem::path& path) {
+  char error[1000] = "";
+  ModelPtr model(mj_loadXML(path.string().c_str(), nullptr, error, sizeof(error)));
+  EXPECT_TRUE(model) << path << ": " << error;
+  return model;
+}
+
+/// Height of the first surface straight below (x, y), cast from `from_z_m`; NaN when nothing is
+/// hit.
+inline double SurfaceHeight(const mjModel* m, mjData* d, double x, double y,
+                            double from_z_m = 200.0) {
+  const mjtNum origin[3] = {x, y, from_z_m};
+  const mjtNum down[3] = {0.0, 0.0, -1.0};
+  int geom = -1;
+  const mjtNum distance = mj_ray(m, d, origin, down, nullptr, 1, -1, &geom);
+  return distance < 0 ? std::nan("") : from_z_m - distance;
+}
+
+/// A fresh, empty folder under the system temp dir, removed with the object.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& tag) {
+    std::random_device device;
+    path_ = std::filesystem::temp_directory_path() /
+            ("pitchlab_worlds_" + tag + "_" + std::to_string(device()));
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() { std::filesystem::remove_all(path_); }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// The whole file as bytes.
+inline std::string ReadBytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+/// Writes `text` to `path`.
+inline void WriteText(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream(path) << text;
+}
+
+}  // namespace pitchlab::worlds::test

@@ -1,0 +1,51 @@
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "pitchlab/worlds/dem_projection.hpp"
+
+namespace pitchlab::worlds {
+
+/// A heightfield world built from a user's DEM (ESRI ASCII grid).
+struct DemWorldConfig {
+  std::filesystem::path dem_path;            ///< the .asc file
+  std::optional<DemPlacement> placement;     ///< absent: lon/lat if a .prj says GEOGCS, else local
+  double cell_m = 0.2;                       ///< output vertex spacing [m]
+  std::optional<std::uint64_t> relief_seed;  ///< add seeded rocks and cracks when given
+  std::string description;                   ///< empty: derived from the file name
+};
+
+/// A DEM world before it is written: the surface, its metadata and how the DEM was placed.
+struct DemWorld {
+  HeightGrid grid;         ///< surface heights in the local ENU frame [m]
+  WorldMetadata metadata;  ///< description, geodetic origin, bounds, flattest start
+  DemPlacement placement;  ///< the coordinates used (given or detected)
+  std::string comment;     ///< provenance line for the MJCF (file, placement, cell, seed)
+};
+
+/// Loads, places, resamples and (optionally) roughens the DEM. Throws std::runtime_error /
+/// std::invalid_argument naming the DEM file and the problem; asks for explicit coordinates when a
+/// grid without .prj has a cell size that looks like degrees.
+DemWorld BuildDemWorld(const DemWorldConfig& config);
+
+/// BuildDemWorld, then writes `out_xml` and its `<stem>_hfield.bin`; returns the placement used.
+DemPlacement GenerateDemWorld(const DemWorldConfig& config, const std::filesystem::path& out_xml);
+
+/// The `gully` world: west_bijou_gully.asc (3 m, UTM 13N) upsampled to `cell_m` with relief.
+struct GullyConfig {
+  std::filesystem::path dem_path;    ///< west_bijou_gully.asc
+  double cell_m = 0.15;              ///< [m]
+  std::uint64_t relief_seed = 3980;  ///< the default world's seed
+};
+
+/// The DemWorldConfig of the gully world (UTM 13N, relief on).
+DemWorldConfig GullyDemConfig(const GullyConfig& config);
+
+/// Writes gully.xml and gully_hfield.bin into `out_dir`; returns the XML's path.
+std::filesystem::path GenerateGullyWorld(const GullyConfig& config,
+                                         const std::filesystem::path& out_dir);
+
+}  // namespace pitchlab::worlds

@@ -1,0 +1,155 @@
+// pitchlab_worldgen: writes the procedural worlds (and worlds from users' DEMs). A thin shell over
+// the worlds library: parse flags, call one generator, report errors once with a non-zero exit.
+#include <cstdint>
+#include <cstdlib>
+#include <iostream>
+#include <map>
+#include <stdexcept>
+#include <string>
+
+#include "pitchlab/worlds/dem_world.hpp"
+#include "pitchlab/worlds/terrain_generator.hpp"
+
+namespace {
+
+constexpr const char* kUsage = R"(usage: pitchlab_worldgen <command> [options]
+
+commands:
+  terrain --out DIR [--seed N] [--cell M] [--size M]
+      procedural outdoor terrain -> DIR/terrain.xml + DIR/terrain_hfield.bin
+  gully --dem FILE.asc --out DIR [--relief-seed N] [--cell M]
+      the West Bijou gully (3 m DEM, UTM 13N) -> DIR/gully.xml + DIR/gully_hfield.bin
+  dem --in FILE.asc --out DIR/NAME.xml [--utm-zone 13N | --geographic | --local]
+      [--cell M] [--relief-seed N]
+      any ESRI ASCII grid -> NAME.xml + NAME_hfield.bin; lon/lat is detected from a .prj with
+      GEOGCS, otherwise give the coordinates; the geodetic origin is the valid data's centre
+
+options:
+  --cell M   output vertex spacing [m] (terrain 0.1, gully 0.15, dem 0.2)
+  --help     this text
+)";
+
+// "--key value" pairs and "--flag" switches after the command.
+std::map<std::string, std::string> ParseFlags(int argc, char** argv) {
+  std::map<std::string, std::string> flags;
+  for (int i = 2; i < argc; ++i) {
+    const std::string key = argv[i];
+    if (key.rfind("--", 0) != 0) throw std::invalid_argument("unexpected argument '" + key + "'");
+    const bool is_switch = key == "--geographic" || key == "--local" || key == "--help";
+    if (is_switch) {
+      flags[key] = "";
+    } else if (i + 1 < argc) {
+      flags[key] = argv[++i];
+    } else {
+      throw std::invalid_argument("option " + key + " needs a value");
+    }
+  }
+  return flags;
+}
+
+std::string Require(const std::map<std::string, std::string>& flags, const std::string& key) {
+  const auto it = flags.find(key);
+  if (it == flags.end()) throw std::invalid_argument("missing required option " + key);
+  return it->second;
+}
+
+double NumberFlag(const std::map<std::string, std::string>& flags, const std::string& key,
+                  double fallback) {
+  const auto it = flags.find(key);
+  if (it == flags.end()) return fallback;
+  size_t used = 0;
+  double value = 0.0;
+  try {
+    value = std::stod(it->second, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != it->second.size() || !(value > 0.0)) {
+    throw std::invalid_argument("option " + key + ": expected a positive number, got '" +
+                                it->second + "'");
+  }
+  return value;
+}
+
+std::uint64_t SeedFlag(const std::map<std::string, std::string>& flags, const std::string& key,
+                       std::uint64_t fallback) {
+  const auto it = flags.find(key);
+  if (it == flags.end()) return fallback;
+  const std::string& text = it->second;
+  if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos) {
+    throw std::invalid_argument("option " + key + ": expected a non-negative integer, got '" +
+                                text + "'");
+  }
+  return std::stoull(text);
+}
+
+void CheckKnown(const std::map<std::string, std::string>& flags,
+                std::initializer_list<const char*> known) {
+  for (const auto& [key, value] : flags) {
+    bool found = false;
+    for (const char* k : known) found = found || key == k;
+    if (!found) throw std::invalid_argument("unknown option " + key);
+  }
+}
+
+int Run(int argc, char** argv) {
+  using namespace pitchlab::worlds;
+  const std::string command = argc > 1 ? argv[1] : "";
+  if (command.empty() || command == "--help" || command == "-h" || command == "help") {
+    std::cout << kUsage;
+    return command.empty() ? 2 : 0;
+  }
+  const auto flags = ParseFlags(argc, argv);
+  if (flags.count("--help")) {
+    std::cout << kUsage;
+    return 0;
+  }
+  if (command == "terrain") {
+    CheckKnown(flags, {"--out", "--seed", "--cell", "--size"});
+    TerrainConfig config;
+    config.seed = SeedFlag(flags, "--seed", config.seed);
+    config.cell_m = NumberFlag(flags, "--cell", config.cell_m);
+    config.size_m = NumberFlag(flags, "--size", config.size_m);
+    std::cout << GenerateTerrainWorld(config, Require(flags, "--out")).string() << "\n";
+  } else if (command == "gully") {
+    CheckKnown(flags, {"--dem", "--out", "--relief-seed", "--cell"});
+    GullyConfig config;
+    config.dem_path = Require(flags, "--dem");
+    config.relief_seed = SeedFlag(flags, "--relief-seed", config.relief_seed);
+    config.cell_m = NumberFlag(flags, "--cell", config.cell_m);
+    std::cout << GenerateGullyWorld(config, Require(flags, "--out")).string() << "\n";
+  } else if (command == "dem") {
+    CheckKnown(flags, {"--in", "--out", "--utm-zone", "--geographic", "--local", "--cell",
+                       "--relief-seed"});
+    DemWorldConfig config;
+    config.dem_path = Require(flags, "--in");
+    config.cell_m = NumberFlag(flags, "--cell", config.cell_m);
+    if (flags.count("--relief-seed")) config.relief_seed = SeedFlag(flags, "--relief-seed", 0);
+    if (flags.count("--utm-zone") + flags.count("--geographic") + flags.count("--local") > 1) {
+      throw std::invalid_argument("give at most one of --utm-zone, --geographic, --local");
+    }
+    if (flags.count("--utm-zone")) config.placement = ParseUtmZone(flags.at("--utm-zone"));
+    if (flags.count("--geographic")) config.placement = DemPlacement{DemCoordinates::kGeographic};
+    if (flags.count("--local")) config.placement = DemPlacement{DemCoordinates::kLocal};
+    const std::string out = Require(flags, "--out");
+    if (std::filesystem::path(out).extension() != ".xml") {
+      throw std::invalid_argument("--out must name an .xml file, got '" + out + "'");
+    }
+    GenerateDemWorld(config, out);
+    std::cout << out << "\n";
+  } else {
+    throw std::invalid_argument("unknown command '" + command + "' (see --help)");
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return Run(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "pitchlab_worldgen: " << e.what() << "\n";
+    return 1;
+  }
+}
