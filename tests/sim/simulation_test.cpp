@@ -1,0 +1,189 @@
+#include "pitchlab/sim/simulation.hpp"
+
+#include <dirent.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
+#include "pitchlab/sim/robot_model.hpp"
+#include "pitchlab/sim/world.hpp"
+#include "sim_test_worlds.hpp"
+
+namespace pitchlab::sim {
+namespace {
+
+using testing::kFlatWorld;
+using testing::kWallWorld;
+
+constexpr double kGroundTolerance_m = 0.005;  // tyre/contact softness sag
+constexpr double kMountTolerance_m = 0.005;
+
+RobotConfig Robot(P3Model model) {
+  RobotConfig c;
+  c.model = model;
+  return c;
+}
+
+class RobotModels : public ::testing::TestWithParam<P3Model> {};
+INSTANTIATE_TEST_SUITE_P(Sim, RobotModels, ::testing::Values(P3Model::kP3AT, P3Model::kP3DX),
+                         [](const auto& info) {
+                           return std::string(info.param == P3Model::kP3AT ? "P3AT" : "P3DX");
+                         });
+
+TEST_P(RobotModels, RobotDocumentLoadsInMujocoWithAllNamedElements) {
+  const std::string xml = RobotMjcfDocument(Robot(GetParam()));
+  char path[] = "/tmp/pitchlab_robot_test_XXXXXX.xml";
+  const int fd = mkstemps(path, 4);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(write(fd, xml.data(), xml.size()), static_cast<ssize_t>(xml.size()));
+  close(fd);
+  char error[1000] = "";
+  mjModel* m = mj_loadXML(path, nullptr, error, sizeof error);
+  unlink(path);
+  ASSERT_NE(m, nullptr) << error;
+  EXPECT_GE(mj_name2id(m, mjOBJ_BODY, kRobotBody), 0);
+  EXPECT_GE(mj_name2id(m, mjOBJ_SITE, kBaseLinkSite), 0);
+  EXPECT_GE(mj_name2id(m, mjOBJ_SITE, kLaserSite), 0);
+  EXPECT_GE(mj_name2id(m, mjOBJ_JOINT, kPitchJoint), 0);
+  EXPECT_GE(mj_name2id(m, mjOBJ_ACTUATOR, kPitchActuator), 0);
+  const P3Params& p = ParamsFor(GetParam());
+  const int body = mj_name2id(m, mjOBJ_BODY, kRobotBody);
+  EXPECT_NEAR(m->body_subtreemass[body], p.base_mass_kg + p.laser_mass_kg, 1e-6);
+  mj_deleteModel(m);
+}
+
+TEST_P(RobotModels, SettlesOnFlatFloorWithBaseLinkAtGroundAndLaserAtMountHeight) {
+  const RobotConfig robot = Robot(GetParam());
+  auto sim = Simulation::FromString(kFlatWorld, "/tmp", robot);
+  Result<Eigen::Isometry3d> pose = sim->PlaceRobot(0.5, -1.0, 0.3);
+  ASSERT_TRUE(pose) << pose.error().message;
+  EXPECT_NEAR(pose->translation().z(), 0.0, kGroundTolerance_m);
+  EXPECT_NEAR(pose->translation().x(), 0.5, 0.01);
+  EXPECT_NEAR(pose->translation().y(), -1.0, 0.01);
+  const Eigen::Isometry3d T_world_laser = sim->T_world_laser();
+  const double mount_z = (robot.mount.t_base_mount_m + robot.mount.t_mount_laser_m).z();
+  EXPECT_NEAR(T_world_laser.translation().z(), mount_z, kMountTolerance_m);
+  // The generated site agrees with the mount model (Eq. 1's frames).
+  const Eigen::Isometry3d T_base_laser = pose->inverse() * T_world_laser;
+  const Eigen::Isometry3d expected = robot.mount.BaseToLaser(sim->pitch_rad());
+  EXPECT_TRUE(T_base_laser.isApprox(expected, 1e-3)) << T_base_laser.matrix();
+  EXPECT_TRUE(sim->TakeWarnings().empty());
+}
+
+TEST(Simulation, ReadsThePitchlabCustomFields) {
+  auto sim = Simulation::FromString(kFlatWorld, "/tmp", Robot(P3Model::kP3DX));
+  const WorldInfo& w = sim->world();
+  EXPECT_EQ(w.description, "flat test floor");
+  ASSERT_TRUE(w.bounds);
+  EXPECT_EQ(*w.bounds, Eigen::Vector4d(-9, -9, 9, 9));
+  ASSERT_TRUE(w.default_start);
+  EXPECT_NEAR((*w.default_start)[2], M_PI / 2, 1e-12);
+  ASSERT_TRUE(w.geodetic_origin);
+  EXPECT_NEAR(sim->timestep_s(), 0.002, 1e-12);
+}
+
+TEST(Simulation, PlacementInsideAnObstacleIsAClearError) {
+  auto sim = Simulation::FromString(kFlatWorld, "/tmp", Robot(P3Model::kP3AT));
+  Result<Eigen::Isometry3d> pose = sim->PlaceRobot(5.0, 0.0, 0.0);
+  ASSERT_FALSE(pose);
+  EXPECT_EQ(pose.error().code, Error::Code::kInvalidArgument);
+  EXPECT_NE(pose.error().message.find("obstacle"), std::string::npos) << pose.error().message;
+}
+
+TEST(Simulation, PlacementOverlappingAnObstacleEdgeIsAClearError) {
+  auto sim = Simulation::FromString(kFlatWorld, "/tmp", Robot(P3Model::kP3AT));
+  Result<Eigen::Isometry3d> pose = sim->PlaceRobot(4.35, 0.0, 0.0);  // nose 0.1 m into the box
+  ASSERT_FALSE(pose);
+  EXPECT_NE(pose.error().message.find("obstacle"), std::string::npos) << pose.error().message;
+}
+
+TEST(Simulation, PlacementOutsideTheBoundsIsAClearError) {
+  auto sim = Simulation::FromString(kFlatWorld, "/tmp", Robot(P3Model::kP3AT));
+  Result<Eigen::Isometry3d> pose = sim->PlaceRobot(9.5, 0.0, 0.0);
+  ASSERT_FALSE(pose);
+  EXPECT_NE(pose.error().message.find("bounds"), std::string::npos) << pose.error().message;
+}
+
+TEST(Simulation, PlacementOffTheWorldIsAClearError) {
+  auto sim = Simulation::FromString(kWallWorld, "/tmp", Robot(P3Model::kP3DX));
+  Result<Eigen::Isometry3d> pose = sim->PlaceRobot(-9.9, 0.0, 0.0);  // half over the floor's edge
+  ASSERT_FALSE(pose);
+  EXPECT_NE(pose.error().message.find("off the world"), std::string::npos) << pose.error().message;
+  EXPECT_FALSE(sim->PlaceRobot(-30.0, 0.0, 0.0));
+  EXPECT_TRUE(sim->PlaceRobot(0.0, 0.0, 0.0));  // and the simulation is still usable
+}
+
+TEST(Simulation, BrokenWorldThrowsWithThePathAndMujocosMessage) {
+  const std::string path = "/tmp/pitchlab_sim_test_broken.xml";
+  std::ofstream(path) << "<mujoco><worldbody><geom type=\"sphere\"/></worldbody></mujoco>";
+  try {
+    Simulation sim(path, Robot(P3Model::kP3DX));
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("size"), std::string::npos) << e.what();
+  }
+  std::remove(path.c_str());
+  EXPECT_THROW(Simulation("/nonexistent/world.xml", Robot(P3Model::kP3DX)), std::runtime_error);
+}
+
+int CountFiles(const std::string& dir) {
+  int n = 0;
+  DIR* d = opendir(dir.c_str());
+  while (dirent* e = readdir(d)) n += e->d_name[0] != '.';
+  closedir(d);
+  return n;
+}
+
+TEST(Simulation, HeightfieldFileResolvesAgainstTheWorldFolderWhichStaysUntouched) {
+  char dir[] = "/tmp/pitchlab_world_dir_XXXXXX";
+  ASSERT_NE(mkdtemp(dir), nullptr);
+  const std::string world_dir = dir;
+  {
+    std::ofstream hf(world_dir + "/flat.bin", std::ios::binary);
+    const int32_t rows = 3, cols = 3;
+    hf.write(reinterpret_cast<const char*>(&rows), 4).write(reinterpret_cast<const char*>(&cols), 4);
+    const float zero[9] = {};
+    hf.write(reinterpret_cast<const char*>(zero), sizeof zero);
+  }
+  std::ofstream(world_dir + "/terrain.xml") << R"(<mujoco>
+    <asset><hfield name="ground" file="flat.bin" size="10 10 1 0.1"/></asset>
+    <worldbody><geom name="terrain" type="hfield" hfield="ground" pos="0 0 0.2"/></worldbody>
+  </mujoco>)";
+  const int before = CountFiles(world_dir);
+  {
+    Simulation sim(world_dir + "/terrain.xml", Robot(P3Model::kP3AT));
+    Result<Eigen::Isometry3d> pose = sim.PlaceRobot(1.0, 1.0, 0.0);
+    ASSERT_TRUE(pose) << pose.error().message;
+    EXPECT_NEAR(pose->translation().z(), 0.2, 0.01);  // hfield at z = 0.2, all heights 0
+  }
+  EXPECT_EQ(CountFiles(world_dir), before);
+  std::remove((world_dir + "/flat.bin").c_str());
+  std::remove((world_dir + "/terrain.xml").c_str());
+  rmdir(dir);
+}
+
+TEST(ComposeWorldXml, MakesRelativeAssetPathsAbsoluteAndKeepsAbsoluteOnes) {
+  const std::string xml = ComposeWorldXml(R"(<mujoco>
+    <compiler texturedir="tex"/>
+    <asset><hfield name="h" file="a/h.bin" size="1 1 1 1"/>
+      <texture name="t" file="t.png"/><mesh name="m" file="/abs/m.stl"/></asset>
+    <worldbody/></mujoco>)", "/w", Robot(P3Model::kP3DX));
+  EXPECT_NE(xml.find("file=\"/w/a/h.bin\""), std::string::npos);
+  EXPECT_NE(xml.find("texturedir=\"/w/tex\""), std::string::npos);
+  EXPECT_NE(xml.find("file=\"t.png\""), std::string::npos);  // under the absolute texturedir
+  EXPECT_NE(xml.find("file=\"/abs/m.stl\""), std::string::npos);
+  EXPECT_NE(xml.find("<body name=\"robot\""), std::string::npos);
+  EXPECT_THROW(ComposeWorldXml("<mujoco></mujoco>", "/w", Robot(P3Model::kP3DX)),
+               std::runtime_error);
+}
+
+}  // namespace
+}  // namespace pitchlab::sim
