@@ -1,0 +1,10 @@
+#pragma once
+// The pitchlab subcommands. Each takes the arguments after its name and returns the exit code;
+// errors a user can fix are thrown (CliError: exit 2; anything else: exit 1) and printed by main.
+
+namespace pitchlab::apps {
+
+/// `pitchlab scan`: one full 3D scan of a world written as PCD.
+int RunScan(int argc, char** argv);
+
+}  // namespace pitchlab::apps

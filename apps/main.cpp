@@ -1,0 +1,52 @@
+// pitchlab: the command-line entry point. Dispatches to subcommands; the only place that catches
+// and prints errors and picks the exit code (STYLE.md "Errors").
+
+#include <cstring>
+#include <exception>
+#include <iostream>
+#include <string>
+
+#include "cli_args.hpp"
+#include "commands.hpp"
+
+namespace {
+
+struct Command {
+  const char* name;
+  int (*run)(int, char**);
+  const char* summary;
+};
+
+constexpr Command kCommands[] = {
+    {"scan", pitchlab::apps::RunScan, "one full 3D scan of a world, written as PCD"},
+};
+
+void PrintUsage(std::ostream& os) {
+  os << "usage: pitchlab <command> [options]   (pitchlab <command> --help for its options)\n\n"
+        "pitchlab: pitching-LMS200 3D mapping and elevation-map planning testbed\n\ncommands:\n";
+  for (const Command& c : kCommands) os << "  " << c.name << "\t" << c.summary << "\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
+    PrintUsage(argc < 2 ? std::cerr : std::cout);
+    return argc < 2 ? 2 : 0;
+  }
+  for (const Command& c : kCommands) {
+    if (std::string(argv[1]) != c.name) continue;
+    try {
+      return c.run(argc - 2, argv + 2);
+    } catch (const pitchlab::apps::CliError& e) {
+      std::cerr << "pitchlab " << c.name << ": " << e.what() << "\n";
+      return 2;
+    } catch (const std::exception& e) {
+      std::cerr << "pitchlab " << c.name << ": error: " << e.what() << "\n";
+      return 1;
+    }
+  }
+  std::cerr << "pitchlab: unknown command '" << argv[1] << "'\n\n";
+  PrintUsage(std::cerr);
+  return 2;
+}
