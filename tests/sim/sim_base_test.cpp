@@ -12,8 +12,8 @@ namespace {
 
 using testing::kFlatWorld;
 
-constexpr double kDistanceTolerance = 0.05;   // relative, for tyre slip and servo lag [1]
-constexpr double kOdometryAgreement = 0.03;   // odometry vs truth, noise off [1]
+constexpr double kDistanceTolerance = 0.05;  // relative, for tyre slip and servo lag [1]
+constexpr double kOdometryAgreement = 0.03;  // odometry vs truth, noise off [1]
 
 double Yaw(const Eigen::Isometry3d& T) { return std::atan2(T.linear()(1, 0), T.linear()(0, 0)); }
 

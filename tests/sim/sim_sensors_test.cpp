@@ -58,9 +58,11 @@ TEST(SimPitchAxis, TooShortATimeoutIsATimeoutError) {
 }
 
 class BothCasters : public ::testing::TestWithParam<CasterKind> {};
-INSTANTIATE_TEST_SUITE_P(Sim, BothCasters, ::testing::Values(CasterKind::kEmbree, CasterKind::kMujoco),
+INSTANTIATE_TEST_SUITE_P(Sim, BothCasters,
+                         ::testing::Values(CasterKind::kEmbree, CasterKind::kMujoco),
                          [](const auto& info) {
-                           return std::string(info.param == CasterKind::kEmbree ? "Embree" : "Mujoco");
+                           return std::string(info.param == CasterKind::kEmbree ? "Embree"
+                                                                                : "Mujoco");
                          });
 
 TEST_P(BothCasters, ALineOfAWallGivesTheKnownRanges) {
@@ -104,6 +106,35 @@ TEST(SimRig, AcquireGivesAScanWithGroundTruthAndTheWallInBaseLink) {
   }
   EXPECT_GT(on_wall, 5 * 200);
   EXPECT_EQ(on_wall + on_floor, static_cast<int>(scan->points.size()));  // nothing else in view
+}
+
+TEST(SimLineScanner, MixedPixelsCastsTheBeamEdgesToo) {
+  SimRigConfig config = QuietConfig();
+  config.lms200.mixed_pixels = true;
+  auto rig = MakeRig(config);
+  Result<sensors::LaserLine> line = rig->scanner().NextLine(kTimeout);
+  ASSERT_TRUE(line) << line.error().message;
+  const std::size_t ahead = 180;  // theta = 0: the flat wall, no depth edge
+  ASSERT_EQ(line->status[ahead], sensors::ReadingStatus::kValid);
+  EXPECT_NEAR(line->ranges_m[ahead], 3.0 - rig->sim().T_world_laser().translation().x(),
+              kRangeTolerance_m);
+}
+
+TEST(SimRig, TheSeedPatternTakesItsLinePeriodsPlusServoMovesOfSimulatedTime) {
+  SimRigConfig config = QuietConfig();
+  config.pattern = sensors::ScanPatternConfig{};  // 200 lines over -40 .. 60 deg
+  auto rig = MakeRig(config);
+  Result<sensors::Scan3D> scan = rig->Acquire();
+  ASSERT_TRUE(scan) << scan.error().message;
+  EXPECT_EQ(scan->lines.size(), 200u);
+  // Lower bound: every line's period plus every servo move's MoveTime (slew + settle_s).
+  const sensors::PitchUnitModel& servo = rig->pitch_axis().model();
+  double bound_s = 200 * rig->scanner().model().line_period_s();
+  for (std::size_t k = 1; k < scan->lines.size(); ++k) {
+    bound_s += servo.MoveTime(scan->lines[k - 1].pitch_rad, scan->lines[k].pitch_rad);
+  }
+  EXPECT_GT(scan->duration_s, bound_s - 0.1);
+  EXPECT_LT(scan->duration_s, 1.4 * bound_s);  // settling to half an encoder count costs < 40 %
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
@@ -149,7 +150,8 @@ TEST(Simulation, HeightfieldFileResolvesAgainstTheWorldFolderWhichStaysUntouched
   {
     std::ofstream hf(world_dir + "/flat.bin", std::ios::binary);
     const int32_t rows = 3, cols = 3;
-    hf.write(reinterpret_cast<const char*>(&rows), 4).write(reinterpret_cast<const char*>(&cols), 4);
+    hf.write(reinterpret_cast<const char*>(&rows), 4)
+        .write(reinterpret_cast<const char*>(&cols), 4);
     const float zero[9] = {};
     hf.write(reinterpret_cast<const char*>(zero), sizeof zero);
   }
@@ -175,7 +177,8 @@ TEST(ComposeWorldXml, MakesRelativeAssetPathsAbsoluteAndKeepsAbsoluteOnes) {
     <compiler texturedir="tex"/>
     <asset><hfield name="h" file="a/h.bin" size="1 1 1 1"/>
       <texture name="t" file="t.png"/><mesh name="m" file="/abs/m.stl"/></asset>
-    <worldbody/></mujoco>)", "/w", Robot(P3Model::kP3DX));
+    <worldbody/></mujoco>)",
+                                          "/w", Robot(P3Model::kP3DX));
   EXPECT_NE(xml.find("file=\"/w/a/h.bin\""), std::string::npos);
   EXPECT_NE(xml.find("texturedir=\"/w/tex\""), std::string::npos);
   EXPECT_NE(xml.find("file=\"t.png\""), std::string::npos);  // under the absolute texturedir
@@ -183,6 +186,35 @@ TEST(ComposeWorldXml, MakesRelativeAssetPathsAbsoluteAndKeepsAbsoluteOnes) {
   EXPECT_NE(xml.find("<body name=\"robot\""), std::string::npos);
   EXPECT_THROW(ComposeWorldXml("<mujoco></mujoco>", "/w", Robot(P3Model::kP3DX)),
                std::runtime_error);
+}
+
+}  // namespace
+}  // namespace pitchlab::sim
+
+namespace pitchlab::sim {
+namespace {
+
+// Every world the build generates loads with the robot, places at its default start and settles.
+TEST(Worlds, EveryBuildWorldPlacesBothRobotsAtItsDefaultStart) {
+  DIR* dir = opendir(PITCHLAB_WORLDS_DIR);
+  if (dir == nullptr) GTEST_SKIP() << "no worlds folder " << PITCHLAB_WORLDS_DIR;
+  std::vector<std::string> worlds;
+  while (dirent* e = readdir(dir)) {
+    const std::string name = e->d_name;
+    if (name.size() > 4 && name.substr(name.size() - 4) == ".xml") worlds.push_back(name);
+  }
+  closedir(dir);
+  for (const std::string& name : worlds) {
+    for (P3Model model : {P3Model::kP3AT, P3Model::kP3DX}) {
+      RobotConfig robot;
+      robot.model = model;
+      Simulation sim(std::string(PITCHLAB_WORLDS_DIR) + "/" + name, robot);
+      const Eigen::Vector3d start = sim.world().default_start.value_or(Eigen::Vector3d::Zero());
+      Result<Eigen::Isometry3d> pose = sim.PlaceRobot(start.x(), start.y(), start.z());
+      EXPECT_TRUE(pose) << name << ": " << pose.error().message;
+      EXPECT_TRUE(sim.TakeWarnings().empty()) << name;
+    }
+  }
 }
 
 }  // namespace

@@ -1,0 +1,35 @@
+#pragma once
+// The simulated LMS200 behind the LineScanner seam: one ray per beam from the "robot_laser" site,
+// cast by a sensors::RayCaster, turned into readings by sensors::Lms200Model.
+
+#include <vector>
+
+#include "pitchlab/sensors/lms200.hpp"
+#include "pitchlab/sensors/ray_caster.hpp"
+#include "pitchlab/sensors/scan_source.hpp"
+#include "pitchlab/sim/simulation.hpp"
+
+namespace pitchlab::sim {
+
+/// LineScanner on a Simulation. `caster` and `sim` must outlive it; the caster must have been
+/// built on sim.model()/sim.data() (it is Refresh()ed before every line).
+class SimLineScanner final : public sensors::LineScanner {
+ public:
+  SimLineScanner(Simulation& sim, sensors::RayCaster& caster, const sensors::Lms200Config& config);
+  /// Casts the line at the laser's current pose, stamps it with the sim time at its start and
+  /// advances the simulation by line_period_s(). kTimeout when the period exceeds `timeout`.
+  [[nodiscard]] Result<sensors::LaserLine> NextLine(std::chrono::milliseconds timeout) override;
+  const sensors::Lms200Model& model() const { return model_; }
+  /// Rays reach this far: 5 % beyond the range mode's maximum, so over-range can be flagged [m].
+  float cast_range_m() const;
+
+ private:
+  void CastAt(const Eigen::Isometry3d& T_world_laser, double offset_rad, std::vector<float>& out);
+
+  Simulation& sim_;
+  sensors::RayCaster& caster_;
+  sensors::Lms200Model model_;
+  std::vector<float> origins_, directions_, ranges_, edge_lo_, edge_hi_;
+};
+
+}  // namespace pitchlab::sim

@@ -1,0 +1,163 @@
+// Simulation::PlaceRobot: find the ground under the footprint, check it is free, drop and settle.
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "pitchlab/sim/simulation.hpp"
+#include "simulation_impl.hpp"
+
+namespace pitchlab::sim {
+namespace {
+
+constexpr double kNoHit = -1.0;
+
+std::string Xy(double x, double y) {
+  std::ostringstream os;
+  os.precision(3);
+  os << std::fixed << "(" << x << ", " << y << ")";
+  return os.str();
+}
+
+// Footprint sample points in the world: a 3 x 3 grid over the robot's length and width.
+std::vector<Eigen::Vector2d> FootprintSamples(const P3Params& p, double x, double y, double yaw) {
+  std::vector<Eigen::Vector2d> out;
+  const Eigen::Rotation2Dd R(yaw);
+  for (double fx : {-0.5, 0.0, 0.5}) {
+    for (double fy : {-0.5, 0.0, 0.5}) {
+      const Eigen::Vector2d local(p.footprint_x_m + fx * (p.length_m - 0.04),
+                                  fy * (p.width_m - 0.04));
+      out.push_back(Eigen::Vector2d(x, y) + R * local);
+    }
+  }
+  return out;
+}
+
+// Highest terrain (plane / heightfield) surface under (x, y) [m], or NaN. `from_z` is above all.
+double TerrainHeight(const mjModel* m, const mjData* d, const Eigen::Vector2d& xy, double from_z,
+                     bool any_terrain, const mjtByte* groups) {
+  const mjtNum pnt[3] = {xy.x(), xy.y(), from_z};
+  const mjtNum down[3] = {0, 0, -1};
+  double best = std::numeric_limits<double>::infinity();
+  if (!any_terrain) {  // worlds without planes or heightfields: the first static surface is ground
+    int geom = -1;
+    const double dist = mj_ray(m, d, pnt, down, groups, 1, -1, &geom);
+    return dist >= 0 ? from_z - dist : std::nan("");
+  }
+  for (int g = 0; g < m->ngeom; ++g) {
+    double dist = kNoHit;
+    if (m->geom_type[g] == mjGEOM_PLANE) {
+      dist = mju_rayGeom(d->geom_xpos + 3 * g, d->geom_xmat + 9 * g, m->geom_size + 3 * g, pnt,
+                         down, mjGEOM_PLANE);
+    } else if (m->geom_type[g] == mjGEOM_HFIELD) {
+      dist = mj_rayHfield(m, d, g, pnt, down);
+    }
+    if (dist >= 0 && dist < best) best = dist;
+  }
+  return std::isfinite(best) ? from_z - best : std::nan("");
+}
+
+}  // namespace
+
+Result<Eigen::Isometry3d> Simulation::PlaceRobot(double x_m, double y_m, double yaw_rad,
+                                                 const PlacementConfig& config) {
+  Impl& s = *impl_;
+  const P3Params& p = params();
+  if (world_.bounds) {
+    const Eigen::Vector4d& b = *world_.bounds;
+    if (x_m < b[0] || x_m > b[2] || y_m < b[1] || y_m > b[3]) {
+      std::ostringstream os;
+      os << "start " << Xy(x_m, y_m) << " is outside the world's pitchlab:bounds [" << b[0] << ", "
+         << b[1] << ", " << b[2] << ", " << b[3] << "] of " << world_.path;
+      return Fail(Error::Code::kInvalidArgument, os.str());
+    }
+  }
+
+  // 1. Ground under every footprint sample, ignoring the robot's own geoms.
+  mjtByte groups[mjNGROUP];
+  for (int i = 0; i < mjNGROUP; ++i) groups[i] = i == kRobotGeomGroup ? 0 : 1;
+  bool any_terrain = false;
+  for (int g = 0; g < s.m->ngeom; ++g)
+    any_terrain |= !s.InRobot(s.m->geom_bodyid[g]) && s.IsTerrain(g);
+  const double from_z = s.m->stat.center[2] + 2.0 * s.m->stat.extent + 100.0;
+  const std::vector<Eigen::Vector2d> samples = FootprintSamples(p, x_m, y_m, yaw_rad);
+  std::vector<double> ground(samples.size());
+  double ground_max = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    ground[i] = TerrainHeight(s.m, s.d, samples[i], from_z, any_terrain, groups);
+    if (std::isnan(ground[i])) {
+      return Fail(Error::Code::kInvalidArgument,
+                  "start " + Xy(x_m, y_m) + " is off the world: no ground under the footprint at " +
+                      Xy(samples[i].x(), samples[i].y()) + " in " + world_.path);
+    }
+    ground_max = std::max(ground_max, ground[i]);
+  }
+
+  // 2. Nothing may stand in the robot's volume above the ground (upward rays from step height).
+  const double envelope_m =
+      robot_.mount.t_base_mount_m.z() + robot_.mount.t_mount_laser_m.norm() + 0.1;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const mjtNum pnt[3] = {samples[i].x(), samples[i].y(), ground[i] + config.max_step_m};
+    const mjtNum up[3] = {0, 0, 1};
+    int geom = -1;
+    const double dist = mj_ray(s.m, s.d, pnt, up, groups, 1, -1, &geom);
+    if (dist >= 0 && dist < envelope_m) {
+      return Fail(Error::Code::kInvalidArgument,
+                  "start " + Xy(x_m, y_m) + " is inside or under an obstacle: geom " +
+                      s.GeomName(geom) + " is " + std::to_string(dist + config.max_step_m) +
+                      " m above the ground at " + Xy(samples[i].x(), samples[i].y()));
+    }
+  }
+
+  // 3. Put the robot just above the highest ground sample, at rest, and check for overlaps.
+  mjtNum* q = s.d->qpos + s.root_qpos;
+  q[0] = x_m, q[1] = y_m, q[2] = ground_max + config.drop_height_m;
+  q[3] = std::cos(yaw_rad / 2), q[4] = 0, q[5] = 0, q[6] = std::sin(yaw_rad / 2);
+  for (int j = 0; j < s.m->njnt; ++j) {
+    if (!s.InRobot(s.m->jnt_bodyid[j])) continue;
+    const int dofs = s.m->jnt_type[j] == mjJNT_FREE ? 6 : s.m->jnt_type[j] == mjJNT_BALL ? 3 : 1;
+    for (int k = 0; k < dofs; ++k) s.d->qvel[s.m->jnt_dofadr[j] + k] = 0;
+  }
+  SetWheelSpeeds(0, 0);
+  mj_forward(s.m, s.d);
+  for (int c = 0; c < s.d->ncon; ++c) {
+    const mjContact& con = s.d->contact[c];
+    const bool r1 = s.InRobot(s.m->geom_bodyid[con.geom1]),
+               r2 = s.InRobot(s.m->geom_bodyid[con.geom2]);
+    if (r1 == r2) continue;
+    const int other = r1 ? con.geom2 : con.geom1;
+    if (!s.IsTerrain(other) && con.dist < -config.max_penetration_m) {
+      return Fail(Error::Code::kInvalidArgument,
+                  "start " + Xy(x_m, y_m) + " overlaps obstacle geom " + s.GeomName(other) +
+                      " (penetration " + std::to_string(-con.dist) + " m)");
+    }
+  }
+
+  // 4. Let it settle: speeds below the thresholds for settle_hold_s.
+  const double t0 = time_s();
+  double still_since = t0;
+  while (true) {
+    Step(1);
+    const Eigen::Vector2d speeds = BaseSpeeds();
+    if (speeds[0] > config.settle_speed_mps || speeds[1] > config.settle_rate_rps)
+      still_since = time_s();
+    if (time_s() - still_since >= config.settle_hold_s) break;
+    if (time_s() - t0 > config.max_settle_s) {
+      return Fail(Error::Code::kFailed, "robot placed at " + Xy(x_m, y_m) +
+                                            " did not settle within " +
+                                            std::to_string(config.max_settle_s) + " s");
+    }
+  }
+
+  // 5. Upright enough to drive and scan?
+  const Eigen::Isometry3d T = T_world_base();
+  const double tilt_deg = std::acos(std::clamp(T.linear()(2, 2), -1.0, 1.0)) * 180.0 / M_PI;
+  if (tilt_deg > config.max_tilt_deg) {
+    return Fail(Error::Code::kFailed, "robot placed at " + Xy(x_m, y_m) + " settled tilted " +
+                                          std::to_string(tilt_deg) + " deg (limit " +
+                                          std::to_string(config.max_tilt_deg) + " deg)");
+  }
+  return T;
+}
+
+}  // namespace pitchlab::sim

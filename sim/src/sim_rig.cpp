@@ -1,0 +1,54 @@
+#include "pitchlab/sim/sim_rig.hpp"
+
+namespace pitchlab::sim {
+
+SimRig::SimRig(const std::string& world_path, const SimRigConfig& config)
+    : SimRig(std::make_unique<Simulation>(world_path, config.robot), config) {}
+
+std::unique_ptr<SimRig> SimRig::FromString(const std::string& world_xml,
+                                           const std::string& base_dir,
+                                           const SimRigConfig& config) {
+  return std::unique_ptr<SimRig>(
+      new SimRig(Simulation::FromString(world_xml, base_dir, config.robot), config));
+}
+
+SimRig::SimRig(std::unique_ptr<Simulation> sim, const SimRigConfig& config)
+    : config_(config), sim_(std::move(sim)) {
+  sensors::RayCasterOptions options;
+  options.exclude_subtree_of_body = kRobotBody;
+  caster_ = config_.caster == CasterKind::kEmbree
+                ? sensors::MakeEmbreeRayCaster(sim_->model(), sim_->data(), options)
+                : sensors::MakeMujocoRayCaster(sim_->model(), sim_->data(), options);
+  base_ = std::make_unique<SimBase>(*sim_, config_.odometry);
+  axis_ = std::make_unique<SimPitchAxis>(*sim_, config_.pitch_unit);
+  scanner_ = std::make_unique<SimLineScanner>(*sim_, *caster_, config_.lms200);
+  source_ = std::make_unique<sensors::PitchingScanSource>(*scanner_, *axis_, config_.pattern,
+                                                          config_.robot.mount);
+}
+
+SimRig::~SimRig() = default;
+
+Result<Eigen::Isometry3d> SimRig::PlaceRobot(double x_m, double y_m, double yaw_rad) {
+  Result<Eigen::Isometry3d> pose = sim_->PlaceRobot(x_m, y_m, yaw_rad, config_.placement);
+  base_->ResetOdometry();
+  return pose;
+}
+
+Result<Eigen::Isometry3d> SimRig::PlaceAtDefaultStart() {
+  const Eigen::Vector3d start = sim_->world().default_start.value_or(Eigen::Vector3d::Zero());
+  return PlaceRobot(start.x(), start.y(), start.z());
+}
+
+Result<sensors::Scan3D> SimRig::Acquire() {
+  if (Result<sensors::Odometry> stopped = base_->Stop(); !stopped) {
+    return Fail(stopped.error().code, "before the scan: " + stopped.error().message);
+  }
+  const Eigen::Isometry3d T_world_base = sim_->T_world_base();
+  Result<sensors::Scan3D> scan = source_->Acquire();
+  if (!scan) return scan;
+  scan->has_truth = true;
+  scan->T_world_base = T_world_base;
+  return scan;
+}
+
+}  // namespace pitchlab::sim

@@ -1,0 +1,274 @@
+#include "pitchlab/sim/simulation.hpp"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+#include <mujoco/mujoco.h>
+
+#include "mujoco_handlers.hpp"
+#include "robot_layout.hpp"
+#include "simulation_impl.hpp"
+
+namespace pitchlab::sim {
+namespace {
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("world " + path + ": cannot open the file");
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+std::string DirOf(const std::string& path) {
+  const std::size_t slash = path.rfind('/');
+  std::string dir = slash == std::string::npos ? "." : path.substr(0, slash);
+  if (dir.empty()) dir = "/";
+  if (dir.front() != '/') {
+    char cwd[4096];
+    if (getcwd(cwd, sizeof cwd) != nullptr) dir = std::string(cwd) + "/" + dir;
+  }
+  return dir;
+}
+
+// Writes the composed text to a private temp file, loads it and removes the file again.
+mjModel* LoadComposed(const std::string& xml, const std::string& source) {
+  const char* tmpdir = std::getenv("TMPDIR");
+  std::string path =
+      std::string(tmpdir && *tmpdir ? tmpdir : "/tmp") + "/pitchlab_world_XXXXXX.xml";
+  const int fd = mkstemps(path.data(), 4);
+  if (fd < 0) throw std::runtime_error("world " + source + ": cannot create a temp file " + path);
+  const bool written = write(fd, xml.data(), xml.size()) == static_cast<ssize_t>(xml.size());
+  close(fd);
+  char error[1024] = "";
+  mjModel* model = written ? mj_loadXML(path.c_str(), nullptr, error, sizeof error) : nullptr;
+  unlink(path.c_str());
+  if (!written) throw std::runtime_error("world " + source + ": cannot write temp file " + path);
+  if (model == nullptr) {
+    throw std::runtime_error("world " + source +
+                             ": MuJoCo cannot load it (with the robot spliced in; " +
+                             "Simulation::composed_xml shows the text): " + error);
+  }
+  return model;
+}
+
+int IdOrThrow(const mjModel* m, mjtObj type, const char* name) {
+  const int id = mj_name2id(m, type, name);
+  if (id < 0) throw std::runtime_error(std::string("robot model has no element named ") + name);
+  return id;
+}
+
+// Reads numeric pitchlab:<field> of exactly `n` values; throws naming the field when malformed.
+template <int N>
+std::optional<Eigen::Matrix<double, N, 1>> Numeric(const mjModel* m, const std::string& field,
+                                                   const std::string& source) {
+  const int id = mj_name2id(m, mjOBJ_NUMERIC, field.c_str());
+  if (id < 0) return std::nullopt;
+  if (m->numeric_size[id] != N) {
+    throw std::runtime_error("world " + source + ": custom numeric " + field + " has " +
+                             std::to_string(m->numeric_size[id]) + " values, expected " +
+                             std::to_string(N));
+  }
+  Eigen::Matrix<double, N, 1> v;
+  for (int i = 0; i < N; ++i) v[i] = m->numeric_data[m->numeric_adr[id] + i];
+  return v;
+}
+
+WorldInfo ReadWorldInfo(const mjModel* m, const std::string& source) {
+  WorldInfo info;
+  info.path = source;
+  const int text = mj_name2id(m, mjOBJ_TEXT, "pitchlab:description");
+  if (text >= 0) info.description = std::string(m->text_data + m->text_adr[text]);
+  info.geodetic_origin = Numeric<3>(m, "pitchlab:geodetic_origin", source);
+  info.bounds = Numeric<4>(m, "pitchlab:bounds", source);
+  if (info.bounds &&
+      !((*info.bounds)[0] < (*info.bounds)[2] && (*info.bounds)[1] < (*info.bounds)[3])) {
+    throw std::runtime_error("world " + source + ": pitchlab:bounds must be xmin ymin xmax ymax");
+  }
+  info.default_start = Numeric<3>(m, "pitchlab:default_start", source);
+  if (info.default_start) (*info.default_start)[2] *= M_PI / 180.0;  // yaw_deg -> rad
+  return info;
+}
+
+}  // namespace
+
+Simulation::Simulation(const std::string& world_path, const RobotConfig& robot)
+    : Simulation(ReadFile(world_path), DirOf(world_path), world_path, robot) {}
+
+std::unique_ptr<Simulation> Simulation::FromString(const std::string& world_xml,
+                                                   const std::string& base_dir,
+                                                   const RobotConfig& robot) {
+  return std::unique_ptr<Simulation>(new Simulation(world_xml, base_dir, "<string>", robot));
+}
+
+Simulation::Simulation(const std::string& world_xml, const std::string& base_dir,
+                       const std::string& source, const RobotConfig& robot)
+    : robot_(robot), impl_(std::make_unique<Impl>()) {
+  InstallMujocoHandlers();
+  composed_xml_ = ComposeWorldXml(world_xml, base_dir, robot_, source);
+  Impl& s = *impl_;
+  s.m = LoadComposed(composed_xml_, source);
+  s.d = mj_makeData(s.m);
+  if (s.d == nullptr) throw std::runtime_error("world " + source + ": mj_makeData failed");
+  world_ = ReadWorldInfo(s.m, source);
+
+  s.robot_body = IdOrThrow(s.m, mjOBJ_BODY, kRobotBody);
+  const int root = IdOrThrow(s.m, mjOBJ_JOINT, "robot_root");
+  s.root_qpos = s.m->jnt_qposadr[root];
+  s.root_dof = s.m->jnt_dofadr[root];
+  s.base_site = IdOrThrow(s.m, mjOBJ_SITE, kBaseLinkSite);
+  s.laser_site = IdOrThrow(s.m, mjOBJ_SITE, kLaserSite);
+  const int pitch = IdOrThrow(s.m, mjOBJ_JOINT, kPitchJoint);
+  s.pitch_qpos = s.m->jnt_qposadr[pitch];
+  s.pitch_dof = s.m->jnt_dofadr[pitch];
+  s.pitch_act = IdOrThrow(s.m, mjOBJ_ACTUATOR, kPitchActuator);
+  for (const WheelSpec& w : Wheels(params())) {
+    const int j = IdOrThrow(s.m, mjOBJ_JOINT, w.joint.c_str());
+    const int a = IdOrThrow(s.m, mjOBJ_ACTUATOR, (w.joint + "_motor").c_str());
+    s.wheels.push_back({s.m->jnt_qposadr[j], s.m->jnt_dofadr[j], a, w.left});
+  }
+  // The PD servo's velocity gain is explicit in MuJoCo's Euler step: refuse an unstable world.
+  const double inertia =
+      s.m->dof_armature[s.pitch_dof] + s.m->body_inertia[3 * s.m->jnt_bodyid[pitch] + 1];
+  const double courant = robot_.pitch_servo.kv_nms_per_rad * timestep_s() / inertia;
+  if (courant > 1.5) {
+    throw std::runtime_error("world " + source + ": <option timestep=\"" +
+                             std::to_string(timestep_s()) +
+                             "\"> is too long for robot.pitch_servo.kv = " +
+                             std::to_string(robot_.pitch_servo.kv_nms_per_rad) +
+                             " (kv * timestep / inertia = " + std::to_string(courant) + " > 1.5)");
+  }
+  mj_forward(s.m, s.d);
+}
+
+Simulation::~Simulation() = default;
+
+const mjModel_* Simulation::model() const { return impl_->m; }
+const mjData_* Simulation::data() const { return impl_->d; }
+double Simulation::time_s() const { return impl_->d->time; }
+double Simulation::timestep_s() const { return impl_->m->opt.timestep; }
+
+void Simulation::Step(int n) {
+  Impl& s = *impl_;
+  for (int i = 0; i < n; ++i) {
+    mj_step1(s.m, s.d);
+    for (auto& [id, hook] : s.hooks) {
+      if (hook.first) hook.first();
+    }
+    // PD servo with bias (gravity) and rate feed-forward: torque = kp (q_sp - q) + kv (rate_sp -
+    // qdot) + bias, so q tracks a slewing setpoint and sits exactly on a fixed one.
+    const PitchServoConfig& servo = robot_.pitch_servo;
+    s.d->ctrl[s.pitch_act] =
+        pitch_setpoint_rad_ + (s.d->qfrc_bias[s.pitch_dof] - s.d->qfrc_passive[s.pitch_dof] +
+                               servo.kv_nms_per_rad * pitch_setpoint_rate_rps_) /
+                                  servo.kp_nm_per_rad;
+    mj_step2(s.m, s.d);
+    for (auto& [id, hook] : s.hooks) {
+      if (hook.second) hook.second();
+    }
+  }
+  mj_kinematics(s.m, s.d);  // fresh xpos/site/geom poses for ground truth and the ray casters
+}
+
+void Simulation::StepFor(double duration_s) {
+  if (!(duration_s > 0.0)) return;
+  Step(std::max(1, static_cast<int>(std::lround(duration_s / timestep_s()))));
+}
+
+Eigen::Isometry3d Simulation::T_world_base() const {
+  const mjData* d = impl_->d;
+  const int site = impl_->base_site;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = Eigen::Map<const Eigen::Vector3d>(d->site_xpos + 3 * site);
+  T.linear() =
+      Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(d->site_xmat + 9 * site);
+  return T;
+}
+
+Eigen::Isometry3d Simulation::T_world_laser() const {
+  const mjData* d = impl_->d;
+  const int site = impl_->laser_site;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = Eigen::Map<const Eigen::Vector3d>(d->site_xpos + 3 * site);
+  T.linear() =
+      Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(d->site_xmat + 9 * site);
+  return T;
+}
+
+double Simulation::pitch_rad() const { return impl_->d->qpos[impl_->pitch_qpos]; }
+double Simulation::pitch_rate_rps() const { return impl_->d->qvel[impl_->pitch_dof]; }
+void Simulation::SetPitchSetpoint(double pitch_rad, double rate_rps) {
+  pitch_setpoint_rad_ = pitch_rad;
+  pitch_setpoint_rate_rps_ = rate_rps;
+}
+
+void Simulation::SetWheelSpeeds(double left_rps, double right_rps) {
+  for (const Impl::Wheel& w : impl_->wheels) impl_->d->ctrl[w.act] = w.left ? left_rps : right_rps;
+}
+
+Eigen::Vector2d Simulation::WheelAngles() const {
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero(), count = Eigen::Vector2d::Zero();
+  for (const Impl::Wheel& w : impl_->wheels) {
+    sum[w.left ? 0 : 1] += impl_->d->qpos[w.qpos];
+    count[w.left ? 0 : 1] += 1;
+  }
+  return sum.cwiseQuotient(count);
+}
+
+Eigen::Vector2d Simulation::WheelSpeeds() const {
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero(), count = Eigen::Vector2d::Zero();
+  for (const Impl::Wheel& w : impl_->wheels) {
+    sum[w.left ? 0 : 1] += impl_->d->qvel[w.dof];
+    count[w.left ? 0 : 1] += 1;
+  }
+  return sum.cwiseQuotient(count);
+}
+
+bool Simulation::WheelStalled() const {
+  const mjModel* m = impl_->m;
+  const mjData* d = impl_->d;
+  for (const Impl::Wheel& w : impl_->wheels) {
+    const double limit = m->actuator_forcerange[2 * w.act + 1];
+    const double cmd = d->ctrl[w.act];
+    if (std::abs(d->actuator_force[w.act]) >= 0.99 * limit && std::abs(cmd) > 0.1 &&
+        std::abs(d->qvel[w.dof]) < 0.5 * std::abs(cmd)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+Eigen::Vector2d Simulation::BaseSpeeds() const {
+  const mjtNum* v = impl_->d->qvel + impl_->root_dof;
+  return {Eigen::Vector3d(v[0], v[1], v[2]).norm(), Eigen::Vector3d(v[3], v[4], v[5]).norm()};
+}
+
+int Simulation::AddStepHooks(StepHook before, StepHook after) {
+  const int id = impl_->next_hook++;
+  impl_->hooks[id] = {std::move(before), std::move(after)};
+  return id;
+}
+
+void Simulation::RemoveHooks(int id) { impl_->hooks.erase(id); }
+
+std::vector<std::string> Simulation::TakeWarnings() {
+  std::vector<std::string> out = TakeMujocoWarnings();
+  mjData* d = impl_->d;
+  for (int i = 0; i < mjNWARNING; ++i) {
+    if (d->warning[i].number > 0) {
+      out.push_back("MuJoCo warning " + std::to_string(i) + " raised " +
+                    std::to_string(d->warning[i].number) + " times (info " +
+                    std::to_string(d->warning[i].lastinfo) + ")");
+      d->warning[i].number = 0;
+    }
+  }
+  return out;
+}
+
+}  // namespace pitchlab::sim

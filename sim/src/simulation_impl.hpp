@@ -1,0 +1,48 @@
+#pragma once
+// Private: the MuJoCo side of Simulation, shared by simulation.cpp and placement.cpp.
+
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <mujoco/mujoco.h>
+
+#include "pitchlab/sim/simulation.hpp"
+
+namespace pitchlab::sim {
+
+struct Simulation::Impl {
+  mjModel* m = nullptr;
+  mjData* d = nullptr;
+  int robot_body = -1, root_qpos = -1, root_dof = -1;
+  int base_site = -1, laser_site = -1;
+  int pitch_qpos = -1, pitch_dof = -1, pitch_act = -1;
+  struct Wheel {
+    int qpos, dof, act;
+    bool left;
+  };
+  std::vector<Wheel> wheels;
+  std::map<int, std::pair<StepHook, StepHook>> hooks;
+  int next_hook = 0;
+
+  ~Impl() {
+    if (d) mj_deleteData(d);
+    if (m) mj_deleteModel(m);
+  }
+  bool InRobot(int body) const {
+    for (int b = body; b > 0; b = m->body_parentid[b]) {
+      if (b == robot_body) return true;
+    }
+    return false;
+  }
+  bool IsTerrain(int geom) const {
+    return m->geom_type[geom] == mjGEOM_PLANE || m->geom_type[geom] == mjGEOM_HFIELD;
+  }
+  std::string GeomName(int geom) const {
+    const char* name = mj_id2name(m, mjOBJ_GEOM, geom);
+    return name ? std::string("'") + name + "'" : "#" + std::to_string(geom);
+  }
+};
+
+}  // namespace pitchlab::sim
