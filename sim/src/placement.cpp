@@ -57,6 +57,34 @@ double TerrainHeight(const mjModel* m, const mjData* d, const Eigen::Vector2d& x
   return std::isfinite(best) ? from_z - best : std::nan("");
 }
 
+// Least-squares plane z = a + b (x - x0) + c (y - y0) through the ground samples, and the largest
+// deviation of a sample from it [m].
+struct GroundPlane {
+  Eigen::Vector3d coeffs;  ///< a [m], b, c [1]
+  double max_residual_m;
+};
+GroundPlane FitGroundPlane(const Eigen::Vector2d& origin, const std::vector<Eigen::Vector2d>& xy,
+                           const std::vector<double>& z) {
+  Eigen::MatrixXd A(xy.size(), 3);
+  Eigen::VectorXd b(xy.size());
+  for (std::size_t i = 0; i < xy.size(); ++i) {
+    A.row(i) << 1.0, xy[i].x() - origin.x(), xy[i].y() - origin.y();
+    b[i] = z[i];
+  }
+  const Eigen::Vector3d plane = A.colPivHouseholderQr().solve(b);
+  return {plane, (A * plane - b).cwiseAbs().maxCoeff()};
+}
+
+// Orientation that puts base_link's z on the plane normal and its x along `yaw_rad` in the plane.
+Eigen::Quaterniond OnPlane(const Eigen::Vector3d& coeffs, double yaw_rad) {
+  const Eigen::Vector3d n = Eigen::Vector3d(-coeffs[1], -coeffs[2], 1.0).normalized();
+  const Eigen::Vector3d heading(std::cos(yaw_rad), std::sin(yaw_rad), 0.0);
+  const Eigen::Vector3d x = (heading - heading.dot(n) * n).normalized();
+  Eigen::Matrix3d R;
+  R << x, n.cross(x), n;
+  return Eigen::Quaterniond(R);
+}
+
 }  // namespace
 
 Result<Eigen::Isometry3d> Simulation::PlaceRobot(double x_m, double y_m, double yaw_rad,
@@ -93,6 +121,16 @@ Result<Eigen::Isometry3d> Simulation::PlaceRobot(double x_m, double y_m, double 
     ground_max = std::max(ground_max, ground[i]);
   }
 
+  // 1b. The footprint must rest on one surface: samples may deviate from their best-fit plane by
+  // at most a step (a slope is fine, the top of a wall or a curb edge is not).
+  const GroundPlane plane = FitGroundPlane(Eigen::Vector2d(x_m, y_m), samples, ground);
+  if (const double step = plane.max_residual_m; step > config.max_step_m) {
+    return Fail(Error::Code::kInvalidArgument,
+                "start " + Xy(x_m, y_m) + " is not on drivable ground: the surface under the " +
+                    "footprint has a step of " + std::to_string(step) + " m (limit " +
+                    std::to_string(config.max_step_m) + " m), e.g. on an obstacle or an edge");
+  }
+
   // 2. Nothing may stand in the robot's volume above the ground (upward rays from step height).
   const double envelope_m =
       robot_.mount.t_base_mount_m.z() + robot_.mount.t_mount_laser_m.norm() + 0.1;
@@ -111,8 +149,11 @@ Result<Eigen::Isometry3d> Simulation::PlaceRobot(double x_m, double y_m, double 
 
   // 3. Put the robot just above the highest ground sample, at rest, and check for overlaps.
   mjtNum* q = s.d->qpos + s.root_qpos;
-  q[0] = x_m, q[1] = y_m, q[2] = ground_max + config.drop_height_m;
-  q[3] = std::cos(yaw_rad / 2), q[4] = 0, q[5] = 0, q[6] = std::sin(yaw_rad / 2);
+  // Lying on the fitted plane, so a slope start does not drop the robot onto one edge.
+  const Eigen::Quaterniond attitude = OnPlane(plane.coeffs, yaw_rad);
+  q[0] = x_m, q[1] = y_m;
+  q[2] = plane.coeffs[0] + plane.max_residual_m + config.drop_height_m;
+  q[3] = attitude.w(), q[4] = attitude.x(), q[5] = attitude.y(), q[6] = attitude.z();
   for (int j = 0; j < s.m->njnt; ++j) {
     if (!s.InRobot(s.m->jnt_bodyid[j])) continue;
     const int dofs = s.m->jnt_type[j] == mjJNT_FREE ? 6 : s.m->jnt_type[j] == mjJNT_BALL ? 3 : 1;

@@ -115,7 +115,6 @@ void SimBase::BeforeStep() {
   integral_rps_ = (integral_rps_ + kWheelKi_per_s * dt * error)
                       .cwiseMax(-kMaxIntegral_rps)
                       .cwiseMin(kMaxIntegral_rps);
-  if (command_.isZero() && target_.isZero()) integral_rps_ *= 0.99;  // bleed off when parked
   const Eigen::Vector2d ctrl = ref_rps + integral_rps_;
   sim_.SetWheelSpeeds(ctrl[0], ctrl[1]);
 }

@@ -30,4 +30,15 @@ inline constexpr char kWallWorld[] = R"(
   </worldbody>
 </mujoco>)";
 
+/// Box floors only (as in the office world), a thin 2.5 m wall along y = 1 and a ramp tilted
+/// 10 deg about y centred at (-5, 0).
+inline constexpr char kBoxFloorWorld[] = R"(
+<mujoco model="box_floor">
+  <worldbody>
+    <geom name="floor" type="box" pos="0 0 -0.05" size="10 10 0.05"/>
+    <geom name="thin_wall" type="box" pos="3 1 1.25" size="2 0.05 1.25"/>
+    <geom name="ramp" type="box" pos="-5 0 0.3" size="1.5 1.5 0.05" euler="0 10 0"/>
+  </worldbody>
+</mujoco>)";
+
 }  // namespace pitchlab::sim::testing

@@ -1,5 +1,7 @@
 #include "pitchlab/sim/simulation.hpp"
 
+#include "pitchlab/sim/sim_base.hpp"
+
 #include <dirent.h>
 #include <unistd.h>
 
@@ -22,6 +24,7 @@ namespace {
 
 using testing::kFlatWorld;
 using testing::kWallWorld;
+using testing::kBoxFloorWorld;
 
 constexpr double kGroundTolerance_m = 0.005;  // tyre/contact softness sag
 constexpr double kMountTolerance_m = 0.005;
@@ -103,6 +106,25 @@ TEST(Simulation, PlacementOverlappingAnObstacleEdgeIsAClearError) {
   Result<Eigen::Isometry3d> pose = sim->PlaceRobot(4.35, 0.0, 0.0);  // nose 0.1 m into the box
   ASSERT_FALSE(pose);
   EXPECT_NE(pose.error().message.find("obstacle"), std::string::npos) << pose.error().message;
+}
+
+TEST(Simulation, PlacementOnTopOfAThinWallIsAClearError) {
+  auto sim = Simulation::FromString(kBoxFloorWorld, "/tmp", Robot(P3Model::kP3AT));
+  Result<Eigen::Isometry3d> pose = sim->PlaceRobot(3.0, 1.0, 0.0);
+  ASSERT_FALSE(pose);
+  EXPECT_EQ(pose.error().code, Error::Code::kInvalidArgument);
+  EXPECT_NE(pose.error().message.find("not on drivable ground"), std::string::npos)
+      << pose.error().message;
+}
+
+TEST(Simulation, PlacementOnAnEvenSlopeSettlesTiltedLikeTheSlope) {
+  auto sim = Simulation::FromString(kBoxFloorWorld, "/tmp", Robot(P3Model::kP3AT));
+  SimBase base(*sim);  // its wheel servo holds the robot on the slope, as the P3 firmware does
+  Result<Eigen::Isometry3d> pose = sim->PlaceRobot(-5.0, 0.0, 0.0);
+  ASSERT_TRUE(pose) << pose.error().message;
+  const double tilt_deg = std::acos(pose->linear()(2, 2)) * 180.0 / M_PI;
+  constexpr double kTiltTolerance_deg = 1.0;
+  EXPECT_NEAR(tilt_deg, 10.0, kTiltTolerance_deg);
 }
 
 TEST(Simulation, PlacementOutsideTheBoundsIsAClearError) {
