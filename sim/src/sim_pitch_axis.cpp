@@ -26,7 +26,9 @@ Result<double> SimPitchAxis::MoveTo(double pitch_rad, std::chrono::milliseconds 
     const double elapsed = sim_.time_s() - t0;
     const double travelled = std::min(std::abs(target - from), speed_rps * elapsed);
     const bool slewing = travelled < std::abs(target - from);
-    sim_.SetPitchSetpoint(from + std::copysign(travelled, target - from),
+    // Once the slew is over the setpoint is the target itself: from + (target - from) need not
+    // equal target in floating point.
+    sim_.SetPitchSetpoint(slewing ? from + std::copysign(travelled, target - from) : target,
                           slewing ? std::copysign(speed_rps, target - from) : 0.0);
     const bool there = std::abs(sim_.pitch_rad() - target) < half_count &&
                        std::abs(sim_.pitch_rate_rps()) < kStillRate_rps;
