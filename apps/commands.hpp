@@ -6,5 +6,7 @@ namespace pitchlab::apps {
 
 /// `pitchlab scan`: one full 3D scan of a world written as PCD.
 int RunScan(int argc, char** argv);
+/// `pitchlab worlds`: the built-in worlds and their metadata.
+int RunWorlds(int argc, char** argv);
 
 }  // namespace pitchlab::apps

@@ -19,6 +19,7 @@ struct Command {
 
 constexpr Command kCommands[] = {
     {"scan", pitchlab::apps::RunScan, "one full 3D scan of a world, written as PCD"},
+    {"worlds", pitchlab::apps::RunWorlds, "list the built-in worlds"},
 };
 
 void PrintUsage(std::ostream& os) {

@@ -1,0 +1,62 @@
+// `pitchlab worlds`: what worlds there are, with what each says about itself.
+
+#include <cstdio>
+#include <iostream>
+
+#include <mujoco/mujoco.h>
+#include <nlohmann/json.hpp>
+
+#include "cli_args.hpp"
+#include "commands.hpp"
+#include "pitchlab/worlds/world_catalog.hpp"
+#include "pitchlab/worlds/world_metadata.hpp"
+#include "world_paths.hpp"
+
+namespace pitchlab::apps {
+
+int RunWorlds(int argc, char** argv) {
+  CliArgs args("worlds",
+               "Lists the built-in worlds: description, placement bounds, default start and\n"
+               "geodetic origin. Any MJCF file is a world too (--world path/to/scene.xml).");
+  args.Flag("json", "print the list as JSON on stdout");
+  if (!args.Parse(argc, argv)) return 0;
+  nlohmann::json list = nlohmann::json::array();
+  for (const worlds::CatalogEntry& entry : worlds::BuiltinWorlds()) {
+    const auto path = worlds::ResolveWorld(entry.name, WorldsDir());
+    char error[1000] = "";
+    mjModel* model = mj_loadXML(path.string().c_str(), nullptr, error, sizeof(error));
+    if (model == nullptr) {
+      throw std::runtime_error("cannot load world '" + path.string() + "': " + error);
+    }
+    const worlds::WorldMetadata meta = worlds::ReadWorldMetadata(model);
+    mj_deleteModel(model);
+    nlohmann::json w = {{"name", entry.name},
+                        {"file", path.string()},
+                        {"description", meta.description},
+                        {"bounds_m", {meta.bounds.x_min_m, meta.bounds.y_min_m,
+                                      meta.bounds.x_max_m, meta.bounds.y_max_m}},
+                        {"default_start", {{"x_m", meta.default_start.x_m},
+                                           {"y_m", meta.default_start.y_m},
+                                           {"yaw_deg", meta.default_start.yaw_rad * 180 / M_PI}}}};
+    if (meta.geodetic_origin) {
+      w["geodetic_origin"] = {{"latitude_deg", meta.geodetic_origin->latitude_deg},
+                              {"longitude_deg", meta.geodetic_origin->longitude_deg},
+                              {"height_m", meta.geodetic_origin->height_m}};
+    }
+    list.push_back(w);
+  }
+  if (args.Flagged("json")) {
+    std::cout << list.dump(2) << "\n";
+    return 0;
+  }
+  for (const auto& w : list) {
+    const auto& b = w["bounds_m"];
+    std::printf("%-10s %5.0f x %-5.0f m  %s\n", w["name"].get<std::string>().c_str(),
+                b[2].get<double>() - b[0].get<double>(), b[3].get<double>() - b[1].get<double>(),
+                w["description"].get<std::string>().c_str());
+  }
+  std::printf("\nworld files in %s\n", WorldsDir().string().c_str());
+  return 0;
+}
+
+}  // namespace pitchlab::apps
