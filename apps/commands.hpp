@@ -6,6 +6,10 @@ namespace pitchlab::apps {
 
 /// `pitchlab scan`: one full 3D scan of a world written as PCD.
 int RunScan(int argc, char** argv);
+/// `pitchlab map`: elevation map from clouds (lossless, ESRI grid, PNG).
+int RunMap(int argc, char** argv);
+/// `pitchlab plan`: traversability path on an elevation map.
+int RunPlan(int argc, char** argv);
 /// `pitchlab worlds`: the built-in worlds and their metadata.
 int RunWorlds(int argc, char** argv);
 

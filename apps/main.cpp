@@ -19,6 +19,8 @@ struct Command {
 
 constexpr Command kCommands[] = {
     {"scan", pitchlab::apps::RunScan, "one full 3D scan of a world, written as PCD"},
+    {"map", pitchlab::apps::RunMap, "elevation map from point clouds (Eq. 2-3)"},
+    {"plan", pitchlab::apps::RunPlan, "traversability path on an elevation map (Eq. 4-5)"},
     {"worlds", pitchlab::apps::RunWorlds, "list the built-in worlds"},
 };
 

@@ -6,7 +6,7 @@ packages=(
   build-essential cmake pkg-config git
   libeigen3-dev libmujoco-dev libembree-dev libpcl-dev libgeographiclib-dev
   libyaml-cpp-dev libexpected-dev libpng-dev nlohmann-json3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libboost-graph-dev
 )
 
 missing=()

@@ -1,0 +1,204 @@
+// `pitchlab map`: clouds (PCD) -> elevation map (Eq. 2, 3, inclination), written losslessly, as an
+// ESRI ASCII grid with its projection and as a PNG; with --world, scored against ground truth.
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_args.hpp"
+#include "commands.hpp"
+#include "pitchlab/mapping/elevation_io.hpp"
+#include "pitchlab/mapping/elevation_layers.hpp"
+#include "pitchlab/mapping/elevation_map.hpp"
+#include "pitchlab/mapping/elevation_truth.hpp"
+#include "pitchlab/sensors/ray_caster.hpp"
+#include "pitchlab/sensors/scan_pcd.hpp"
+#include "pitchlab/sim/simulation.hpp"
+#include "pitchlab/worlds/world_catalog.hpp"
+#include "world_paths.hpp"
+
+namespace pitchlab::apps {
+namespace {
+
+CliArgs MapArgs() {
+  CliArgs args("map",
+               "Builds an elevation map from point clouds (PCD; points moved into the world by\n"
+               "each file's VIEWPOINT pose) and writes DIR/map.plem (lossless), DIR/elevation.asc\n"
+               "+ .prj (georeferenced raster), DIR/elevation.png and DIR/map.json. With --world,\n"
+               "the map is georeferenced and scored against the world's true surface.");
+  args.Positionals("CLOUD.pcd", "one or more clouds", 1, 1000)
+      .Option("cell", "METRES", "cell size [m]", "0.1")
+      .Option("out", "DIR", "output folder (created)")
+      .Option("area", "xmin,ymin,xmax,ymax", "map area [m] (default: the clouds' extent)")
+      .Option("margin", "METRES", "added around the clouds' extent [m]", "0.5")
+      .Option("world", "NAME|FILE.xml",
+              "world the clouds came from: geodetic origin and ground truth (" +
+                  BuiltinWorldNames() + ")")
+      .Option("clearance", "METRES",
+              "ray length behind each hit that marks free space (drops); 0 disables", "2.0")
+      .Flag("json", "print the summary as JSON on stdout");
+  return args;
+}
+
+struct LoadedCloud {
+  std::vector<Eigen::Vector3f> points;  // world frame
+  Eigen::Vector3f sensor_origin;        // approximate laser position in the world
+};
+
+LoadedCloud LoadCloud(const std::string& path) {
+  Result<sensors::Scan3D> scan = sensors::ReadScanPcd(path);
+  if (!scan) throw std::runtime_error(scan.error().message);
+  LoadedCloud c;
+  const Eigen::Isometry3f T = scan->T_world_base.cast<float>();
+  c.points.reserve(scan->points.size());
+  for (const sensors::ScanPoint& p : scan->points)
+    c.points.push_back(T * Eigen::Vector3f(p.x, p.y, p.z));
+  // The mirror at zero pitch; it moves by a few centimetres while pitching, which shifts the
+  // clearance rays' ends (the last 2 m) by well under a centimetre.
+  const sensors::MountConfig mount;
+  c.sensor_origin = T * (mount.t_base_mount_m + mount.t_mount_laser_m).cast<float>();
+  return c;
+}
+
+nlohmann::json ErrorJson(const mapping::MapErrorReport& r) {
+  return {{"compared_cells", r.compared_cells},
+          {"truth_cells", r.truth_cells},
+          {"coverage", r.coverage},
+          {"rmse_m", r.rmse_m},
+          {"mean_error_m", r.mean_error_m},
+          {"max_abs_error_m", r.max_abs_error_m},
+          {"p95_abs_error_m", r.p95_abs_error_m},
+          {"drop_cells", r.drop_cells}};
+}
+
+}  // namespace
+
+int RunMap(int argc, char** argv) {
+  CliArgs args = MapArgs();
+  if (!args.Parse(argc, argv)) return 0;
+  const std::filesystem::path out = args.Get("out");
+  const double cell = args.GetNumbers("cell", 1)[0];
+  if (!(cell > 0)) throw CliError("--cell must be positive");
+  mapping::InsertConfig insert;
+  insert.clearance_length_m = args.GetNumbers("clearance", 1)[0];
+  const auto wall_start = std::chrono::steady_clock::now();
+
+  std::vector<LoadedCloud> clouds;
+  Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
+  std::size_t total_points = 0;
+  for (const std::string& path : args.positionals()) {
+    clouds.push_back(LoadCloud(path));
+    for (const Eigen::Vector3f& p : clouds.back().points) {
+      lo = lo.cwiseMin(p.head<2>().cast<double>());
+      hi = hi.cwiseMax(p.head<2>().cast<double>());
+    }
+    total_points += clouds.back().points.size();
+  }
+  mapping::GridGeometry geometry;
+  if (args.Has("area")) {
+    const auto a = args.GetNumbers("area", 4);
+    if (!(a[2] > a[0] && a[3] > a[1])) throw CliError("--area needs xmin < xmax and ymin < ymax");
+    geometry = mapping::GridGeometry::FromArea(a[0], a[1], a[2] - a[0], a[3] - a[1], cell);
+  } else {
+    if (total_points == 0) throw std::runtime_error("the clouds hold no points; give --area");
+    geometry = mapping::GridGeometry::Covering(lo, hi, cell, args.GetNumbers("margin", 1)[0]);
+  }
+
+  // The world, when given: its geodetic origin and its true surface.
+  std::unique_ptr<sim::Simulation> sim;
+  std::optional<mapping::GeodeticOrigin> origin;
+  if (args.Has("world")) {
+    const auto world_path = worlds::ResolveWorld(args.Get("world"), WorldsDir());
+    sim = std::make_unique<sim::Simulation>(world_path.string(), sim::RobotConfig{});
+    if (const auto& g = sim->world().geodetic_origin)
+      origin = mapping::GeodeticOrigin{g->x(), g->y(), g->z()};
+  }
+
+  mapping::ElevationMap map(geometry, origin);
+  const auto insert_start = std::chrono::steady_clock::now();
+  mapping::InsertStats stats;
+  for (const LoadedCloud& c : clouds) {
+    const mapping::InsertStats s =
+        map.InsertScan(c.points.data(), c.points.size(), c.sensor_origin, insert);
+    stats.inserted += s.inserted;
+    stats.outside += s.outside;
+    stats.non_finite += s.non_finite;
+  }
+  const double insert_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - insert_start).count();
+  const mapping::ElevationLayers layers = mapping::ComputeLayers(map);
+
+  std::filesystem::create_directories(out);
+  const auto check = [](Result<void> r) {
+    if (!r) throw std::runtime_error(r.error().message);
+  };
+  check(mapping::SaveElevationMap(map, (out / "map.plem").string()));
+  check(mapping::WriteEsriAsciiGrid(layers, origin, (out / "elevation.asc").string()));
+  check(mapping::WritePng(mapping::RenderElevationImage(layers), (out / "elevation.png").string()));
+
+  std::size_t known = 0, drops = 0;
+  for (mapping::CellState s : layers.state) {
+    known += s == mapping::CellState::kObserved;
+    drops += s == mapping::CellState::kDrop;
+  }
+  nlohmann::json summary = {
+      {"clouds", args.positionals()},
+      {"out", out.string()},
+      {"cell_m", cell},
+      {"size_x", geometry.size_x},
+      {"size_y", geometry.size_y},
+      {"x_min_m", geometry.x_min_m},
+      {"y_min_m", geometry.y_min_m},
+      {"bytes_per_cell", mapping::ElevationMap::kBytesPerCell},
+      {"points", total_points},
+      {"inserted", stats.inserted},
+      {"outside", stats.outside},
+      {"non_finite", stats.non_finite},
+      {"known_cells", known},
+      {"drop_cells", drops},
+      {"insert_time_s", insert_s},
+      {"files", {"map.plem", "elevation.asc", "elevation.prj", "elevation.png", "map.json"}}};
+  if (origin) {
+    summary["geodetic_origin"] = {origin->latitude_deg, origin->longitude_deg, origin->height_m};
+  }
+  if (sim) {
+    const std::unique_ptr<sensors::RayCaster> caster =
+        sensors::MakeEmbreeRayCaster(sim->model(), sim->data());
+    const mapping::ElevationLayers truth =
+        mapping::ComputeLayers(mapping::ComputeTrueElevationMap(*caster, geometry));
+    summary["truth"] = ErrorJson(mapping::CompareToTruth(layers, truth));
+    summary["world"] = args.Get("world");
+  }
+  summary["wall_time_s"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  {
+    const std::string tmp = (out / "map.json.tmp").string();
+    std::FILE* f = std::fopen(tmp.c_str(), "w");
+    if (!f) throw std::runtime_error(tmp + ": cannot write");
+    std::fputs((summary.dump(2) + "\n").c_str(), f);
+    std::fclose(f);
+    std::filesystem::rename(tmp, out / "map.json");
+  }
+  if (args.Flagged("json")) {
+    std::cout << summary.dump(2) << "\n";
+    return 0;
+  }
+  std::printf(
+      "elevation map %d x %d cells of %.3f m: %zu of %zu points inserted, %zu cells known, "
+      "%zu drop cells\nwrote %s/{map.plem, elevation.asc, elevation.prj, elevation.png, "
+      "map.json}\n",
+      geometry.size_x, geometry.size_y, cell, stats.inserted, total_points, known, drops,
+      out.string().c_str());
+  if (summary.contains("truth")) {
+    const auto& t = summary["truth"];
+    std::printf("vs ground truth: RMSE %.4f m, max %.4f m, bias %.4f m, coverage %.1f %%\n",
+                t["rmse_m"].get<double>(), t["max_abs_error_m"].get<double>(),
+                t["mean_error_m"].get<double>(), 100 * t["coverage"].get<double>());
+  }
+  return 0;
+}
+
+}  // namespace pitchlab::apps

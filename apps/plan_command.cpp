@@ -1,0 +1,153 @@
+// `pitchlab plan`: least-cost path (Eq. 4-5, Algorithm 2) on an elevation map, written as CSV,
+// GeoJSON (WGS84) and drawn on the map picture.
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_args.hpp"
+#include "commands.hpp"
+#include "pitchlab/mapping/elevation_io.hpp"
+#include "pitchlab/planning/path_io.hpp"
+#include "pitchlab/planning/planner.hpp"
+#include "pitchlab/planning/traversability.hpp"
+
+namespace pitchlab::apps {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+CliArgs PlanArgs() {
+  CliArgs args(
+      "plan",
+      "Plans the least-cost path (Eq. 5: W_T*T + W_P*P + W_phix*phi_x + W_phiy*phi_y per\n"
+      "edge, 8-connected cells) on an elevation map written by `pitchlab map`, and writes\n"
+      "DIR/path.csv, DIR/path.geojson (when the map is georeferenced), DIR/path.png and\n"
+      "DIR/plan.json. No path: the reason is printed and the exit code is 1.");
+  args.Positionals("MAP.plem", "elevation map", 1, 1)
+      .Option("start", "x,y", "start in the map frame [m]")
+      .Option("goal", "x,y", "goal in the map frame [m]")
+      .Option("robot", "p3at|p3dx", "robot preset (step, inclination, width); overrides --config's")
+      .Option("algo", "astar|dijkstra", "graph search", "astar")
+      .Option("config", "FILE.yaml", "planner config: weights, robot limits, unknown policy")
+      .Option("unknown", "forbid|penalise", "unknown cells, overrides --config's")
+      .Option("out", "DIR", "output folder (created)")
+      .Flag("json", "print the result as JSON on stdout");
+  return args;
+}
+
+nlohmann::json PathJson(const planning::Path& p) {
+  return {{"found", true},
+          {"algorithm", planning::ToString(p.algorithm)},
+          {"cost", p.cost},
+          {"cost_parts",
+           {{"roughness", p.parts.roughness},
+            {"length", p.parts.length},
+            {"inclination_x", p.parts.inclination_x},
+            {"inclination_y", p.parts.inclination_y},
+            {"unknown", p.parts.unknown}}},
+          {"length_m", p.length_m},
+          {"waypoints", p.waypoints.size()},
+          {"max_step_m", p.max_step_m},
+          {"max_inclination_deg", p.max_inclination_rad * kRadToDeg},
+          {"expanded", p.expanded}};
+}
+
+}  // namespace
+
+int RunPlan(int argc, char** argv) {
+  CliArgs args = PlanArgs();
+  if (!args.Parse(argc, argv)) return 0;
+  const std::vector<double> start = args.GetNumbers("start", 2), goal = args.GetNumbers("goal", 2);
+  const std::filesystem::path out = args.Get("out");
+  planning::PlannerConfig config;
+  if (args.Has("config")) config = planning::LoadPlannerConfig(args.Get("config"));
+  try {
+    if (args.Has("robot")) config.robot = planning::RobotLimits::Preset(args.Get("robot"));
+  } catch (const std::invalid_argument& e) {
+    throw CliError(std::string("--robot: ") + e.what());
+  }
+  if (args.Has("unknown")) {
+    const std::string u = args.Get("unknown");
+    if (u != "forbid" && u != "penalise") throw CliError("--unknown must be forbid or penalise");
+    config.unknown =
+        u == "forbid" ? planning::UnknownPolicy::kForbid : planning::UnknownPolicy::kPenalise;
+  }
+  planning::Algorithm algorithm;
+  try {
+    algorithm = planning::ParseAlgorithm(args.Get("algo"));
+  } catch (const std::invalid_argument& e) {
+    throw CliError(std::string("--algo: ") + e.what());
+  }
+  Result<mapping::ElevationMap> map = mapping::LoadElevationMap(args.positionals()[0]);
+  if (!map) throw std::runtime_error(map.error().message);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  const mapping::ElevationLayers layers = mapping::ComputeLayers(*map);
+  const planning::TraversabilityGrid grid = planning::BuildTraversability(layers, config);
+  const auto t1 = std::chrono::steady_clock::now();
+  const auto result = planning::PlanPath(grid, {start[0], start[1]}, {goal[0], goal[1]}, algorithm);
+  const auto t2 = std::chrono::steady_clock::now();
+
+  std::filesystem::create_directories(out);
+  nlohmann::json summary;
+  mapping::RgbImage image = mapping::RenderElevationImage(layers);
+  if (result) {
+    summary = PathJson(*result);
+    const auto check = [](Result<void> r) {
+      if (!r) throw std::runtime_error(r.error().message);
+    };
+    check(planning::WritePathCsv(*result, (out / "path.csv").string()));
+    if (map->geodetic_origin()) {
+      check(planning::WritePathGeoJson(*result, map->geodetic_origin(),
+                                       (out / "path.geojson").string()));
+    } else {
+      summary["geojson"] = "skipped: the map has no geodetic origin (map it with --world)";
+    }
+    planning::DrawPath(*result, map->geometry(), image);
+  } else {
+    summary = {{"found", false},
+               {"reason", planning::ToString(result.error().reason)},
+               {"message", result.error().message}};
+  }
+  if (auto r = mapping::WritePng(image, (out / "path.png").string()); !r) {
+    throw std::runtime_error(r.error().message);
+  }
+  summary["robot"] = config.robot.name;
+  summary["start"] = start;
+  summary["goal"] = goal;
+  summary["traversability_time_s"] = std::chrono::duration<double>(t1 - t0).count();
+  summary["search_time_s"] = std::chrono::duration<double>(t2 - t1).count();
+  {
+    const std::filesystem::path tmp = out / "plan.json.tmp";
+    std::FILE* f = std::fopen(tmp.c_str(), "w");
+    if (!f) throw std::runtime_error(tmp.string() + ": cannot write");
+    std::fputs((summary.dump(2) + "\n").c_str(), f);
+    std::fclose(f);
+    std::filesystem::rename(tmp, out / "plan.json");
+  }
+  if (args.Flagged("json")) {
+    std::cout << summary.dump(2) << "\n";
+  } else if (result) {
+    std::printf(
+        "path (%s): cost %.4f (roughness %.4f, length %.4f, incl. x %.4f, incl. y %.4f, "
+        "unknown %.4f), %.2f m, %zu waypoints, max step %.3f m, max inclination %.1f deg\n"
+        "wrote %s/{path.csv, path.geojson, path.png, plan.json}\n",
+        planning::ToString(algorithm), result->cost, result->parts.roughness, result->parts.length,
+        result->parts.inclination_x, result->parts.inclination_y, result->parts.unknown,
+        result->length_m, result->waypoints.size(), result->max_step_m,
+        result->max_inclination_rad * kRadToDeg, out.string().c_str());
+  }
+  if (!result) {
+    std::cerr << "pitchlab plan: no path (" << planning::ToString(result.error().reason)
+              << "): " << result.error().message << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace pitchlab::apps

@@ -1,0 +1,64 @@
+#pragma once
+// The layers users and the planner read, derived from an ElevationMap's running statistics:
+// mean height (Eq. 2), roughness T (Eq. 3), inclination phi_x, phi_y, and what is known.
+//
+// Inclination: a least-squares plane z = a + b x + c y through all points of the cell and its 8
+// neighbours (the 3 x 3 cell region), computed from the pooled co-moments (no point is re-read):
+// phi_x = atan(b), phi_y = atan(c). When the pooled points do not span the plane (fewer than 3, or
+// all on one line, e.g. a single scan line), the same fit is made through the centres of the known
+// cells of the region at their mean heights; with fewer than 3 non-collinear known cells the
+// inclination is unknown (NaN). A neighbour whose mean differs from the cell's by more than
+// max_fit_slope times their centre distance is a step, not part of the slope, and is left out, so
+// the ground beside a wall keeps its own inclination.
+
+#include <cstdint>
+#include <vector>
+
+#include "pitchlab/mapping/elevation_map.hpp"
+
+namespace pitchlab::mapping {
+
+/// What is known of a cell.
+enum class CellState : std::uint8_t {
+  kUnknown = 0,   ///< no point fell in it and no ray proves a drop
+  kObserved = 1,  ///< at least one point
+  kDrop = 2,      ///< no point, but rays passed lower than the lowest point of every observed
+                  ///< neighbour by more than drop_depth_m (or next to such a drop cell, below the
+                  ///< same reference): a negative hazard (ditch, stairs down, cliff edge)
+};
+
+/// How the derived layers are made.
+struct LayerConfig {
+  double drop_depth_m = 0.2;  ///< clearance this far below an observed neighbour is a drop [m]
+  /// A region whose point spread is smaller than this along its narrow horizontal axis is
+  /// degenerate for the point fit (its sqrt of the smallest eigenvalue of the xy covariance) [m].
+  double min_spread_m = 0.005;
+  /// Neighbours steeper than this from the cell (|dz| / centre distance) are steps, excluded
+  /// from the inclination fit [1]; tan(60 deg).
+  double max_fit_slope = 1.7320508;
+};
+
+/// Dense per-cell layers over the map's geometry (index as GridGeometry::Linear).
+struct ElevationLayers {
+  GridGeometry geometry;
+  std::vector<CellState> state;
+  std::vector<std::uint32_t> count;  ///< points [1]
+  std::vector<float> mean_z;         ///< Eq. 2 cell elevation [m]; NaN unknown
+  std::vector<float> min_z;          ///< [m]; NaN unknown
+  std::vector<float> max_z;          ///< [m]; NaN unknown
+  std::vector<float> roughness;      ///< Eq. 3 T: std dev of the cell's heights [m]; NaN unknown
+  std::vector<float> phi_x;          ///< inclination along x: atan(dz/dx) [rad]; NaN unknown
+  std::vector<float> phi_y;          ///< inclination along y: atan(dz/dy) [rad]; NaN unknown
+  std::vector<float> clearance_z;    ///< lowest ray height over the cell [m]; +inf none
+
+  /// Overall tilt of the cell's plane, atan(sqrt(tan^2 phi_x + tan^2 phi_y)) [rad]; NaN unknown.
+  float Tilt(std::size_t k) const;
+};
+
+/// Eq. 3: population standard deviation of the cell's heights [m]; NaN for an unknown cell.
+float Roughness(const CellStats& cell);
+
+/// Computes every layer. O(cells).
+ElevationLayers ComputeLayers(const ElevationMap& map, const LayerConfig& config = {});
+
+}  // namespace pitchlab::mapping

@@ -1,0 +1,198 @@
+#pragma once
+// Elevation map (Eq. 2, 3 and the inclination fit): a grid of m x n cells over a map area, each
+// keeping running statistics of the heights that fell in it, so clouds are inserted incrementally
+// and two maps merge without re-reading any point.
+//
+// Frames and index order (frame `map`, x east/forward, y north/left, z up):
+//
+//        y ^
+//          |  (0,n-1) (1,n-1) ...  (m-1,n-1)
+//          |   ...
+//          |  (0,1)   (1,1)   ...
+//          |  (0,0)   (1,0)   ...  (m-1,0)
+//   origin +----------------------------------> x
+//   (x_min_m, y_min_m) is the outer corner of cell (0,0); cell (i,j) spans
+//   [x_min + i*cell, x_min + (i+1)*cell) x [y_min + j*cell, y_min + (j+1)*cell);
+//   storage index = j * size_x + i (rows of constant y, west to east, south to north).
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "pitchlab/sensors/result.hpp"
+
+namespace pitchlab::mapping {
+
+/// Integer cell index: i along x, j along y.
+struct CellIndex {
+  int i = 0;  ///< column (x) [cell]
+  int j = 0;  ///< row (y) [cell]
+  bool operator==(const CellIndex& o) const { return i == o.i && j == o.j; }
+};
+
+/// Where the grid lies in the map frame and how fine it is (Eq. 2).
+struct GridGeometry {
+  double x_min_m = 0.0;  ///< outer x of column 0 [m]
+  double y_min_m = 0.0;  ///< outer y of row 0 [m]
+  double cell_m = 0.1;   ///< cell edge [m/cell]
+  int size_x = 0;        ///< m: cells along x [cell]
+  int size_y = 0;        ///< n: cells along y [cell]
+
+  /// Eq. 2: m = round(size_x_m / cell_m), n = round(size_y_m / cell_m) cells from the corner
+  /// (x_min_m, y_min_m). Throws std::invalid_argument on a non-positive size or cell, or more than
+  /// 2^31 cells.
+  static GridGeometry FromArea(double x_min_m, double y_min_m, double size_x_m, double size_y_m,
+                               double cell_m);
+  /// The grid of `cell_m` cells aligned to multiples of cell_m that covers [lo, hi] (plus
+  /// `margin_m`). Throws as FromArea.
+  static GridGeometry Covering(const Eigen::Vector2d& lo_m, const Eigen::Vector2d& hi_m,
+                               double cell_m, double margin_m = 0.0);
+
+  std::size_t cell_count() const { return static_cast<std::size_t>(size_x) * size_y; }
+  double x_max_m() const { return x_min_m + size_x * cell_m; }  ///< [m]
+  double y_max_m() const { return y_min_m + size_y * cell_m; }  ///< [m]
+  bool Contains(const CellIndex& c) const {
+    return c.i >= 0 && c.j >= 0 && c.i < size_x && c.j < size_y;
+  }
+  /// Cell under the point (x, y) [m]; may be outside the grid (check Contains).
+  CellIndex IndexOf(double x_m, double y_m) const {
+    return {static_cast<int>(std::floor((x_m - x_min_m) / cell_m)),
+            static_cast<int>(std::floor((y_m - y_min_m) / cell_m))};
+  }
+  /// Centre of cell c in the map frame [m].
+  Eigen::Vector2d CenterOf(const CellIndex& c) const {
+    return {x_min_m + (c.i + 0.5) * cell_m, y_min_m + (c.j + 0.5) * cell_m};
+  }
+  std::size_t Linear(const CellIndex& c) const {
+    return static_cast<std::size_t>(c.j) * size_x + c.i;
+  }
+  CellIndex FromLinear(std::size_t k) const {
+    return {static_cast<int>(k % size_x), static_cast<int>(k / size_x)};
+  }
+  /// Same cell size and size, origins equal within 1e-9 m.
+  bool SameAs(const GridGeometry& o) const;
+};
+
+/// WGS84 position of the map frame's origin (not of the grid corner).
+struct GeodeticOrigin {
+  double latitude_deg = 0.0;   ///< [deg]
+  double longitude_deg = 0.0;  ///< [deg]
+  double height_m = 0.0;       ///< ellipsoidal height of map z = 0 [m]
+};
+
+/// Running statistics of one cell: 52 bytes. Positions are relative to the cell centre, so float
+/// keeps sub-micrometre resolution; the co-moments are updated by Welford's method (stable).
+struct CellStats {
+  std::uint32_t count = 0;                   ///< points in the cell [1]
+  float mean_x = 0, mean_y = 0, mean_z = 0;  ///< mean point, x/y from the cell centre [m]
+  /// Co-moments sum((a - mean_a)(b - mean_b)) [m^2].
+  float c_xx = 0, c_xy = 0, c_xz = 0, c_yy = 0, c_yz = 0, c_zz = 0;
+  float min_z = std::numeric_limits<float>::infinity();   ///< lowest point [m]
+  float max_z = -std::numeric_limits<float>::infinity();  ///< highest point [m]
+  /// Lowest height at which a laser ray passed over the cell without hitting it: the surface
+  /// here is below this [m]; +inf when no ray crossed. What makes unobserved drops visible.
+  float clearance_z = std::numeric_limits<float>::infinity();
+
+  bool known() const { return count > 0; }
+};
+static_assert(sizeof(CellStats) <= 64, "issue 4: map memory <= 64 bytes per cell");
+
+/// Insertion options.
+struct InsertConfig {
+  /// Length of each ray, back from its hit, along which cells get their clearance updated [m];
+  /// 0 disables clearance. Drops appear where rays pass below the ground around them, which
+  /// happens close to the far hit, so a couple of metres suffice.
+  double clearance_length_m = 2.0;
+  /// Points outside [min_z, max_z] (map frame) are ignored: ceiling, outliers [m].
+  double min_z_m = -1e6;
+  double max_z_m = 1e6;
+};
+
+/// What one insertion did.
+struct InsertStats {
+  std::size_t inserted = 0;         ///< points that landed in a cell
+  std::size_t outside = 0;          ///< points off the grid or outside the z limits
+  std::size_t non_finite = 0;       ///< NaN / inf points skipped
+  std::size_t clearance_cells = 0;  ///< cell updates by ray clearance
+};
+
+/// The elevation grid: geometry, georeference and one CellStats per cell.
+class ElevationMap {
+ public:
+  ElevationMap() = default;
+  /// An all-unknown map over `geometry`. Throws std::invalid_argument on an empty geometry.
+  explicit ElevationMap(const GridGeometry& geometry,
+                        std::optional<GeodeticOrigin> geodetic_origin = std::nullopt);
+
+  const GridGeometry& geometry() const { return geometry_; }
+  const std::optional<GeodeticOrigin>& geodetic_origin() const { return geodetic_origin_; }
+  void set_geodetic_origin(std::optional<GeodeticOrigin> g) { geodetic_origin_ = g; }
+
+  const CellStats& at(const CellIndex& c) const { return cells_[geometry_.Linear(c)]; }
+  const CellStats& at(std::size_t linear) const { return cells_[linear]; }
+  const std::vector<CellStats>& cells() const { return cells_; }
+  /// Bytes held per cell (the CellStats array only) [B/cell].
+  static constexpr std::size_t kBytesPerCell = sizeof(CellStats);
+
+  /// Eq. 2: each point goes to the cell under its x, y and updates that cell's statistics.
+  /// Points are in the map frame [m]. No allocation.
+  InsertStats InsertPoints(const Eigen::Vector3f* points_m, std::size_t count,
+                           const InsertConfig& config = {});
+  /// As InsertPoints, and for each point the ray from `sensor_origin_m` (map frame) to it sets
+  /// the clearance of the cells it crosses over its last `clearance_length_m`.
+  InsertStats InsertScan(const Eigen::Vector3f* points_m, std::size_t count,
+                         const Eigen::Vector3f& sensor_origin_m, const InsertConfig& config = {});
+  /// Any container of points with float members x, y, z (pcl::PointCloud<pcl::PointXYZ>,
+  /// std::vector<sensors::ScanPoint>), transformed by T_map_cloud on the way in.
+  template <typename Cloud>
+  InsertStats Insert(const Cloud& cloud, const Eigen::Isometry3f& T_map_cloud,
+                     const std::optional<Eigen::Vector3f>& sensor_origin_m = std::nullopt,
+                     const InsertConfig& config = {});
+
+  /// Adds every cell of `other` into this map as if its points had been inserted here (Chan's
+  /// parallel update of the moments). Fails (kInvalidArgument) when the cell sizes differ or the
+  /// grids are not aligned to a whole number of cells; cells of `other` off this grid are counted
+  /// in the returned number and dropped.
+  [[nodiscard]] Result<std::size_t> Merge(const ElevationMap& other);
+
+  /// Replaces the statistics of every cell (for the loader); throws std::invalid_argument when
+  /// the size does not match the geometry.
+  void SetCells(std::vector<CellStats> cells);
+
+ private:
+  GridGeometry geometry_;
+  std::optional<GeodeticOrigin> geodetic_origin_;
+  std::vector<CellStats> cells_;
+};
+
+template <typename Cloud>
+InsertStats ElevationMap::Insert(const Cloud& cloud, const Eigen::Isometry3f& T_map_cloud,
+                                 const std::optional<Eigen::Vector3f>& sensor_origin_m,
+                                 const InsertConfig& config) {
+  constexpr std::size_t kChunk = 1024;
+  Eigen::Vector3f buffer[kChunk];
+  InsertStats total;
+  std::size_t n = 0;
+  auto flush = [&] {
+    const InsertStats s = sensor_origin_m ? InsertScan(buffer, n, *sensor_origin_m, config)
+                                          : InsertPoints(buffer, n, config);
+    total.inserted += s.inserted;
+    total.outside += s.outside;
+    total.non_finite += s.non_finite;
+    total.clearance_cells += s.clearance_cells;
+    n = 0;
+  };
+  for (const auto& p : cloud) {
+    buffer[n++] = T_map_cloud * Eigen::Vector3f(p.x, p.y, p.z);
+    if (n == kChunk) flush();
+  }
+  if (n > 0) flush();
+  return total;
+}
+
+}  // namespace pitchlab::mapping

@@ -1,0 +1,152 @@
+// The map picture: colour by height, hillshade, unknown and drops distinct; PNG through libpng.
+
+#include <png.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "pitchlab/mapping/elevation_io.hpp"
+
+namespace pitchlab::mapping {
+namespace {
+
+// Height ramp: deep blue, green, yellow-brown, white.
+std::array<double, 3> Ramp(double t) {
+  static constexpr double kStops[][4] = {{0.00, 40, 70, 160},
+                                         {0.25, 60, 150, 90},
+                                         {0.50, 170, 190, 90},
+                                         {0.75, 150, 100, 60},
+                                         {1.00, 250, 250, 250}};
+  t = std::clamp(t, 0.0, 1.0);
+  for (int s = 1; s < 5; ++s) {
+    if (t <= kStops[s][0]) {
+      const double u = (t - kStops[s - 1][0]) / (kStops[s][0] - kStops[s - 1][0]);
+      return {kStops[s - 1][1] + u * (kStops[s][1] - kStops[s - 1][1]),
+              kStops[s - 1][2] + u * (kStops[s][2] - kStops[s - 1][2]),
+              kStops[s - 1][3] + u * (kStops[s][3] - kStops[s - 1][3])};
+    }
+  }
+  return {250, 250, 250};
+}
+
+// 2nd and 98th percentile of the observed heights.
+std::pair<double, double> HeightRange(const ElevationLayers& L) {
+  std::vector<float> z;
+  for (std::size_t k = 0; k < L.mean_z.size(); ++k)
+    if (L.state[k] == CellState::kObserved) z.push_back(L.mean_z[k]);
+  if (z.empty()) return {0.0, 1.0};
+  const auto at = [&](double q) {
+    auto it = z.begin() + static_cast<std::ptrdiff_t>(q * (z.size() - 1));
+    std::nth_element(z.begin(), it, z.end());
+    return static_cast<double>(*it);
+  };
+  const double lo = at(0.02), hi = at(0.98);
+  return {lo, hi > lo ? hi : lo + 1.0};
+}
+
+// Hillshade in [0, 1] of cell (i, j) from central differences of known neighbours (Horn-like).
+double Hillshade(const ElevationLayers& L, int i, int j, const ImageOptions& o) {
+  const GridGeometry& g = L.geometry;
+  const auto z = [&](int a, int b, double fallback) {
+    const CellIndex c{a, b};
+    if (!g.Contains(c)) return fallback;
+    const std::size_t k = g.Linear(c);
+    return L.state[k] == CellState::kObserved ? static_cast<double>(L.mean_z[k]) : fallback;
+  };
+  const double z0 = z(i, j, 0.0);
+  const double dzdx = (z(i + 1, j, z0) - z(i - 1, j, z0)) / (2 * g.cell_m) * o.z_exaggeration;
+  const double dzdy = (z(i, j + 1, z0) - z(i, j - 1, z0)) / (2 * g.cell_m) * o.z_exaggeration;
+  const double az = o.sun_azimuth_deg * M_PI / 180.0, alt = o.sun_altitude_deg * M_PI / 180.0;
+  // Light direction: azimuth clockwise from north (y), elevation alt.
+  const double lx = std::sin(az) * std::cos(alt), ly = std::cos(az) * std::cos(alt),
+               lz = std::sin(alt);
+  const double norm = std::sqrt(dzdx * dzdx + dzdy * dzdy + 1.0);
+  return std::max(0.0, (-dzdx * lx - dzdy * ly + lz) / norm);
+}
+
+}  // namespace
+
+void RgbImage::Set(int x, int y, std::uint8_t r, std::uint8_t g, std::uint8_t b) {
+  if (x < 0 || y < 0 || x >= width || y >= height) return;
+  std::uint8_t* p = &rgb[(static_cast<std::size_t>(y) * width + x) * 3];
+  p[0] = r;
+  p[1] = g;
+  p[2] = b;
+}
+
+RgbImage RenderElevationImage(const ElevationLayers& L, const ImageOptions& o) {
+  const GridGeometry& g = L.geometry;
+  int ppc = o.pixels_per_cell;
+  if (ppc <= 0) ppc = std::max(1, o.max_side_px / std::max(g.size_x, g.size_y));
+  RgbImage img;
+  img.pixels_per_cell = ppc;
+  img.width = g.size_x * ppc;
+  img.height = g.size_y * ppc;
+  img.rgb.assign(static_cast<std::size_t>(img.width) * img.height * 3, 0);
+  const auto [lo, hi] = HeightRange(L);
+  for (int j = 0; j < g.size_y; ++j) {
+    for (int i = 0; i < g.size_x; ++i) {
+      const std::size_t k = g.Linear({i, j});
+      std::array<double, 3> c;
+      if (L.state[k] == CellState::kObserved) {
+        const double shade = 0.35 + 0.65 * Hillshade(L, i, j, o);
+        c = Ramp((L.mean_z[k] - lo) / (hi - lo));
+        for (double& v : c) v *= shade;
+      } else if (L.state[k] == CellState::kDrop) {
+        c = {220, 0, 220};
+      } else {
+        const bool dark = ((i / 4) + (j / 4)) % 2;  // checkerboard of 4-cell squares
+        c = dark ? std::array<double, 3>{150, 150, 150} : std::array<double, 3>{200, 200, 200};
+      }
+      const int y0 = (g.size_y - 1 - j) * ppc, x0 = i * ppc;  // north up
+      for (int dy = 0; dy < ppc; ++dy)
+        for (int dx = 0; dx < ppc; ++dx)
+          img.Set(x0 + dx, y0 + dy, static_cast<std::uint8_t>(std::clamp(c[0], 0.0, 255.0)),
+                  static_cast<std::uint8_t>(std::clamp(c[1], 0.0, 255.0)),
+                  static_cast<std::uint8_t>(std::clamp(c[2], 0.0, 255.0)));
+    }
+  }
+  return img;
+}
+
+Eigen::Vector2d MapToPixel(const GridGeometry& g, const RgbImage& image, double x_m, double y_m) {
+  const double ppm = image.pixels_per_cell / g.cell_m;
+  return {(x_m - g.x_min_m) * ppm, (g.y_max_m() - y_m) * ppm};
+}
+
+Result<void> WritePng(const RgbImage& image, const std::string& path) {
+  const std::string tmp = path + ".tmp";
+  FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) return Fail(Error::Code::kInvalidArgument, path + ": cannot write");
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  if (!png || !info || setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    std::fclose(f);
+    std::remove(tmp.c_str());
+    return Fail(Error::Code::kFailed, path + ": libpng failed");
+  }
+  png_init_io(png, f);
+  png_set_IHDR(png, info, image.width, image.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  for (int y = 0; y < image.height; ++y) {
+    png_write_row(png,
+                  const_cast<png_bytep>(&image.rgb[static_cast<std::size_t>(y) * image.width * 3]));
+  }
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  if (std::fclose(f) != 0) {
+    std::remove(tmp.c_str());
+    return Fail(Error::Code::kFailed, path + ": write failed");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) return Fail(Error::Code::kFailed, path + ": rename failed: " + ec.message());
+  return {};
+}
+
+}  // namespace pitchlab::mapping

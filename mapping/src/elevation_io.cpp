@@ -1,0 +1,186 @@
+#include "pitchlab/mapping/elevation_io.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace pitchlab::mapping {
+namespace {
+
+constexpr char kMagic[8] = {'P', 'L', 'E', 'L', 'E', 'V', '0', '1'};
+static_assert(sizeof(CellStats) == 52, "the .plem record layout is 13 packed 4-byte fields");
+
+std::uint64_t Fnv1a(const std::string& bytes) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : bytes) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+template <typename T>
+void Put(std::string& out, const T& v) {
+  out.append(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+
+template <typename T>
+bool Get(const std::string& in, std::size_t& pos, T* v) {
+  if (pos + sizeof(T) > in.size()) return false;
+  std::memcpy(v, in.data() + pos, sizeof(T));
+  pos += sizeof(T);
+  return true;
+}
+
+// Writes `bytes` to a temporary file beside `path`, then renames it over `path`.
+Result<void> WriteAtomically(const std::string& path, const std::string& bytes) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out)
+      return Fail(Error::Code::kInvalidArgument, path + ": cannot write: " + std::strerror(errno));
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    if (!out.flush()) {
+      std::remove(tmp.c_str());
+      return Fail(Error::Code::kFailed, path + ": write failed");
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    return Fail(Error::Code::kFailed, path + ": rename failed: " + ec.message());
+  }
+  return {};
+}
+
+double LayerValue(const ElevationLayers& L, std::size_t k, RasterLayer layer) {
+  switch (layer) {
+    case RasterLayer::kMean:
+      return L.mean_z[k];
+    case RasterLayer::kMin:
+      return L.min_z[k];
+    case RasterLayer::kMax:
+      return L.max_z[k];
+    case RasterLayer::kRoughness:
+      return L.roughness[k];
+  }
+  return std::nan("");
+}
+
+}  // namespace
+
+Result<void> SaveElevationMap(const ElevationMap& map, const std::string& path) {
+  const GridGeometry& g = map.geometry();
+  std::string out;
+  out.reserve(128 + g.cell_count() * sizeof(CellStats));
+  out.append(kMagic, sizeof(kMagic));
+  Put(out, g.x_min_m);
+  Put(out, g.y_min_m);
+  Put(out, g.cell_m);
+  Put(out, static_cast<std::int32_t>(g.size_x));
+  Put(out, static_cast<std::int32_t>(g.size_y));
+  const GeodeticOrigin geo = map.geodetic_origin().value_or(GeodeticOrigin{});
+  Put(out, static_cast<std::uint32_t>(map.geodetic_origin().has_value()));
+  Put(out, geo.latitude_deg);
+  Put(out, geo.longitude_deg);
+  Put(out, geo.height_m);
+  Put(out, static_cast<std::uint32_t>(sizeof(CellStats)));
+  out.append(reinterpret_cast<const char*>(map.cells().data()),
+             map.cells().size() * sizeof(CellStats));
+  Put(out, Fnv1a(out));
+  return WriteAtomically(path, out);
+}
+
+Result<ElevationMap> LoadElevationMap(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Fail(Error::Code::kNotFound, path + ": cannot open: " + std::strerror(errno));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string bytes = ss.str();
+  const auto bad = [&](const std::string& why) {
+    return Fail(Error::Code::kInvalidArgument, path + ": not a pitchlab elevation map: " + why);
+  };
+  if (bytes.size() < sizeof(kMagic) + 8 || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0)
+    return bad("bad magic (expected PLELEV01)");
+  std::uint64_t stored_hash = 0;
+  std::memcpy(&stored_hash, bytes.data() + bytes.size() - 8, 8);
+  if (Fnv1a(bytes.substr(0, bytes.size() - 8)) != stored_hash)
+    return bad("hash mismatch (corrupt or truncated)");
+  std::size_t pos = sizeof(kMagic);
+  GridGeometry g;
+  std::int32_t sx = 0, sy = 0;
+  std::uint32_t has_geo = 0, record = 0;
+  GeodeticOrigin geo;
+  if (!Get(bytes, pos, &g.x_min_m) || !Get(bytes, pos, &g.y_min_m) || !Get(bytes, pos, &g.cell_m) ||
+      !Get(bytes, pos, &sx) || !Get(bytes, pos, &sy) || !Get(bytes, pos, &has_geo) ||
+      !Get(bytes, pos, &geo.latitude_deg) || !Get(bytes, pos, &geo.longitude_deg) ||
+      !Get(bytes, pos, &geo.height_m) || !Get(bytes, pos, &record))
+    return bad("truncated header");
+  if (record != sizeof(CellStats))
+    return bad("cell record of " + std::to_string(record) + " bytes");
+  if (sx <= 0 || sy <= 0 || !(g.cell_m > 0)) return bad("empty grid");
+  g.size_x = sx;
+  g.size_y = sy;
+  const std::size_t cells_bytes = g.cell_count() * sizeof(CellStats);
+  if (pos + cells_bytes + 8 != bytes.size()) return bad("size does not match the grid");
+  std::vector<CellStats> cells(g.cell_count());
+  std::memcpy(cells.data(), bytes.data() + pos, cells_bytes);
+  ElevationMap map(g, has_geo ? std::optional<GeodeticOrigin>(geo) : std::nullopt);
+  map.SetCells(std::move(cells));
+  return map;
+}
+
+std::string ProjectionWkt(const std::optional<GeodeticOrigin>& origin) {
+  if (!origin) {
+    return "LOCAL_CS[\"pitchlab map frame (x east, y north)\",LOCAL_DATUM[\"pitchlab\",0],"
+           "UNIT[\"Meter\",1.0],AXIS[\"X\",EAST],AXIS[\"Y\",NORTH]]";
+  }
+  char buf[1024];
+  std::snprintf(buf, sizeof(buf),
+                "PROJCS[\"pitchlab_local_TM\",GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\","
+                "SPHEROID[\"WGS_1984\",6378137.0,298.257223563]],PRIMEM[\"Greenwich\",0.0],"
+                "UNIT[\"Degree\",0.0174532925199433]],PROJECTION[\"Transverse_Mercator\"],"
+                "PARAMETER[\"False_Easting\",0.0],PARAMETER[\"False_Northing\",0.0],"
+                "PARAMETER[\"Central_Meridian\",%.12f],PARAMETER[\"Scale_Factor\",1.0],"
+                "PARAMETER[\"Latitude_Of_Origin\",%.12f],UNIT[\"Meter\",1.0]]",
+                origin->longitude_deg, origin->latitude_deg);
+  return buf;
+}
+
+Result<void> WriteEsriAsciiGrid(const ElevationLayers& L,
+                                const std::optional<GeodeticOrigin>& origin,
+                                const std::string& asc_path, RasterLayer layer) {
+  const GridGeometry& g = L.geometry;
+  const double z_offset = (origin && layer != RasterLayer::kRoughness) ? origin->height_m : 0.0;
+  std::string out;
+  out.reserve(g.cell_count() * 10 + 256);
+  char buf[128];
+  std::snprintf(buf, sizeof(buf),
+                "ncols %d\nnrows %d\nxllcorner %.6f\nyllcorner %.6f\ncellsize %.9g\n"
+                "NODATA_value -9999\n",
+                g.size_x, g.size_y, g.x_min_m, g.y_min_m, g.cell_m);
+  out += buf;
+  for (int j = g.size_y - 1; j >= 0; --j) {  // ESRI rows run north to south
+    for (int i = 0; i < g.size_x; ++i) {
+      const std::size_t k = g.Linear({i, j});
+      const double v = L.state[k] == CellState::kObserved ? LayerValue(L, k, layer) : std::nan("");
+      if (std::isfinite(v)) {
+        std::snprintf(buf, sizeof(buf), i ? " %.4f" : "%.4f", v + z_offset);
+      } else {
+        std::snprintf(buf, sizeof(buf), i ? " -9999" : "-9999");
+      }
+      out += buf;
+    }
+    out += '\n';
+  }
+  if (auto r = WriteAtomically(asc_path, out); !r) return r;
+  const std::filesystem::path prj = std::filesystem::path(asc_path).replace_extension(".prj");
+  return WriteAtomically(prj.string(), ProjectionWkt(origin) + "\n");
+}
+
+}  // namespace pitchlab::mapping

@@ -1,0 +1,173 @@
+#include "pitchlab/mapping/elevation_layers.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+
+namespace pitchlab::mapping {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// Pooled moments of the points of a region, in the frame of its centre cell (double precision).
+struct Moments {
+  double n = 0, mx = 0, my = 0, mz = 0;
+  double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0;
+
+  // Chan's combination with a cell (or a single point when c_* are zero) at offset (ox, oy).
+  void Add(double nb, double bx, double by, double bz, double bxx, double bxy, double bxz,
+           double byy, double byz) {
+    const double n_new = n + nb;
+    const double dx = bx - mx, dy = by - my, dz = bz - mz, w = n * nb / n_new;
+    xx += bxx + dx * dx * w;
+    xy += bxy + dx * dy * w;
+    xz += bxz + dx * dz * w;
+    yy += byy + dy * dy * w;
+    yz += byz + dy * dz * w;
+    mx += dx * nb / n_new;
+    my += dy * nb / n_new;
+    mz += dz * nb / n_new;
+    n = n_new;
+  }
+
+  // Least-squares slopes (b, c) of z = a + b x + c y; false when the xy spread along the narrow
+  // axis is below min_spread (std dev) or fewer than 3 samples.
+  bool Slopes(double min_spread, double* b, double* c) const {
+    if (n < 3) return false;
+    const double det = xx * yy - xy * xy;
+    const double tr = xx + yy;
+    const double lambda_min = 0.5 * (tr - std::sqrt(std::max(0.0, tr * tr - 4.0 * det)));
+    if (!(lambda_min / n > min_spread * min_spread) || det <= 0) return false;
+    *b = (yy * xz - xy * yz) / det;
+    *c = (xx * yz - xy * xz) / det;
+    return true;
+  }
+};
+
+// Inclination of cell (ci, cj) from its 3 x 3 region (see the header for the method).
+void Inclination(const ElevationMap& map, int ci, int cj, const LayerConfig& config, float* phi_x,
+                 float* phi_y) {
+  const GridGeometry& g = map.geometry();
+  Moments points, centres;
+  const float z_c = map.at({ci, cj}).mean_z;
+  for (int dj = -1; dj <= 1; ++dj) {
+    for (int di = -1; di <= 1; ++di) {
+      const CellIndex nb{ci + di, cj + dj};
+      if (!g.Contains(nb)) continue;
+      const CellStats& c = map.at(nb);
+      if (c.count == 0) continue;
+      const double ox = di * g.cell_m, oy = dj * g.cell_m;
+      if (std::abs(c.mean_z - z_c) > config.max_fit_slope * std::hypot(ox, oy)) continue;
+      points.Add(c.count, c.mean_x + ox, c.mean_y + oy, c.mean_z, c.c_xx, c.c_xy, c.c_xz, c.c_yy,
+                 c.c_yz);
+      centres.Add(1, ox, oy, c.mean_z, 0, 0, 0, 0, 0);
+    }
+  }
+  double b = 0, c = 0;
+  if (points.Slopes(config.min_spread_m, &b, &c) || centres.Slopes(0.25 * g.cell_m, &b, &c)) {
+    *phi_x = static_cast<float>(std::atan(b));
+    *phi_y = static_cast<float>(std::atan(c));
+  } else {
+    *phi_x = *phi_y = kNaN;
+  }
+}
+
+// Unknown cells whose clearance is below the lowest point of every observed neighbour (or below a
+// drop neighbour's reference)
+// by more than drop_depth become drops; grown breadth-first so a whole ditch is marked.
+float LowestObservedNeighbour(const ElevationLayers& L, const CellIndex& c) {
+  const GridGeometry& g = L.geometry;
+  float ref = std::numeric_limits<float>::infinity();
+  for (int dj = -1; dj <= 1; ++dj)
+    for (int di = -1; di <= 1; ++di) {
+      const CellIndex nb{c.i + di, c.j + dj};
+      if (!g.Contains(nb)) continue;
+      const std::size_t kn = g.Linear(nb);
+      if (L.state[kn] == CellState::kObserved) ref = std::min(ref, L.min_z[kn]);
+    }
+  return ref;
+}
+
+void MarkDrops(ElevationLayers& L, const LayerConfig& config) {
+  const GridGeometry& g = L.geometry;
+  std::vector<float> reference(g.cell_count(), std::numeric_limits<float>::infinity());
+  std::deque<std::size_t> queue;
+  const auto unknown_with_ray = [&](std::size_t k) {
+    return L.state[k] == CellState::kUnknown && std::isfinite(L.clearance_z[k]);
+  };
+  for (std::size_t k = 0; k < g.cell_count(); ++k) {
+    if (!unknown_with_ray(k)) continue;
+    const float ref = LowestObservedNeighbour(L, g.FromLinear(k));
+    if (std::isfinite(ref) && L.clearance_z[k] < ref - config.drop_depth_m) {
+      L.state[k] = CellState::kDrop;
+      reference[k] = ref;
+      queue.push_back(k);
+    }
+  }
+  while (!queue.empty()) {
+    const std::size_t k = queue.front();
+    queue.pop_front();
+    const CellIndex c = g.FromLinear(k);
+    for (int dj = -1; dj <= 1; ++dj)
+      for (int di = -1; di <= 1; ++di) {
+        const CellIndex nb{c.i + di, c.j + dj};
+        if (!g.Contains(nb)) continue;
+        const std::size_t kn = g.Linear(nb);
+        if (!unknown_with_ray(kn)) continue;
+        // The reference only goes down: observed ground beside the new cell stops a flood that
+        // started at something tall (a car roof, a canopy).
+        const float ref = std::min(reference[k], LowestObservedNeighbour(L, nb));
+        if (!(L.clearance_z[kn] < ref - config.drop_depth_m)) continue;
+        L.state[kn] = CellState::kDrop;
+        reference[kn] = ref;
+        queue.push_back(kn);
+      }
+  }
+}
+
+}  // namespace
+
+float Roughness(const CellStats& cell) {
+  if (cell.count == 0) return kNaN;
+  return std::sqrt(std::max(0.0f, cell.c_zz / static_cast<float>(cell.count)));  // Eq. 3
+}
+
+float ElevationLayers::Tilt(std::size_t k) const {
+  const float tx = std::tan(phi_x[k]), ty = std::tan(phi_y[k]);
+  return std::atan(std::sqrt(tx * tx + ty * ty));
+}
+
+ElevationLayers ComputeLayers(const ElevationMap& map, const LayerConfig& config) {
+  const GridGeometry& g = map.geometry();
+  const std::size_t n = g.cell_count();
+  ElevationLayers L;
+  L.geometry = g;
+  L.state.assign(n, CellState::kUnknown);
+  L.count.assign(n, 0);
+  L.mean_z.assign(n, kNaN);
+  L.min_z.assign(n, kNaN);
+  L.max_z.assign(n, kNaN);
+  L.roughness.assign(n, kNaN);
+  L.phi_x.assign(n, kNaN);
+  L.phi_y.assign(n, kNaN);
+  L.clearance_z.assign(n, std::numeric_limits<float>::infinity());
+  for (int j = 0; j < g.size_y; ++j) {
+    for (int i = 0; i < g.size_x; ++i) {
+      const std::size_t k = g.Linear({i, j});
+      const CellStats& c = map.at(k);
+      L.clearance_z[k] = c.clearance_z;
+      if (c.count == 0) continue;
+      L.state[k] = CellState::kObserved;
+      L.count[k] = c.count;
+      L.mean_z[k] = c.mean_z;  // Eq. 2
+      L.min_z[k] = c.min_z;
+      L.max_z[k] = c.max_z;
+      L.roughness[k] = Roughness(c);  // Eq. 3
+      Inclination(map, i, j, config, &L.phi_x[k], &L.phi_y[k]);
+    }
+  }
+  MarkDrops(L, config);
+  return L;
+}
+
+}  // namespace pitchlab::mapping

@@ -1,0 +1,249 @@
+#include "pitchlab/mapping/elevation_map.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace pitchlab::mapping {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// Welford's update of one cell's moments with a point (lx, ly) from the cell centre, height z.
+inline void AddToCell(CellStats& c, float lx, float ly, float z) {
+  const std::uint32_t n = ++c.count;
+  const float inv_n = 1.0f / static_cast<float>(n);
+  const float dx = lx - c.mean_x, dy = ly - c.mean_y, dz = z - c.mean_z;
+  c.mean_x += dx * inv_n;
+  c.mean_y += dy * inv_n;
+  c.mean_z += dz * inv_n;
+  const float ex = lx - c.mean_x, ey = ly - c.mean_y, ez = z - c.mean_z;
+  c.c_xx += dx * ex;
+  c.c_xy += dx * ey;
+  c.c_xz += dx * ez;
+  c.c_yy += dy * ey;
+  c.c_yz += dy * ez;
+  c.c_zz += dz * ez;
+  c.min_z = std::min(c.min_z, z);
+  c.max_z = std::max(c.max_z, z);
+}
+
+// Chan et al.'s parallel combination: `a` becomes the statistics of a's and b's points, where b's
+// positions are shifted by (ox, oy) into a's cell frame.
+void CombineInto(CellStats& a, const CellStats& b, float ox, float oy) {
+  if (b.count == 0) {
+    a.clearance_z = std::min(a.clearance_z, b.clearance_z);
+    return;
+  }
+  const double na = a.count, nb = b.count, n = na + nb;
+  const double dx = b.mean_x + ox - a.mean_x, dy = b.mean_y + oy - a.mean_y,
+               dz = b.mean_z - a.mean_z;
+  const double w = na * nb / n;
+  a.c_xx = static_cast<float>(a.c_xx + b.c_xx + dx * dx * w);
+  a.c_xy = static_cast<float>(a.c_xy + b.c_xy + dx * dy * w);
+  a.c_xz = static_cast<float>(a.c_xz + b.c_xz + dx * dz * w);
+  a.c_yy = static_cast<float>(a.c_yy + b.c_yy + dy * dy * w);
+  a.c_yz = static_cast<float>(a.c_yz + b.c_yz + dy * dz * w);
+  a.c_zz = static_cast<float>(a.c_zz + b.c_zz + dz * dz * w);
+  a.mean_x = static_cast<float>(a.mean_x + dx * nb / n);
+  a.mean_y = static_cast<float>(a.mean_y + dy * nb / n);
+  a.mean_z = static_cast<float>(a.mean_z + dz * nb / n);
+  a.count += b.count;
+  a.min_z = std::min(a.min_z, b.min_z);
+  a.max_z = std::max(a.max_z, b.max_z);
+  a.clearance_z = std::min(a.clearance_z, b.clearance_z);
+}
+
+// The float constants of the per-point loop.
+struct FastGrid {
+  float x0, y0, inv_cell, cell, half_cell;
+  int sx, sy;
+  explicit FastGrid(const GridGeometry& g)
+      : x0(static_cast<float>(g.x_min_m)),
+        y0(static_cast<float>(g.y_min_m)),
+        inv_cell(static_cast<float>(1.0 / g.cell_m)),
+        cell(static_cast<float>(g.cell_m)),
+        half_cell(static_cast<float>(0.5 * g.cell_m)),
+        sx(g.size_x),
+        sy(g.size_y) {}
+};
+
+// Walks the cells under the segment from `from` to `to` (map frame) in order (Amanatides & Woo
+// in 2D), lowering each crossed cell's clearance to the ray's highest z inside it; the cell of
+// `to` (where the point landed) is left alone. Returns the number of cells updated.
+std::size_t TraceClearance(const FastGrid& g, std::vector<CellStats>& cells,
+                           const Eigen::Vector3f& from, const Eigen::Vector3f& to) {
+  const float gx = (from.x() - g.x0) * g.inv_cell, gy = (from.y() - g.y0) * g.inv_cell;
+  const float hx = (to.x() - g.x0) * g.inv_cell, hy = (to.y() - g.y0) * g.inv_cell;
+  int i = static_cast<int>(std::floor(gx)), j = static_cast<int>(std::floor(gy));
+  const int ie = static_cast<int>(std::floor(hx)), je = static_cast<int>(std::floor(hy));
+  const float ddx = hx - gx, ddy = hy - gy;
+  const int step_i = ddx > 0 ? 1 : -1, step_j = ddy > 0 ? 1 : -1;
+  const float t_dx = ddx != 0 ? std::abs(1.0f / ddx) : kInf;
+  const float t_dy = ddy != 0 ? std::abs(1.0f / ddy) : kInf;
+  float t_x = ddx != 0 ? ((ddx > 0 ? (i + 1 - gx) : (gx - i)) * t_dx) : kInf;
+  float t_y = ddy != 0 ? ((ddy > 0 ? (j + 1 - gy) : (gy - j)) * t_dy) : kInf;
+  const float z0 = from.z(), dz = to.z() - from.z();
+  float t_in = 0.0f;
+  std::size_t updated = 0;
+  const int max_steps = std::abs(ie - i) + std::abs(je - j) + 2;
+  for (int s = 0; s < max_steps && !(i == ie && j == je); ++s) {
+    const float t_out = std::min(std::min(t_x, t_y), 1.0f);
+    if (i >= 0 && j >= 0 && i < g.sx && j < g.sy) {
+      const float z_high = z0 + dz * (dz < 0 ? t_in : t_out);
+      CellStats& c = cells[static_cast<std::size_t>(j) * g.sx + i];
+      c.clearance_z = std::min(c.clearance_z, z_high);
+      ++updated;
+    }
+    t_in = t_out;
+    if (t_x < t_y) {
+      i += step_i;
+      t_x += t_dx;
+    } else {
+      j += step_j;
+      t_y += t_dy;
+    }
+  }
+  return updated;
+}
+
+template <bool kWithRays>
+InsertStats InsertImpl(const GridGeometry& geometry, std::vector<CellStats>& cells,
+                       const Eigen::Vector3f* points, std::size_t count,
+                       const Eigen::Vector3f& origin, const InsertConfig& config) {
+  const FastGrid g(geometry);
+  const float z_lo = static_cast<float>(config.min_z_m), z_hi = static_cast<float>(config.max_z_m);
+  const float ray_len = static_cast<float>(config.clearance_length_m);
+  InsertStats stats;
+  for (std::size_t k = 0; k < count; ++k) {
+    const Eigen::Vector3f& p = points[k];
+    if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) {
+      ++stats.non_finite;
+      continue;
+    }
+    const float fx = (p.x() - g.x0) * g.inv_cell, fy = (p.y() - g.y0) * g.inv_cell;
+    if (!(fx >= 0.0f && fy >= 0.0f && fx < g.sx && fy < g.sy && p.z() >= z_lo && p.z() <= z_hi)) {
+      ++stats.outside;
+      continue;
+    }
+    const int i = static_cast<int>(fx), j = static_cast<int>(fy);
+    const float lx = p.x() - (g.x0 + i * g.cell + g.half_cell);
+    const float ly = p.y() - (g.y0 + j * g.cell + g.half_cell);
+    AddToCell(cells[static_cast<std::size_t>(j) * g.sx + i], lx, ly, p.z());
+    ++stats.inserted;
+    if constexpr (kWithRays) {
+      if (ray_len <= 0.0f) continue;
+      const Eigen::Vector3f d = p - origin;
+      const float horizontal = std::hypot(d.x(), d.y());
+      if (horizontal < 1e-6f) continue;
+      const Eigen::Vector3f from =
+          horizontal > ray_len ? Eigen::Vector3f(p - d * (ray_len / horizontal)) : origin;
+      stats.clearance_cells += TraceClearance(g, cells, from, p);
+    }
+  }
+  return stats;
+}
+
+}  // namespace
+
+GridGeometry GridGeometry::FromArea(double x_min_m, double y_min_m, double size_x_m,
+                                    double size_y_m, double cell_m) {
+  if (!(cell_m > 0.0) || !(size_x_m > 0.0) || !(size_y_m > 0.0)) {
+    throw std::invalid_argument("elevation map: cell (" + std::to_string(cell_m) +
+                                " m) and area (" + std::to_string(size_x_m) + " x " +
+                                std::to_string(size_y_m) + " m) must be positive");
+  }
+  GridGeometry g;
+  g.x_min_m = x_min_m;
+  g.y_min_m = y_min_m;
+  g.cell_m = cell_m;
+  const double m = std::max(1.0, std::round(size_x_m / cell_m));  // Eq. 2
+  const double n = std::max(1.0, std::round(size_y_m / cell_m));
+  if (m * n > 2147483647.0) {
+    throw std::invalid_argument("elevation map: " + std::to_string(m) + " x " + std::to_string(n) +
+                                " cells is too many; use a coarser cell");
+  }
+  g.size_x = static_cast<int>(m);
+  g.size_y = static_cast<int>(n);
+  return g;
+}
+
+GridGeometry GridGeometry::Covering(const Eigen::Vector2d& lo_m, const Eigen::Vector2d& hi_m,
+                                    double cell_m, double margin_m) {
+  if (!(cell_m > 0.0)) throw std::invalid_argument("elevation map: cell must be positive");
+  const double x0 = std::floor((lo_m.x() - margin_m) / cell_m) * cell_m;
+  const double y0 = std::floor((lo_m.y() - margin_m) / cell_m) * cell_m;
+  const double x1 = (std::floor((hi_m.x() + margin_m) / cell_m) + 1) * cell_m;
+  const double y1 = (std::floor((hi_m.y() + margin_m) / cell_m) + 1) * cell_m;
+  return FromArea(x0, y0, x1 - x0, y1 - y0, cell_m);
+}
+
+bool GridGeometry::SameAs(const GridGeometry& o) const {
+  return size_x == o.size_x && size_y == o.size_y && std::abs(cell_m - o.cell_m) < 1e-12 &&
+         std::abs(x_min_m - o.x_min_m) < 1e-9 && std::abs(y_min_m - o.y_min_m) < 1e-9;
+}
+
+ElevationMap::ElevationMap(const GridGeometry& geometry,
+                           std::optional<GeodeticOrigin> geodetic_origin)
+    : geometry_(geometry), geodetic_origin_(geodetic_origin) {
+  if (geometry.size_x <= 0 || geometry.size_y <= 0 || !(geometry.cell_m > 0.0)) {
+    throw std::invalid_argument("elevation map: empty geometry (" +
+                                std::to_string(geometry.size_x) + " x " +
+                                std::to_string(geometry.size_y) + " cells)");
+  }
+  cells_.assign(geometry.cell_count(), CellStats{});
+}
+
+InsertStats ElevationMap::InsertPoints(const Eigen::Vector3f* points_m, std::size_t count,
+                                       const InsertConfig& config) {
+  return InsertImpl<false>(geometry_, cells_, points_m, count, Eigen::Vector3f::Zero(), config);
+}
+
+InsertStats ElevationMap::InsertScan(const Eigen::Vector3f* points_m, std::size_t count,
+                                     const Eigen::Vector3f& sensor_origin_m,
+                                     const InsertConfig& config) {
+  return InsertImpl<true>(geometry_, cells_, points_m, count, sensor_origin_m, config);
+}
+
+Result<std::size_t> ElevationMap::Merge(const ElevationMap& other) {
+  const GridGeometry& a = geometry_;
+  const GridGeometry& b = other.geometry_;
+  if (std::abs(a.cell_m - b.cell_m) > 1e-9 * a.cell_m) {
+    return Fail(Error::Code::kInvalidArgument, "merge: cell sizes differ (" +
+                                                   std::to_string(a.cell_m) + " m vs " +
+                                                   std::to_string(b.cell_m) + " m)");
+  }
+  const double oi = (b.x_min_m - a.x_min_m) / a.cell_m, oj = (b.y_min_m - a.y_min_m) / a.cell_m;
+  if (std::abs(oi - std::round(oi)) > 1e-6 || std::abs(oj - std::round(oj)) > 1e-6) {
+    return Fail(Error::Code::kInvalidArgument, "merge: grids are offset by a fraction of a cell (" +
+                                                   std::to_string(oi) + ", " + std::to_string(oj) +
+                                                   " cells); resample one onto the other's grid");
+  }
+  const int di = static_cast<int>(std::lround(oi)), dj = static_cast<int>(std::lround(oj));
+  std::size_t dropped = 0;
+  for (int j = 0; j < b.size_y; ++j) {
+    for (int i = 0; i < b.size_x; ++i) {
+      const CellStats& src = other.cells_[static_cast<std::size_t>(j) * b.size_x + i];
+      if (src.count == 0 && !std::isfinite(src.clearance_z)) continue;
+      const CellIndex dst{i + di, j + dj};
+      if (!a.Contains(dst)) {
+        dropped += src.count > 0;
+        continue;
+      }
+      CombineInto(cells_[a.Linear(dst)], src, 0.0f, 0.0f);
+    }
+  }
+  return dropped;
+}
+
+void ElevationMap::SetCells(std::vector<CellStats> cells) {
+  if (cells.size() != geometry_.cell_count()) {
+    throw std::invalid_argument("elevation map: " + std::to_string(cells.size()) +
+                                " cells given for a grid of " +
+                                std::to_string(geometry_.cell_count()));
+  }
+  cells_ = std::move(cells);
+}
+
+}  // namespace pitchlab::mapping

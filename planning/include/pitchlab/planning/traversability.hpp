@@ -1,0 +1,98 @@
+#pragma once
+// Traversability (Eq. 3-5 inputs): which cells a P3 may stand on, and what entering each costs.
+// Built once per plan from the elevation map's layers; the graph search only reads flat arrays.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pitchlab/mapping/elevation_layers.hpp"
+
+namespace pitchlab::planning {
+
+/// The weights of Eq. 5: cost of an edge u->v = W_T*T_v + W_P*P_uv + W_phix*|phi_x_v| +
+/// W_phiy*|phi_y_v| (+ the unknown penalty), T [m], P [m] (Eq. 4: 3D length), phi [rad].
+struct CostWeights {
+  double roughness = 10.0;     ///< W_T [1/m]
+  double length = 1.0;         ///< W_P [1/m]
+  double inclination_x = 1.0;  ///< W_phix [1/rad]
+  double inclination_y = 1.0;  ///< W_phiy [1/rad]
+};
+
+/// What a robot can drive over.
+struct RobotLimits {
+  std::string name = "p3at";
+  double step_max_m = 0.089;  ///< highest step between neighbouring cells (or within one) [m]
+  double max_inclination_rad = 0.3367;  ///< slip/tip limit of the cell's plane tilt [rad]
+  double width_m = 0.497;               ///< footprint width: no path through a narrower gap [m]
+
+  /// Pioneer 3-AT (datasheet: 8.9 cm step, 35 % grade, 50.8 x 49.7 cm).
+  static RobotLimits P3AT();
+  /// Pioneer 3-DX (datasheet: 2.5 cm step, 25 % grade, 45.5 x 38.1 cm).
+  static RobotLimits P3DX();
+  /// "p3at" or "p3dx"; throws std::invalid_argument naming the known presets otherwise.
+  static RobotLimits Preset(const std::string& name);
+};
+
+/// What unknown cells are to the planner.
+enum class UnknownPolicy { kForbid, kPenalise };
+
+/// Everything a plan is configured by (YAML: see LoadPlannerConfig).
+struct PlannerConfig {
+  CostWeights weights;
+  RobotLimits robot = RobotLimits::P3AT();
+  UnknownPolicy unknown = UnknownPolicy::kForbid;
+  double unknown_penalty = 1.0;  ///< added to an edge entering an unknown cell (kPenalise) [1]
+
+  /// Throws std::invalid_argument naming the field and value (negative weights, non-positive
+  /// limits).
+  void Validate() const;
+};
+
+/// Reads a planner YAML file:
+///   robot: p3at                  # preset (p3at | p3dx), then any of its fields overridden:
+///   step_max_m: 0.089
+///   max_inclination_deg: 19.3
+///   width_m: 0.497
+///   weights: {roughness: 10, length: 1, inclination_x: 1, inclination_y: 1}
+///   unknown: forbid              # forbid | penalise
+///   unknown_penalty: 1.0
+/// Missing fields keep their defaults. Throws std::runtime_error naming the file, field and value.
+PlannerConfig LoadPlannerConfig(const std::string& path);
+/// The same from YAML text; `source_name` is used in error messages.
+PlannerConfig ParsePlannerConfig(const std::string& yaml_text, const std::string& source_name);
+
+/// Why a cell may not be entered.
+enum class Blocked : std::uint8_t {
+  kFree = 0,
+  kUnknown,     ///< no data (with UnknownPolicy::kForbid)
+  kDrop,        ///< a negative hazard
+  kStep,        ///< a step above step_max_m to a neighbour, or within the cell
+  kTooSteep,    ///< plane tilt above max_inclination_rad
+  kNearHazard,  ///< within half the robot's width of a step, drop or steep cell (footprint)
+};
+const char* ToString(Blocked b);
+
+/// The planning graph's per-cell data: 8-connected cells of the map's geometry.
+struct TraversabilityGrid {
+  mapping::GridGeometry geometry;
+  PlannerConfig config;
+  std::vector<float> z_m;          ///< cell height for P and steps [m]; NaN unknown
+  std::vector<float> enter_cost;   ///< W_T*T + W_phix*|phi_x| + W_phiy*|phi_y| (+ penalty) [1]
+  std::vector<float> roughness_m;  ///< T [m] (0 when unknown)
+  std::vector<float> phi_x_rad, phi_y_rad;  ///< [rad] (0 when unknown)
+  std::vector<Blocked> blocked;
+  /// Bit b set: the move to neighbour b is allowed (target free, no blocked corner cut); order
+  /// +x, -x, +y, -y, (+x+y), (+x-y), (-x+y), (-x-y). Computed for every cell.
+  std::vector<std::uint8_t> moves;
+  float min_enter_cost = 0;  ///< over free cells, for the A* heuristic [1]
+
+  bool Free(std::size_t k) const { return blocked[k] == Blocked::kFree; }
+};
+
+/// Classifies every cell and precomputes its entry cost. Throws std::invalid_argument on a bad
+/// config.
+TraversabilityGrid BuildTraversability(const mapping::ElevationLayers& layers,
+                                       const PlannerConfig& config);
+
+}  // namespace pitchlab::planning

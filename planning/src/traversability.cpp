@@ -1,0 +1,261 @@
+#include "pitchlab/planning/traversability.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace pitchlab::planning {
+namespace {
+
+using mapping::CellIndex;
+using mapping::CellState;
+using mapping::ElevationLayers;
+using mapping::GridGeometry;
+
+constexpr double kDegToRad = M_PI / 180.0;
+
+std::string Named(const std::string& source, const std::string& field, const std::string& why) {
+  return source + ": field '" + field + "': " + why;
+}
+
+template <typename T>
+void Read(const YAML::Node& node, const std::string& key, const std::string& source, T* out) {
+  if (!node[key]) return;
+  try {
+    *out = node[key].as<T>();
+  } catch (const YAML::Exception&) {
+    throw std::runtime_error(
+        Named(source, key, "not a valid value ('" + YAML::Dump(node[key]) + "')"));
+  }
+}
+
+// Steps within a cell (something sticking up or down from its mean), or this cell standing higher
+// than an observed neighbour by more than step_max: the upper side of a step is the hazard cell
+// (a wall, a curb's top, a cliff's edge), so gaps keep their true width before inflation.
+bool HasStep(const ElevationLayers& L, int i, int j, double step_max) {
+  const GridGeometry& g = L.geometry;
+  const std::size_t k = g.Linear({i, j});
+  const float z = L.mean_z[k];
+  if (L.max_z[k] - z > step_max || z - L.min_z[k] > step_max) return true;
+  for (int dj = -1; dj <= 1; ++dj)
+    for (int di = -1; di <= 1; ++di) {
+      const CellIndex nb{i + di, j + dj};
+      if ((di == 0 && dj == 0) || !g.Contains(nb)) continue;
+      const std::size_t kn = g.Linear(nb);
+      if (L.state[kn] == CellState::kObserved && z - L.mean_z[kn] > step_max) return true;
+    }
+  return false;
+}
+
+// Footprint: every free cell whose centre is closer than half the robot's width plus half a cell
+// to the centre of a hazard cell (its edge, within half a cell) is blocked. Stamps a disc around
+// the hazard cells that border a non-hazard cell.
+void InflateHazards(TraversabilityGrid& T) {
+  const GridGeometry& g = T.geometry;
+  const double reach_m = 0.5 * T.config.robot.width_m + 0.5 * g.cell_m;
+  const int r = static_cast<int>(std::ceil(reach_m / g.cell_m));
+  std::vector<std::pair<int, int>> disc;
+  for (int dj = -r; dj <= r; ++dj)
+    for (int di = -r; di <= r; ++di)
+      if (std::hypot(di, dj) * g.cell_m < reach_m - 1e-9 && (di || dj)) disc.emplace_back(di, dj);
+  const auto hazard = [&](std::size_t k) {
+    return T.blocked[k] == Blocked::kDrop || T.blocked[k] == Blocked::kStep ||
+           T.blocked[k] == Blocked::kTooSteep;
+  };
+  std::vector<std::size_t> border;
+  for (int j = 0; j < g.size_y; ++j)
+    for (int i = 0; i < g.size_x; ++i) {
+      const std::size_t k = g.Linear({i, j});
+      if (!hazard(k)) continue;
+      bool edge = false;
+      for (const auto& [di, dj] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+        const CellIndex nb{i + di, j + dj};
+        edge |= g.Contains(nb) && !hazard(g.Linear(nb));
+      }
+      if (edge) border.push_back(k);
+    }
+  for (std::size_t k : border) {
+    const CellIndex c = g.FromLinear(k);
+    for (const auto& [di, dj] : disc) {
+      const CellIndex nb{c.i + di, c.j + dj};
+      if (!g.Contains(nb)) continue;
+      Blocked& b = T.blocked[g.Linear(nb)];
+      if (b == Blocked::kFree || b == Blocked::kUnknown) b = Blocked::kNearHazard;
+    }
+  }
+}
+
+// The 8-neighbour move mask of every cell (see TraversabilityGrid::moves).
+void ComputeMoves(TraversabilityGrid& T) {
+  static constexpr int kDi[8] = {1, -1, 0, 0, 1, 1, -1, -1}, kDj[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+  const GridGeometry& g = T.geometry;
+  T.moves.assign(g.cell_count(), 0);
+  const auto free = [&](int i, int j) { return g.Contains({i, j}) && T.Free(g.Linear({i, j})); };
+  for (int j = 0; j < g.size_y; ++j)
+    for (int i = 0; i < g.size_x; ++i) {
+      std::uint8_t m = 0;
+      for (int b = 0; b < 8; ++b) {
+        const bool ok =
+            free(i + kDi[b], j + kDj[b]) && (b < 4 || (free(i + kDi[b], j) && free(i, j + kDj[b])));
+        m |= static_cast<std::uint8_t>(ok) << b;
+      }
+      T.moves[g.Linear({i, j})] = m;
+    }
+}
+
+}  // namespace
+
+RobotLimits RobotLimits::P3AT() { return {"p3at", 0.089, std::atan(0.35), 0.497}; }
+RobotLimits RobotLimits::P3DX() { return {"p3dx", 0.025, std::atan(0.25), 0.381}; }
+RobotLimits RobotLimits::Preset(const std::string& name) {
+  if (name == "p3at") return P3AT();
+  if (name == "p3dx") return P3DX();
+  throw std::invalid_argument("unknown robot '" + name + "'; known: p3at, p3dx");
+}
+
+void PlannerConfig::Validate() const {
+  const auto check = [](bool ok, const std::string& field, double v) {
+    if (!ok)
+      throw std::invalid_argument("planner config: " + field + " = " + std::to_string(v) +
+                                  " is out of range");
+  };
+  check(weights.roughness >= 0, "weights.roughness", weights.roughness);
+  check(weights.length > 0, "weights.length", weights.length);
+  check(weights.inclination_x >= 0, "weights.inclination_x", weights.inclination_x);
+  check(weights.inclination_y >= 0, "weights.inclination_y", weights.inclination_y);
+  check(robot.step_max_m > 0, "step_max_m", robot.step_max_m);
+  check(robot.max_inclination_rad > 0 && robot.max_inclination_rad < M_PI / 2, "max_inclination",
+        robot.max_inclination_rad);
+  check(robot.width_m >= 0, "width_m", robot.width_m);
+  check(unknown_penalty >= 0, "unknown_penalty", unknown_penalty);
+}
+
+PlannerConfig ParsePlannerConfig(const std::string& yaml_text, const std::string& source) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(source + ": not valid YAML: " + e.what());
+  }
+  PlannerConfig c;
+  if (!root || root.IsNull()) return c;
+  if (!root.IsMap()) throw std::runtime_error(source + ": expected a mapping at the top level");
+  std::string robot = "p3at";
+  Read(root, "robot", source, &robot);
+  try {
+    c.robot = RobotLimits::Preset(robot);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(Named(source, "robot", e.what()));
+  }
+  Read(root, "step_max_m", source, &c.robot.step_max_m);
+  double incl_deg = c.robot.max_inclination_rad / kDegToRad;
+  Read(root, "max_inclination_deg", source, &incl_deg);
+  c.robot.max_inclination_rad = incl_deg * kDegToRad;
+  Read(root, "width_m", source, &c.robot.width_m);
+  if (const YAML::Node w = root["weights"]) {
+    Read(w, "roughness", source, &c.weights.roughness);
+    Read(w, "length", source, &c.weights.length);
+    Read(w, "inclination_x", source, &c.weights.inclination_x);
+    Read(w, "inclination_y", source, &c.weights.inclination_y);
+  }
+  std::string unknown = "forbid";
+  Read(root, "unknown", source, &unknown);
+  if (unknown == "forbid") {
+    c.unknown = UnknownPolicy::kForbid;
+  } else if (unknown == "penalise" || unknown == "penalize") {
+    c.unknown = UnknownPolicy::kPenalise;
+  } else {
+    throw std::runtime_error(
+        Named(source, "unknown", "'" + unknown + "' is not forbid or penalise"));
+  }
+  Read(root, "unknown_penalty", source, &c.unknown_penalty);
+  try {
+    c.Validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(source + ": " + e.what());
+  }
+  return c;
+}
+
+PlannerConfig LoadPlannerConfig(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot read the planner config");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ParsePlannerConfig(ss.str(), path);
+}
+
+const char* ToString(Blocked b) {
+  switch (b) {
+    case Blocked::kFree:
+      return "free";
+    case Blocked::kUnknown:
+      return "unknown";
+    case Blocked::kDrop:
+      return "drop";
+    case Blocked::kStep:
+      return "step";
+    case Blocked::kTooSteep:
+      return "too steep";
+    case Blocked::kNearHazard:
+      return "closer to a hazard than half the robot's width";
+  }
+  return "?";
+}
+
+TraversabilityGrid BuildTraversability(const ElevationLayers& L, const PlannerConfig& config) {
+  config.Validate();
+  const GridGeometry& g = L.geometry;
+  const std::size_t n = g.cell_count();
+  TraversabilityGrid T;
+  T.geometry = g;
+  T.config = config;
+  T.z_m.assign(n, std::numeric_limits<float>::quiet_NaN());
+  T.enter_cost.assign(n, 0.0f);
+  T.roughness_m.assign(n, 0.0f);
+  T.phi_x_rad.assign(n, 0.0f);
+  T.phi_y_rad.assign(n, 0.0f);
+  T.blocked.assign(n, Blocked::kFree);
+  const CostWeights& w = config.weights;
+  for (int j = 0; j < g.size_y; ++j)
+    for (int i = 0; i < g.size_x; ++i) {
+      const std::size_t k = g.Linear({i, j});
+      if (L.state[k] == CellState::kDrop) {
+        T.blocked[k] = Blocked::kDrop;
+        continue;
+      }
+      if (L.state[k] == CellState::kUnknown) {
+        T.blocked[k] =
+            config.unknown == UnknownPolicy::kForbid ? Blocked::kUnknown : Blocked::kFree;
+        T.enter_cost[k] = static_cast<float>(config.unknown_penalty);
+        continue;
+      }
+      T.z_m[k] = L.mean_z[k];
+      T.roughness_m[k] = L.roughness[k];
+      const bool incl_known = std::isfinite(L.phi_x[k]) && std::isfinite(L.phi_y[k]);
+      T.phi_x_rad[k] = incl_known ? L.phi_x[k] : 0.0f;
+      T.phi_y_rad[k] = incl_known ? L.phi_y[k] : 0.0f;
+      // Eq. 5 without the length term, which depends on the edge.
+      T.enter_cost[k] = static_cast<float>(w.roughness * T.roughness_m[k] +
+                                           w.inclination_x * std::abs(T.phi_x_rad[k]) +
+                                           w.inclination_y * std::abs(T.phi_y_rad[k]));
+      if (incl_known && L.Tilt(k) > config.robot.max_inclination_rad) {
+        T.blocked[k] = Blocked::kTooSteep;
+      } else if (HasStep(L, i, j, config.robot.step_max_m)) {
+        T.blocked[k] = Blocked::kStep;
+      }
+    }
+  InflateHazards(T);
+  ComputeMoves(T);
+  float min_cost = std::numeric_limits<float>::infinity();
+  for (std::size_t k = 0; k < n; ++k)
+    if (T.Free(k)) min_cost = std::min(min_cost, T.enter_cost[k]);
+  T.min_enter_cost = std::isfinite(min_cost) ? min_cost : 0.0f;
+  return T;
+}
+
+}  // namespace pitchlab::planning

@@ -1,0 +1,325 @@
+// Elevation map (Eq. 2, 3, inclination) on hand-built clouds with known answers.
+
+#include <gtest/gtest.h>
+
+#include <GeographicLib/LocalCartesian.hpp>
+#include <GeographicLib/TransverseMercator.hpp>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "pitchlab/mapping/elevation_io.hpp"
+#include "pitchlab/mapping/elevation_layers.hpp"
+#include "pitchlab/mapping/elevation_map.hpp"
+#include "pitchlab/mapping/elevation_truth.hpp"
+#include "pitchlab/sensors/ray_caster.hpp"
+
+namespace pitchlab::mapping {
+namespace {
+
+constexpr double kHeightTolM = 1e-5;
+constexpr double kAngleTolRad = 1e-4;
+
+std::filesystem::path TempDir(const std::string& name) {
+  auto dir = std::filesystem::temp_directory_path() / ("pitchlab_elev_" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+// Points on a regular lattice of `step_m` over [x0, x1) x [y0, y1) at height f(x, y).
+template <typename F>
+std::vector<Eigen::Vector3f> Lattice(double x0, double x1, double y0, double y1, double step_m,
+                                     F f) {
+  std::vector<Eigen::Vector3f> pts;
+  for (double y = y0 + step_m / 2; y < y1; y += step_m)
+    for (double x = x0 + step_m / 2; x < x1; x += step_m)
+      pts.emplace_back(static_cast<float>(x), static_cast<float>(y), static_cast<float>(f(x, y)));
+  return pts;
+}
+
+TEST(ElevationMap, Eq2GridSizeIsAreaOverCellRounded) {
+  const GridGeometry g = GridGeometry::FromArea(-5, -2.5, 10.04, 4.96, 0.1);
+  EXPECT_EQ(g.size_x, 100);
+  EXPECT_EQ(g.size_y, 50);
+  EXPECT_EQ(g.IndexOf(-4.95, -2.45), (CellIndex{0, 0}));
+  EXPECT_EQ(g.IndexOf(4.95, 2.45), (CellIndex{99, 49}));
+  EXPECT_THROW(GridGeometry::FromArea(0, 0, 1, 1, 0.0), std::invalid_argument);
+  EXPECT_LE(ElevationMap::kBytesPerCell, 64u);
+}
+
+TEST(ElevationMap, TiltedPlaneGivesItsInclination) {
+  const double bx = 0.2, by = -0.1;
+  const auto plane = [&](double x, double y) { return 1.0 + bx * x + by * y; };
+  ElevationMap map(GridGeometry::FromArea(0, 0, 2, 2, 0.2));
+  const auto pts = Lattice(0, 2, 0, 2, 0.02, plane);
+  const InsertStats s = map.InsertPoints(pts.data(), pts.size());
+  EXPECT_EQ(s.inserted, pts.size());
+  const ElevationLayers L = ComputeLayers(map);
+  for (int j = 0; j < 10; ++j)
+    for (int i = 0; i < 10; ++i) {
+      const std::size_t k = L.geometry.Linear({i, j});
+      ASSERT_EQ(L.state[k], CellState::kObserved);
+      EXPECT_NEAR(L.phi_x[k], std::atan(bx), kAngleTolRad) << i << "," << j;
+      EXPECT_NEAR(L.phi_y[k], std::atan(by), kAngleTolRad) << i << "," << j;
+      const Eigen::Vector2d c = L.geometry.CenterOf({i, j});
+      EXPECT_NEAR(L.mean_z[k], plane(c.x(), c.y()), kHeightTolM);  // lattice symmetric in cell
+    }
+  EXPECT_NEAR(L.Tilt(0), std::atan(std::hypot(bx, by)), kAngleTolRad);
+}
+
+TEST(ElevationMap, SingleScanLineStillGetsAnInclinationFromItsNeighbours) {
+  // Each cell sees points on one line along x only: the pooled fit along y is degenerate per
+  // cell, but the 3 x 3 region spans rows, so the inclination is still known.
+  ElevationMap map(GridGeometry::FromArea(0, 0, 1, 1, 0.1));
+  std::vector<Eigen::Vector3f> pts;
+  for (int j = 0; j < 10; ++j)
+    for (int s = 0; s < 20; ++s) {
+      const float x = 0.0025f + s * 0.05f, y = 0.05f + j * 0.1f;
+      pts.emplace_back(x, y, 0.3f * y);
+    }
+  (void)map.InsertPoints(pts.data(), pts.size());
+  const ElevationLayers L = ComputeLayers(map);
+  const std::size_t k = L.geometry.Linear({5, 5});
+  EXPECT_NEAR(L.phi_x[k], 0.0, kAngleTolRad);
+  EXPECT_NEAR(L.phi_y[k], std::atan(0.3), kAngleTolRad);
+}
+
+TEST(ElevationMap, BoxGivesItsHeightAndAStepEdge) {
+  // Ground z = 0 over 4 x 4 m; a 1 x 1 m box of height 0.3 m at [1.5, 2.5]^2, sides sampled.
+  const double h = 0.3;
+  const auto inside = [](double x, double y) { return x > 1.5 && x < 2.5 && y > 1.5 && y < 2.5; };
+  auto pts = Lattice(0, 4, 0, 4, 0.02, [&](double x, double y) { return inside(x, y) ? h : 0.0; });
+  for (double z = 0.0; z <= h; z += 0.02)
+    for (double t = 1.5; t < 2.5; t += 0.02) pts.emplace_back(1.5f, float(t), float(z));
+  ElevationMap map(GridGeometry::FromArea(0, 0, 4, 4, 0.2));
+  (void)map.InsertPoints(pts.data(), pts.size());
+  const ElevationLayers L = ComputeLayers(map);
+  const auto k = [&](double x, double y) { return L.geometry.Linear(L.geometry.IndexOf(x, y)); };
+  EXPECT_NEAR(L.mean_z[k(2.0, 2.0)], h, kHeightTolM);
+  EXPECT_NEAR(L.roughness[k(2.0, 2.0)], 0.0, kHeightTolM);
+  EXPECT_NEAR(L.mean_z[k(0.5, 0.5)], 0.0, kHeightTolM);
+  // The edge cell x in [1.4, 1.6) holds ground, the wall and the top: min 0, max 0.3.
+  EXPECT_NEAR(L.min_z[k(1.5, 2.0)], 0.0, kHeightTolM);
+  EXPECT_NEAR(L.max_z[k(1.5, 2.0)], h, kHeightTolM);
+  EXPECT_GT(L.roughness[k(1.5, 2.0)], 0.1);
+  // Neighbouring cells across the edge differ by the box height.
+  EXPECT_NEAR(L.mean_z[k(1.7, 2.0)] - L.mean_z[k(1.3, 2.0)], h, kHeightTolM);
+}
+
+TEST(ElevationMap, RoughnessOfAKnownDistribution) {
+  // Heights N(0.5, 0.04^2) in one cell; Eq. 3 T is their standard deviation.
+  const double sigma_m = 0.04, tol_m = 0.0005;
+  std::mt19937 rng(7);
+  std::normal_distribution<float> z(0.5f, static_cast<float>(sigma_m));
+  std::uniform_real_distribution<float> xy(0.0f, 0.5f);
+  std::vector<Eigen::Vector3f> pts(200000);
+  for (auto& p : pts) p = {xy(rng), xy(rng), z(rng)};
+  ElevationMap map(GridGeometry::FromArea(0, 0, 0.5, 0.5, 0.5));
+  (void)map.InsertPoints(pts.data(), pts.size());
+  EXPECT_NEAR(Roughness(map.at({0, 0})), sigma_m, tol_m);
+  EXPECT_NEAR(map.at({0, 0}).mean_z, 0.5, tol_m);
+}
+
+TEST(ElevationMap, UnknownWhereNoPointFellAndOutsidePointsCounted) {
+  ElevationMap map(GridGeometry::FromArea(0, 0, 1, 1, 0.5));
+  const std::vector<Eigen::Vector3f> pts = {
+      {0.1f, 0.1f, 1.0f}, {5.0f, 0.1f, 1.0f}, {0.1f, -0.1f, 1.0f}, {NAN, 0.1f, 1.0f}};
+  const InsertStats s = map.InsertPoints(pts.data(), pts.size());
+  EXPECT_EQ(s.inserted, 1u);
+  EXPECT_EQ(s.outside, 2u);
+  EXPECT_EQ(s.non_finite, 1u);
+  const ElevationLayers L = ComputeLayers(map);
+  EXPECT_EQ(L.state[0], CellState::kObserved);
+  EXPECT_EQ(L.state[3], CellState::kUnknown);
+  EXPECT_TRUE(std::isnan(L.mean_z[3]));
+}
+
+TEST(ElevationMap, MergeEqualsInsertingBothClouds) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0.0f, 2.0f), n(-0.05f, 0.05f);
+  std::vector<Eigen::Vector3f> a(5000), b(7000);
+  for (auto& p : a) p = {u(rng), u(rng), 0.1f * p.x() + n(rng)};
+  for (auto& p : b) p = {u(rng) + 1.0f, u(rng), 0.1f * p.x() + n(rng)};
+  const GridGeometry ga = GridGeometry::FromArea(0, 0, 3, 2, 0.25);
+  const GridGeometry gb = GridGeometry::FromArea(1, 0, 2, 2, 0.25);  // offset by 4 cells
+  ElevationMap all(ga), ma(ga), mb(gb);
+  (void)all.InsertPoints(a.data(), a.size());
+  (void)all.InsertPoints(b.data(), b.size());
+  (void)ma.InsertPoints(a.data(), a.size());
+  (void)mb.InsertPoints(b.data(), b.size());
+  const auto merged = ma.Merge(mb);
+  ASSERT_TRUE(merged) << merged.error().message;
+  EXPECT_EQ(*merged, 0u);
+  for (std::size_t k = 0; k < ga.cell_count(); ++k) {
+    const CellStats &x = all.at(k), &y = ma.at(k);
+    ASSERT_EQ(x.count, y.count);
+    EXPECT_NEAR(x.mean_z, y.mean_z, 1e-5);
+    EXPECT_NEAR(Roughness(x), Roughness(y), 1e-4);
+    EXPECT_EQ(x.min_z, y.min_z);
+    EXPECT_EQ(x.max_z, y.max_z);
+  }
+  ElevationMap misaligned(GridGeometry::FromArea(0.1, 0, 1, 1, 0.25));
+  EXPECT_FALSE(ma.Merge(misaligned));
+}
+
+TEST(ElevationMap, DitchShowsAsDropNotAsUnknown) {
+  // Flat ground z = 0 except a ditch 1 m wide and 0.6 m deep at x in [4, 5); the laser at
+  // (0, 0, 0.55) sees the near ground, the far wall and the far ground, never the ditch floor.
+  const Eigen::Vector3f sensor(0.0f, 0.0f, 0.55f);
+  std::vector<Eigen::Vector3f> pts;
+  for (double y = -1.0; y < 1.0; y += 0.05) {
+    for (double x = 0.5; x < 4.0; x += 0.05) pts.emplace_back(float(x), float(y), 0.0f);
+    for (double z = -0.6; z < 0.0; z += 0.02) pts.emplace_back(5.0f, float(y), float(z));
+    for (double x = 5.0; x < 8.0; x += 0.05) pts.emplace_back(float(x), float(y), 0.0f);
+  }
+  ElevationMap map(GridGeometry::FromArea(0, -1, 8, 2, 0.1));
+  const InsertStats s = map.InsertScan(pts.data(), pts.size(), sensor);
+  EXPECT_GT(s.clearance_cells, 0u);
+  const ElevationLayers L = ComputeLayers(map);
+  int drops = 0, unknown = 0;
+  for (int i = 40; i < 50; ++i) {
+    const std::size_t k = L.geometry.Linear({i, 10});
+    drops += L.state[k] == CellState::kDrop;
+    unknown += L.state[k] == CellState::kUnknown;
+  }
+  EXPECT_GE(drops, 8) << "ditch cells marked drop";
+  EXPECT_EQ(L.state[L.geometry.Linear({20, 10})], CellState::kObserved);
+  // Without rays the same ditch is merely unknown.
+  ElevationMap no_rays(map.geometry());
+  (void)no_rays.InsertPoints(pts.data(), pts.size());
+  EXPECT_EQ(ComputeLayers(no_rays).state[L.geometry.Linear({45, 10})], CellState::kUnknown);
+}
+
+TEST(ElevationMapIo, SaveLoadIsLosslessAndInsertionContinues) {
+  const auto dir = TempDir("io");
+  ElevationMap map(GridGeometry::FromArea(-1, -1, 2, 2, 0.1), GeodeticOrigin{39.5, -104.3, 1500});
+  auto pts = Lattice(-1, 1, -1, 0, 0.03, [](double x, double y) { return 0.1 * x * y; });
+  (void)map.InsertScan(pts.data(), pts.size(), Eigen::Vector3f(0, 0, 0.5f));
+  const std::string path = (dir / "m.plem").string();
+  ASSERT_TRUE(SaveElevationMap(map, path));
+  auto loaded = LoadElevationMap(path);
+  ASSERT_TRUE(loaded) << loaded.error().message;
+  EXPECT_TRUE(loaded->geometry().SameAs(map.geometry()));
+  ASSERT_TRUE(loaded->geodetic_origin());
+  EXPECT_EQ(loaded->geodetic_origin()->latitude_deg, 39.5);
+  auto more = Lattice(-1, 1, 0, 1, 0.03, [](double x, double) { return x; });
+  (void)map.InsertPoints(more.data(), more.size());
+  (void)loaded->InsertPoints(more.data(), more.size());
+  ASSERT_TRUE(SaveElevationMap(*loaded, (dir / "b.plem").string()));
+  ASSERT_TRUE(SaveElevationMap(map, (dir / "a.plem").string()));
+  std::ifstream fa(dir / "a.plem", std::ios::binary), fb(dir / "b.plem", std::ios::binary);
+  const std::string sa((std::istreambuf_iterator<char>(fa)), {}),
+      sb((std::istreambuf_iterator<char>(fb)), {});
+  EXPECT_EQ(sa, sb);
+  // Corruption is detected.
+  std::string bad = sa;
+  bad[200] ^= 1;
+  std::ofstream(dir / "bad.plem", std::ios::binary) << bad;
+  EXPECT_FALSE(LoadElevationMap((dir / "bad.plem").string()));
+  EXPECT_FALSE(LoadElevationMap((dir / "missing.plem").string()));
+}
+
+TEST(ElevationMapIo, EsriGridHasHeaderRowsNorthFirstAndPrj) {
+  const auto dir = TempDir("asc");
+  ElevationMap map(GridGeometry::FromArea(10, 20, 0.3, 0.2, 0.1));
+  const std::vector<Eigen::Vector3f> pts = {{10.05f, 20.15f, 1.5f}, {10.25f, 20.05f, -2.0f}};
+  (void)map.InsertPoints(pts.data(), pts.size());
+  const std::string asc = (dir / "m.asc").string();
+  ASSERT_TRUE(WriteEsriAsciiGrid(ComputeLayers(map), std::nullopt, asc));
+  std::ifstream in(asc);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_NE(text.find("ncols 3\nnrows 2\nxllcorner 10.000000\nyllcorner 20.000000\n"),
+            std::string::npos);
+  EXPECT_NE(text.find("1.5000 -9999 -9999\n-9999 -9999 -2.0000\n"), std::string::npos) << text;
+  EXPECT_TRUE(std::filesystem::exists(dir / "m.prj"));
+}
+
+TEST(ElevationMapIo, PrjTransverseMercatorMatchesTheLocalEnuFrame) {
+  // The .prj's TM centred on the origin must put map (x, y) where LocalCartesian ENU does.
+  const GeodeticOrigin o{39.571, -104.304, 1500};
+  EXPECT_NE(ProjectionWkt(o).find("Transverse_Mercator"), std::string::npos);
+  const GeographicLib::LocalCartesian enu(o.latitude_deg, o.longitude_deg, 0);
+  const GeographicLib::TransverseMercator tm(GeographicLib::Constants::WGS84_a(),
+                                             GeographicLib::Constants::WGS84_f(), 1.0);
+  double x0, y0, x, y, lat, lon, h;
+  tm.Forward(o.longitude_deg, o.latitude_deg, o.longitude_deg, x0, y0);
+  for (const auto& p : {Eigen::Vector2d(100, 0), Eigen::Vector2d(-70, 250)}) {
+    enu.Reverse(p.x(), p.y(), 0, lat, lon, h);
+    tm.Forward(o.longitude_deg, lat, lon, x, y);
+    EXPECT_NEAR(x - x0, p.x(), 0.002);
+    EXPECT_NEAR(y - y0, p.y(), 0.002);
+  }
+}
+
+TEST(ElevationMapIo, PngShowsUnknownAndDropsDistinctly) {
+  const auto dir = TempDir("png");
+  ElevationMap map(GridGeometry::FromArea(0, 0, 1, 1, 0.1));
+  auto pts = Lattice(0, 0.5, 0, 1, 0.02, [](double x, double) { return x; });
+  (void)map.InsertPoints(pts.data(), pts.size());
+  ImageOptions options;
+  options.pixels_per_cell = 2;
+  const RgbImage img = RenderElevationImage(ComputeLayers(map), options);
+  EXPECT_EQ(img.width, 20);
+  EXPECT_EQ(img.height, 20);
+  const auto px = [&](int x, int y) {
+    const std::uint8_t* p = &img.rgb[(y * img.width + x) * 3];
+    return std::array<int, 3>{p[0], p[1], p[2]};
+  };
+  const auto unknown = px(19, 19);
+  EXPECT_EQ(unknown[0], unknown[1]);  // grey
+  EXPECT_NE(px(0, 0), unknown);
+  const std::string path = (dir / "m.png").string();
+  ASSERT_TRUE(WritePng(img, path));
+  std::ifstream in(path, std::ios::binary);
+  char sig[8];
+  in.read(sig, 8);
+  EXPECT_EQ(std::string(sig + 1, 3), "PNG");
+}
+
+// A world z = 0.5 + 0.1 x for rays cast straight down (the caster contract, analytically).
+class SlopeCaster : public sensors::RayCaster {
+ public:
+  void Cast(const float* o, const float* d, std::size_t n, float max_range, float* range,
+            int* geom) const override {
+    for (std::size_t r = 0; r < n; ++r) {
+      const float z = 0.5f + 0.1f * o[3 * r];
+      const float t = (o[3 * r + 2] - z) / -d[3 * r + 2];
+      const bool hit = o[3 * r] < 3.0f && t >= 0 && t <= max_range;  // nothing beyond x = 3
+      range[r] = hit ? t : std::numeric_limits<float>::infinity();
+      if (geom) geom[r] = hit ? 0 : -1;
+    }
+  }
+  void Refresh() override {}
+};
+
+TEST(ElevationTruth, DownwardRaysGiveTheTrueSurfaceAndCompareReportsErrors) {
+  const GridGeometry g = GridGeometry::FromArea(0, 0, 4, 1, 0.25);
+  TruthConfig config;
+  config.samples_per_side = 4;
+  const ElevationMap truth = ComputeTrueElevationMap(SlopeCaster{}, g, config);
+  const ElevationLayers T = ComputeLayers(truth);
+  const std::size_t k = g.Linear({2, 2});
+  EXPECT_NEAR(T.mean_z[k], 0.5 + 0.1 * g.CenterOf({2, 2}).x(), 1e-4);
+  EXPECT_NEAR(T.phi_x[k], std::atan(0.1), kAngleTolRad);
+  EXPECT_EQ(T.state[g.Linear({13, 2})], CellState::kUnknown);  // x > 3: off the world
+  // An estimate 2 cm too high on half of the known cells.
+  ElevationMap est(g);
+  std::vector<Eigen::Vector3f> pts;
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 4; ++j) {
+      const Eigen::Vector2d c = g.CenterOf({i, j});
+      pts.emplace_back(float(c.x()), float(c.y()), float(0.52 + 0.1 * c.x()));
+    }
+  (void)est.InsertPoints(pts.data(), pts.size());
+  const MapErrorReport rep = CompareToTruth(ComputeLayers(est), T);
+  EXPECT_EQ(rep.truth_cells, 48u);
+  EXPECT_EQ(rep.compared_cells, 24u);
+  EXPECT_NEAR(rep.coverage, 0.5, 1e-9);
+  EXPECT_NEAR(rep.rmse_m, 0.02, 1e-4);
+  EXPECT_NEAR(rep.mean_error_m, 0.02, 1e-4);
+}
+
+}  // namespace
+}  // namespace pitchlab::mapping

@@ -1,0 +1,281 @@
+// Planner (Eq. 4-5, Algorithm 2): known optimal paths, footprint, no-path reasons, BGL peer cost.
+
+#include <gtest/gtest.h>
+
+#include <boost/graph/adjacency_list.hpp>
+#include <boost/graph/dijkstra_shortest_paths.hpp>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "pitchlab/planning/path_io.hpp"
+#include "pitchlab/planning/planner.hpp"
+#include "pitchlab/planning/traversability.hpp"
+
+namespace pitchlab::planning {
+namespace {
+
+using mapping::CellIndex;
+using mapping::ElevationLayers;
+using mapping::ElevationMap;
+using mapping::GridGeometry;
+
+constexpr double kCostRelTol = 1e-9;
+
+// One point per cell centre at height z(i, j); NaN leaves the cell unknown.
+ElevationLayers MakeLayers(int sx, int sy, double cell, const std::function<double(int, int)>& z) {
+  ElevationMap map(GridGeometry::FromArea(0, 0, sx * cell, sy * cell, cell));
+  std::vector<Eigen::Vector3f> pts;
+  for (int j = 0; j < sy; ++j)
+    for (int i = 0; i < sx; ++i) {
+      const double h = z(i, j);
+      if (std::isnan(h)) continue;
+      const Eigen::Vector2d c = map.geometry().CenterOf({i, j});
+      pts.emplace_back(float(c.x()), float(c.y()), float(h));
+    }
+  (void)map.InsertPoints(pts.data(), pts.size());
+  return mapping::ComputeLayers(map);
+}
+
+PlannerConfig PointRobot() {
+  PlannerConfig c;
+  c.robot.width_m = 0.0;
+  return c;
+}
+
+Eigen::Vector2d Centre(const TraversabilityGrid& T, int i, int j) {
+  return T.geometry.CenterOf({i, j});
+}
+
+double BglCost(const TraversabilityGrid& T, std::size_t s, std::size_t t) {
+  using Graph =
+      boost::adjacency_list<boost::vecS, boost::vecS, boost::directedS, boost::no_property,
+                            boost::property<boost::edge_weight_t, double>>;
+  const std::vector<GraphEdge> edges = ListEdges(T);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> ends;
+  std::vector<double> w;
+  for (const GraphEdge& e : edges) {
+    ends.emplace_back(e.from, e.to);
+    w.push_back(e.cost);
+  }
+  Graph g(ends.begin(), ends.end(), w.begin(), T.geometry.cell_count());
+  std::vector<double> d(T.geometry.cell_count());
+  boost::dijkstra_shortest_paths(g, s, boost::distance_map(d.data()));
+  return d[t];
+}
+
+TEST(Planner, SerpentineCorridorGivesItsUniqueOptimalPath) {
+  // 1-cell corridor through unknown cells (forbidden): right along row 0, up column 6, left
+  // along row 4. The only path; its cost is W_P * cell per edge on flat ground.
+  const double cell = 0.2;
+  const auto corridor = [](int i, int j) {
+    return (j == 0 && i <= 6) || (i == 6 && j <= 4) || (j == 4 && i <= 6);
+  };
+  const ElevationLayers L =
+      MakeLayers(8, 6, cell, [&](int i, int j) { return corridor(i, j) ? 0.0 : std::nan(""); });
+  const TraversabilityGrid T = BuildTraversability(L, PointRobot());
+  for (Algorithm a : {Algorithm::kDijkstra, Algorithm::kAStar}) {
+    const auto path = PlanPath(T, Centre(T, 0, 0), Centre(T, 0, 4), a);
+    ASSERT_TRUE(path) << path.error().message;
+    ASSERT_EQ(path->cells.size(), 7u + 4u + 6u);
+    EXPECT_EQ(path->cells[6], (CellIndex{6, 0}));
+    EXPECT_EQ(path->cells[10], (CellIndex{6, 4}));
+    EXPECT_NEAR(path->cost, 16 * cell, 1e-9);
+    EXPECT_NEAR(path->length_m, 16 * cell, 1e-9);
+    EXPECT_NEAR(path->parts.Total(), path->cost, 1e-9);
+  }
+}
+
+TEST(Planner, StraightRunOnTiltedGroundCostsEq5) {
+  // Ground z = 0.1 x: a straight run along x is the unique optimum; every edge costs
+  // W_T*0 + W_P*sqrt(c^2 + (0.1c)^2) + W_phix*atan(0.1) + W_phiy*0.
+  const double cell = 0.1;
+  const ElevationLayers L =
+      MakeLayers(20, 5, cell, [&](int i, int) { return 0.1 * (i + 0.5) * cell; });
+  PlannerConfig cfg = PointRobot();
+  cfg.weights = {2.0, 1.0, 3.0, 5.0};
+  const TraversabilityGrid T = BuildTraversability(L, cfg);
+  const auto path = PlanPath(T, Centre(T, 1, 2), Centre(T, 18, 2), Algorithm::kAStar);
+  ASSERT_TRUE(path) << path.error().message;
+  ASSERT_EQ(path->cells.size(), 18u);
+  for (const CellIndex& c : path->cells) EXPECT_EQ(c.j, 2);
+  const double edge = std::hypot(cell, 0.1 * cell) + 3.0 * std::atan(0.1);
+  EXPECT_NEAR(path->cost, 17 * edge, 1e-5);
+  EXPECT_NEAR(path->parts.inclination_x, 17 * 3.0 * std::atan(0.1), 1e-5);
+  EXPECT_NEAR(path->parts.inclination_y, 0.0, 1e-5);
+  EXPECT_NEAR(path->max_step_m, 0.1 * cell, 1e-6);
+  EXPECT_NEAR(path->max_inclination_rad, std::atan(0.1), 1e-5);
+}
+
+TEST(Planner, DijkstraAStarAndBglAgreeOnRandomTerrain) {
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::vector<double> bumps(6);
+    for (double& b : bumps) b = u(rng) * 10;
+    const ElevationLayers L = MakeLayers(48, 40, 0.1, [&](int i, int j) {
+      if (u(rng) < 0.04) return std::nan("");  // scattered unknown cells
+      return 0.08 * std::sin(0.3 * i + bumps[0]) * std::cos(0.25 * j + bumps[1]) + 0.01 * u(rng) +
+             (u(rng) < 0.01 ? 0.3 : 0.0);  // rough, and a few spikes
+    });
+    PlannerConfig cfg = PointRobot();
+    if (seed % 2) {
+      cfg.unknown = UnknownPolicy::kPenalise;
+      cfg.unknown_penalty = 0.5;
+    }
+    const TraversabilityGrid T = BuildTraversability(L, cfg);
+    // Pick free start and goal far apart.
+    std::size_t s = 0, t = T.geometry.cell_count() - 1;
+    while (!T.Free(s)) ++s;
+    while (!T.Free(t)) --t;
+    const auto d = PlanPath(T, T.geometry.CenterOf(T.geometry.FromLinear(s)),
+                            T.geometry.CenterOf(T.geometry.FromLinear(t)), Algorithm::kDijkstra);
+    const auto a = PlanPath(T, T.geometry.CenterOf(T.geometry.FromLinear(s)),
+                            T.geometry.CenterOf(T.geometry.FromLinear(t)), Algorithm::kAStar);
+    const double peer = BglCost(T, s, t);
+    if (!std::isfinite(peer) || peer > 1e300) {
+      EXPECT_FALSE(d);
+      EXPECT_FALSE(a);
+      continue;
+    }
+    ASSERT_TRUE(d) << "seed " << seed << ": " << d.error().message;
+    ASSERT_TRUE(a) << "seed " << seed << ": " << a.error().message;
+    EXPECT_NEAR(d->cost, peer, kCostRelTol * peer) << "seed " << seed;
+    EXPECT_NEAR(a->cost, peer, kCostRelTol * peer) << "seed " << seed;
+    EXPECT_NEAR(d->parts.Total(), d->cost, 1e-6 * peer);
+    EXPECT_LE(a->expanded, d->expanded);
+  }
+}
+
+TEST(Planner, GapNarrowerThanTheRobotIsNotPassed) {
+  // A 0.5 m wall across the map (x = 2 m) with a 9-cell (0.45 m) and an 11-cell (0.55 m) gap.
+  const double cell = 0.05;
+  const auto make = [&](int gap_cells) {
+    return MakeLayers(80, 60, cell, [&](int i, int j) {
+      const bool wall = i == 40 && !(j >= 20 && j < 20 + gap_cells);
+      return wall ? 0.5 : 0.0;
+    });
+  };
+  PlannerConfig at, dx;
+  dx.robot = RobotLimits::P3DX();  // 0.381 m wide
+  at.robot = RobotLimits::P3AT();  // 0.497 m wide
+  const Eigen::Vector2d start(0.5, 1.5), goal(3.5, 1.5);
+  const ElevationLayers narrow = make(9), wide = make(11);
+  EXPECT_TRUE(PlanPath(BuildTraversability(narrow, dx), start, goal, Algorithm::kAStar));
+  const auto blocked = PlanPath(BuildTraversability(narrow, at), start, goal, Algorithm::kAStar);
+  ASSERT_FALSE(blocked);
+  EXPECT_EQ(blocked.error().reason, NoPath::Reason::kDisconnected);
+  EXPECT_TRUE(PlanPath(BuildTraversability(wide, at), start, goal, Algorithm::kAStar));
+}
+
+TEST(Planner, StartOrGoalOffTheMapOrInAnObstacleIsAClearError) {
+  const ElevationLayers L = MakeLayers(40, 40, 0.1, [](int i, int j) {
+    return (i >= 18 && i < 22 && j >= 18 && j < 22) ? 1.0 : 0.0;  // a 0.4 m box, 1 m tall
+  });
+  const TraversabilityGrid T = BuildTraversability(L, PlannerConfig{});
+  const auto reason = [&](Eigen::Vector2d s, Eigen::Vector2d g) {
+    const auto r = PlanPath(T, s, g, Algorithm::kDijkstra);
+    EXPECT_FALSE(r);
+    EXPECT_FALSE(r.error().message.empty());
+    return r.error().reason;
+  };
+  EXPECT_EQ(reason({-1, 1}, {3, 3}), NoPath::Reason::kStartOutsideMap);
+  EXPECT_EQ(reason({1, 1}, {3, 4.5}), NoPath::Reason::kGoalOutsideMap);
+  EXPECT_EQ(reason({2, 2}, {3, 3}), NoPath::Reason::kStartBlocked);
+  EXPECT_EQ(reason({0.5, 0.5}, {2.0, 2.0}), NoPath::Reason::kGoalBlocked);
+  EXPECT_EQ(reason({0.5, 0.5}, {2.0, 2.35}), NoPath::Reason::kGoalBlocked);  // footprint
+  EXPECT_TRUE(PlanPath(T, {0.5, 0.5}, {3.5, 3.5}, Algorithm::kAStar));
+}
+
+TEST(Planner, UnknownCellsForbiddenOrPenalised) {
+  // A band of unknown cells across the map: forbidden -> disconnected; penalised -> crossed.
+  const ElevationLayers L =
+      MakeLayers(30, 10, 0.1, [](int i, int) { return i >= 14 && i < 16 ? std::nan("") : 0.0; });
+  PlannerConfig cfg = PointRobot();
+  const auto forbid =
+      PlanPath(BuildTraversability(L, cfg), {0.5, 0.5}, {2.5, 0.5}, Algorithm::kAStar);
+  ASSERT_FALSE(forbid);
+  EXPECT_EQ(forbid.error().reason, NoPath::Reason::kDisconnected);
+  cfg.unknown = UnknownPolicy::kPenalise;
+  cfg.unknown_penalty = 2.0;
+  const auto pen =
+      PlanPath(BuildTraversability(L, cfg), {0.55, 0.55}, {2.55, 0.55}, Algorithm::kAStar);
+  ASSERT_TRUE(pen) << pen.error().message;
+  EXPECT_NEAR(pen->parts.unknown, 2 * 2.0, 1e-9);
+}
+
+TEST(Planner, SlopeBeyondTheRobotLimitIsTooSteep) {
+  // z = tan(25 deg) x: above the P3-AT's 19.3 deg, below nothing.
+  const ElevationLayers L =
+      MakeLayers(20, 20, 0.1, [](int i, int) { return std::tan(25 * M_PI / 180) * i * 0.1; });
+  const TraversabilityGrid T = BuildTraversability(L, PlannerConfig{});
+  EXPECT_EQ(T.blocked[T.geometry.Linear({10, 10})], Blocked::kTooSteep);
+  PlannerConfig steep;
+  steep.robot.max_inclination_rad = 30 * M_PI / 180;
+  steep.robot.step_max_m = 0.1;
+  EXPECT_EQ(BuildTraversability(L, steep).blocked[T.geometry.Linear({10, 10})], Blocked::kFree);
+}
+
+TEST(PlannerConfig, YamlWeightsPresetsAndErrors) {
+  const PlannerConfig c = ParsePlannerConfig(
+      "robot: p3dx\nweights: {roughness: 4, length: 2, inclination_x: 0.5, inclination_y: 0.25}\n"
+      "unknown: penalise\nunknown_penalty: 3\nmax_inclination_deg: 10\n",
+      "test.yaml");
+  EXPECT_EQ(c.robot.name, "p3dx");
+  EXPECT_DOUBLE_EQ(c.robot.step_max_m, 0.025);
+  EXPECT_NEAR(c.robot.max_inclination_rad, 10 * M_PI / 180, 1e-12);
+  EXPECT_DOUBLE_EQ(c.weights.roughness, 4);
+  EXPECT_DOUBLE_EQ(c.weights.inclination_y, 0.25);
+  EXPECT_EQ(c.unknown, UnknownPolicy::kPenalise);
+  EXPECT_DOUBLE_EQ(c.unknown_penalty, 3);
+  const auto message = [](const std::string& yaml) {
+    try {
+      (void)ParsePlannerConfig(yaml, "bad.yaml");
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message("robot: tank\n").find("bad.yaml: field 'robot'"), std::string::npos);
+  EXPECT_NE(message("weights: {length: -1}\n").find("weights.length"), std::string::npos);
+  EXPECT_NE(message("unknown: maybe\n").find("'unknown'"), std::string::npos);
+  EXPECT_NE(message("step_max_m: abc\n").find("step_max_m"), std::string::npos);
+}
+
+TEST(PathIo, CsvGeoJsonAndPicture) {
+  const auto dir = std::filesystem::temp_directory_path() / "pitchlab_path_io";
+  std::filesystem::create_directories(dir);
+  const ElevationLayers L = MakeLayers(30, 20, 0.1, [](int i, int) { return 0.01 * i; });
+  const TraversabilityGrid T = BuildTraversability(L, PointRobot());
+  const auto path = PlanPath(T, {0.25, 0.25}, {2.75, 1.75}, Algorithm::kAStar);
+  ASSERT_TRUE(path);
+  ASSERT_TRUE(WritePathCsv(*path, (dir / "p.csv").string()));
+  std::ifstream csv(dir / "p.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_EQ(header, "index,x_m,y_m,z_m,cum_length_m");
+  EXPECT_FALSE(WritePathGeoJson(*path, std::nullopt, (dir / "p.geojson").string()));
+  const mapping::GeodeticOrigin o{39.571, -104.304, 1500};
+  ASSERT_TRUE(WritePathGeoJson(*path, o, (dir / "p.geojson").string()));
+  const auto j = nlohmann::json::parse(std::ifstream(dir / "p.geojson"));
+  const auto& coords = j["features"][0]["geometry"]["coordinates"];
+  ASSERT_EQ(coords.size(), path->waypoints.size());
+  // 0.25 m east of the origin is 0.25 / (cos(lat) * 111.3 km) degrees of longitude.
+  EXPECT_NEAR(coords[0][0].get<double>(),
+              o.longitude_deg + 0.25 / (std::cos(o.latitude_deg * M_PI / 180) * 111319.5), 1e-7);
+  EXPECT_NEAR(coords[0][1].get<double>(), o.latitude_deg + 0.25 / 110990.0, 2e-7);
+  EXPECT_NEAR(j["features"][0]["properties"]["cost"].get<double>(), path->cost, 1e-5);
+  mapping::ImageOptions opt;
+  opt.pixels_per_cell = 4;
+  mapping::RgbImage img = mapping::RenderElevationImage(L, opt);
+  const auto before = img.rgb;
+  DrawPath(*path, L.geometry, img);
+  EXPECT_NE(before, img.rgb);
+  ASSERT_TRUE(mapping::WritePng(img, (dir / "p.png").string()));
+}
+
+}  // namespace
+}  // namespace pitchlab::planning
