@@ -171,6 +171,9 @@ void ToEmbreeTransform(const mjtNum* pos, const mjtNum* mat, float xfm[12]) {
 RTCScene NewScene(Device& device, RTCBuildQuality quality) {
   RTCScene scene = rtcNewScene(device.get());
   rtcSetSceneBuildQuality(scene, quality);
+  // Watertight triangles: rays through a shared edge or vertex (a vertical truth ray over a
+  // heightfield vertex, a beam grazing a box edge) must not slip through the surface.
+  rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
   device.Check("creating a scene");
   return scene;
 }
@@ -313,7 +316,7 @@ class EmbreeRayCaster final : public RayCaster {
       return;
     }
     top_ = NewScene(*device_, RTC_BUILD_QUALITY_LOW);
-    rtcSetSceneFlags(top_, RTC_SCENE_FLAG_DYNAMIC);
+    rtcSetSceneFlags(top_, RTC_SCENE_FLAG_DYNAMIC | RTC_SCENE_FLAG_ROBUST);
     lookup_.static_instance = AttachInstance(static_);
     for (std::size_t i = 0; i < moving_.size(); ++i) {
       const unsigned id = AttachInstance(moving_[i].scene, &moving_[i].instance);

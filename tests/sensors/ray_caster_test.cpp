@@ -535,6 +535,40 @@ TEST(EmbreeRayCaster, AgreesWithMjRayOnTheTopOfANonSquareHeightfield) {
   ExpectAgreement("non-square heightfield top", Compare(world, rays));
 }
 
+constexpr char kGridHeightfield[] = R"(
+<mujoco>
+  <asset>
+    <hfield name="grid" file="hills.bin" size="4 4 1 0.5"/>
+  </asset>
+  <worldbody>
+    <geom type="hfield" hfield="grid"/>
+  </worldbody>
+</mujoco>)";
+
+// Ground truth casts rays straight down on a regular grid, which lines them up with heightfield
+// vertices and cell edges: a caster that is not watertight lets some slip through.
+TEST(EmbreeRayCaster, VerticalRaysThroughHeightfieldVerticesAndEdgesNeverSlipThrough) {
+  const fs::path dir = World::MakeTempDir();
+  WriteHillsHfield(dir, 41, 41);  // vertices every 0.2 m, edge midpoints between them
+  const World world(kGridHeightfield, dir);
+  const auto caster = Make(Backend::kEmbree, world);
+  // Vertex coordinates exactly as the caster computes them, and the midpoints between them.
+  std::vector<float> grid;
+  for (int c = 0; c < 41; ++c) {
+    grid.push_back(static_cast<float>(-4.0 + c * (8.0 / 40)));
+    if (c < 40) grid.push_back(static_cast<float>(-4.0 + (c + 0.5) * (8.0 / 40)));
+  }
+  int rays = 0, misses = 0;
+  for (float x : grid) {
+    for (float y : grid) {
+      const Hit hit = CastOne(*caster, {x, y, 10.0f}, {0, 0, -1}, 50.0f);
+      ++rays;
+      misses += !std::isfinite(hit.range_m);
+    }
+  }
+  EXPECT_EQ(misses, 0) << "of " << rays << " vertical rays";
+}
+
 // ---- the project's worlds
 // ------------------------------------------------------------------------
 
