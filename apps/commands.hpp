@@ -10,6 +10,10 @@ int RunScan(int argc, char** argv);
 int RunMap(int argc, char** argv);
 /// `pitchlab plan`: traversability path on an elevation map.
 int RunPlan(int argc, char** argv);
+/// `pitchlab run`: the closed-loop mission, scored, with a run folder and report.
+int RunRun(int argc, char** argv);
+/// `pitchlab hw`: emulate devices on ptys driven by the simulator; read an LMS200.
+int RunHw(int argc, char** argv);
 /// `pitchlab worlds`: the built-in worlds and their metadata.
 int RunWorlds(int argc, char** argv);
 

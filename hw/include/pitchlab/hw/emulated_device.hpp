@@ -1,0 +1,108 @@
+#pragma once
+// The device side of a serial link on a pseudo-terminal: a thread that reads requests, a paced
+// writer for replies (bytes at the baud rate), fault injection and unplug/replug. The protocol
+// state machines (LMS200, pitch unit, P2OS) derive from it.
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <mutex>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace pitchlab::hw {
+
+/// What goes wrong on the wire, applied to the device's outgoing messages.
+struct FaultPlan {
+  enum class Kind {
+    kNone,
+    kDrop,       ///< one random byte of a message is lost
+    kFlip,       ///< one random bit of a message is inverted
+    kDuplicate,  ///< one random byte of a message is sent twice
+    kDelay,      ///< the message stalls `delay_ms` halfway through
+    kSilent,     ///< nothing is sent (no ACK, no reply)
+  };
+  Kind kind = Kind::kNone;
+  int messages = -1;         ///< how many of the next messages it hits; -1 = all of them
+  double probability = 1.0;  ///< chance a message is hit [0, 1]
+  int delay_ms = 300;        ///< stall for kDelay [ms]
+  std::uint64_t seed = 1;    ///< which byte / bit is hit
+};
+
+/// Counters of what the emulator did.
+struct DeviceStats {
+  std::size_t requests = 0;       ///< well-formed requests handled
+  std::size_t bad_requests = 0;   ///< malformed requests (CRC, framing) seen
+  std::size_t messages_sent = 0;  ///< messages (ACK bytes, replies) put on the wire
+  std::size_t faults = 0;         ///< messages a fault hit
+};
+
+/// A pseudo-terminal with a device behind it. Drivers open path(); the path is a symlink that
+/// stays valid across Unplug()/Replug() (like a udev name), so a driver can reconnect.
+class EmulatedDevice {
+ public:
+  /// Creates the pty and the symlink `link_path` (empty: a fresh name under /tmp). Throws
+  /// std::runtime_error naming the path when the pty or the link cannot be made.
+  EmulatedDevice(std::string name, int baud, std::string link_path = "");
+  virtual ~EmulatedDevice();
+  EmulatedDevice(const EmulatedDevice&) = delete;
+  EmulatedDevice& operator=(const EmulatedDevice&) = delete;
+
+  /// The device path a driver opens (the stable symlink).
+  const std::string& path() const { return link_path_; }
+  /// Installs a fault plan (replaces the previous one).
+  void SetFaults(const FaultPlan& plan);
+  /// Closes the pty: the driver's reads fail with a hang-up, the path dangles.
+  void Unplug();
+  /// A fresh pty behind the same path; the device restarts (power-on behaviour).
+  void Replug();
+  bool plugged() const { return plugged_; }
+  /// Current line rate [bit/s].
+  int baud() const { return baud_; }
+  DeviceStats stats() const;
+
+ protected:
+  /// Starts the I/O thread; derived constructors call it last.
+  void Start();
+  /// Stops the I/O thread; derived destructors call it first.
+  void Stop();
+  /// Request bytes arrived (I/O thread).
+  virtual void OnBytes(const std::uint8_t* bytes, std::size_t size) = 0;
+  /// Called about every 5 ms on the I/O thread (streaming, watchdogs).
+  virtual void OnIdle() {}
+  /// Called on the I/O thread after Replug(): reset protocol state, send a power-on message.
+  virtual void OnPowerOn() {}
+  /// Sends one message, paced at the baud rate, through the fault plan (I/O thread).
+  void Send(const std::vector<std::uint8_t>& bytes);
+  /// Changes the rate the device speaks at from now on.
+  void set_baud(int baud) { baud_ = baud; }
+  /// True when the driver's port is set to the device's rate (a pty stores the termios speed);
+  /// a real device would see only garbage otherwise.
+  bool DriverBaudMatches() const;
+  void CountRequest(bool well_formed);
+
+ private:
+  void OpenPty();
+  void ClosePty();
+  void Loop();
+  void WritePaced(const std::uint8_t* bytes, std::size_t size);
+
+  std::string name_;
+  std::atomic<int> baud_;
+  std::string link_path_;
+  bool own_link_dir_ = false;
+  std::atomic<int> master_{-1};
+  int held_slave_ = -1;  // keeps the pty alive while no driver has it open
+  std::atomic<bool> plugged_{false};
+  std::atomic<bool> running_{false};
+  std::atomic<bool> replugged_{false};
+  std::thread thread_;
+  mutable std::mutex mutex_;  // guards plan_, rng_, stats_, the pty fds during (un)plug
+  FaultPlan plan_;
+  std::mt19937_64 rng_;
+  DeviceStats stats_;
+};
+
+}  // namespace pitchlab::hw

@@ -1,0 +1,159 @@
+#pragma once
+// The SICK LMS2xx binary telegram protocol: framing, SICK's CRC, measured values, and a
+// resynchronising reader. Pure functions on bytes: no I/O, so decoders can be fuzzed.
+//
+// Telegram: STX(02) ADR LEN(2, LE) CMD DATA... CRC(2, LE). LEN counts CMD + DATA (a reply's
+// trailing status byte is part of DATA). Replies come from ADR 0x80 with CMD | 0x80, each
+// preceded by one ACK (06) or NAK (15) byte.
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pitchlab/sensors/laser_line.hpp"
+#include "pitchlab/sensors/lms200.hpp"
+#include "pitchlab/sensors/result.hpp"
+
+namespace pitchlab::hw::lms200 {
+
+constexpr std::uint8_t kStx = 0x02;
+constexpr std::uint8_t kAck = 0x06;
+constexpr std::uint8_t kNak = 0x15;
+constexpr std::uint8_t kHostAddress = 0x00;   ///< requests go to device address 0
+constexpr std::uint8_t kReplyAddress = 0x80;  ///< replies come from 0x80
+constexpr std::uint8_t kReplyBit = 0x80;      ///< reply command = request command | 0x80
+constexpr std::size_t kMaxDataBytes = 1024;   ///< longest CMD + DATA accepted (801 values fit)
+
+/// Request commands the driver uses.
+enum Command : std::uint8_t {
+  kReset = 0x10,          ///< re-initialise; reply 0x91, then the power-on telegram
+  kSwitchMode = 0x20,     ///< operating mode / baud rate; reply 0xA0
+  kRequestValues = 0x30,  ///< measured values (0x01 = one full scan); reply 0xB0
+  kRequestStatus = 0x31,  ///< status; reply 0xB1
+  kRequestType = 0x3A,    ///< type string ("LMS200;30106"); reply 0xBA
+  kSwitchVariant = 0x3B,  ///< field of view + resolution; reply 0xBB
+  kRequestConfig = 0x74,  ///< configuration block; reply 0xF4
+  kConfigure = 0x77,      ///< write configuration block (setup mode); reply 0xF7
+  kPowerOn = 0x90,        ///< unsolicited power-on telegram (a reply-side command)
+};
+
+/// Operating-mode codes for kSwitchMode.
+enum Mode : std::uint8_t {
+  kModeSetup = 0x00,       ///< installation mode (needs the password "SICK_LMS")
+  kModeContinuous = 0x24,  ///< stream all measured values
+  kModeOnRequest = 0x25,   ///< measured values only on request
+  kModeBaud38400 = 0x40,
+  kModeBaud19200 = 0x41,
+  kModeBaud9600 = 0x42,
+  kModeBaud500k = 0x48,
+};
+
+/// Index of the measuring-units byte in the configuration block (0 = cm, 1 = mm).
+constexpr std::size_t kConfigUnitsIndex = 6;
+/// Length of the configuration block of an LMS200 (kRequestConfig reply without status).
+constexpr std::size_t kConfigBlockBytes = 32;
+/// Special measured-value codes (13-bit).
+constexpr std::uint16_t kCodeNoReturn = 8191;  ///< invalid / no measurement
+constexpr std::uint16_t kCodeDazzled = 8190;
+constexpr std::uint16_t kCodeOverRange = 8183;  ///< beyond the maximum (cm mode)
+constexpr std::uint16_t kFirstSpecialCode = 8183;
+
+/// SICK's 16-bit CRC (poly 0x8005, init 0, over STX .. last data byte). Not CRC-16/ARC.
+std::uint16_t Crc16(const std::uint8_t* data, std::size_t size);
+
+/// One telegram. `data` includes a reply's trailing status byte.
+struct Telegram {
+  std::uint8_t address = kHostAddress;
+  std::uint8_t command = 0;
+  std::vector<std::uint8_t> data;
+
+  /// The reply status byte (last data byte); 0 when there is no data.
+  std::uint8_t status() const { return data.empty() ? 0 : data.back(); }
+  bool operator==(const Telegram& o) const {
+    return address == o.address && command == o.command && data == o.data;
+  }
+};
+
+/// The bytes of `telegram` with its length and CRC.
+std::vector<std::uint8_t> Encode(const Telegram& telegram);
+/// Exactly one telegram from `bytes`; kProtocol naming what is wrong (framing, length, CRC).
+[[nodiscard]] Result<Telegram> Decode(const std::uint8_t* bytes, std::size_t size);
+
+/// Baud-rate code for kSwitchMode, or nullopt for a rate the LMS200 cannot do.
+std::optional<std::uint8_t> BaudModeCode(int baud);
+
+/// Request builders for every command the driver sends.
+Telegram SwitchModeRequest(std::uint8_t mode);
+Telegram SetupModeRequest();  ///< kSwitchMode 0x00 with the password "SICK_LMS"
+Telegram SingleScanRequest();
+Telegram TypeRequest();
+Telegram StatusRequest();
+Telegram VariantRequest(int fov_deg, int resolution_cdeg);  ///< e.g. (180, 50)
+Telegram ConfigRequest();
+Telegram ConfigureRequest(const std::vector<std::uint8_t>& block);
+
+/// Measured-value units from bits 14-15 of the count word.
+enum class Units : std::uint8_t { kCm = 0, kMm = 1, kDm = 2 };
+
+/// The payload of a 0xB0 reply.
+struct MeasuredValues {
+  Units units = Units::kCm;
+  bool partial = false;               ///< bit 13: a partial (interlaced) scan
+  std::vector<std::uint16_t> values;  ///< 13-bit readings (flag bits 13-15 stripped)
+  std::uint8_t status = 0;            ///< the telegram's status byte
+};
+
+/// Decodes a 0xB0 telegram; kProtocol when the command, count or length do not agree.
+[[nodiscard]] Result<MeasuredValues> DecodeMeasuredValues(const Telegram& telegram);
+/// Builds a 0xB0 reply telegram.
+Telegram EncodeMeasuredValues(const MeasuredValues& values);
+
+/// One reading as (range [m] or NaN, status): 8191 no return, 8190 dazzled, 8183 over range,
+/// other codes >= 8183 no return; else value x unit.
+std::pair<float, sensors::ReadingStatus> DecodeReading(std::uint16_t value, Units units);
+/// The 13-bit value for a reading (inverse of DecodeReading; valid ranges that would land on a
+/// special code are sent as over range).
+std::uint16_t EncodeReading(float range_m, sensors::ReadingStatus status, Units units);
+
+/// Reader counters: what was skipped while resynchronising.
+struct ReaderStats {
+  std::size_t telegrams = 0;  ///< good telegrams
+  std::size_t acks = 0;
+  std::size_t naks = 0;
+  std::size_t crc_errors = 0;     ///< framed telegrams whose CRC did not match
+  std::size_t garbage_bytes = 0;  ///< bytes skipped outside any telegram
+};
+
+/// What the reader found next in the byte stream.
+struct ReaderEvent {
+  enum class Kind { kTelegram, kAck, kNak } kind = Kind::kTelegram;
+  Telegram telegram;  ///< for kTelegram
+};
+
+/// Turns a byte stream into telegrams and ACK/NAK bytes. Garbage, partial telegrams, CRC errors
+/// and bad lengths are skipped (one byte at a time, so a telegram hidden behind a false STX is
+/// still found) and counted. `reply_address_bit` selects the addresses accepted: 0x80 for a host
+/// reading replies, 0x00 for a device reading requests.
+class TelegramReader {
+ public:
+  explicit TelegramReader(std::uint8_t reply_address_bit = kReplyAddress);
+  /// Appends received bytes.
+  void Feed(const std::uint8_t* bytes, std::size_t size);
+  /// The next complete item, or nullopt when more bytes are needed.
+  std::optional<ReaderEvent> Next();
+  /// Drops everything buffered (counted as garbage).
+  void Clear();
+  /// Bytes buffered and not yet consumed.
+  std::size_t buffered() const { return buffer_.size(); }
+  const ReaderStats& stats() const { return stats_; }
+
+ private:
+  std::uint8_t address_bit_;
+  std::deque<std::uint8_t> buffer_;
+  ReaderStats stats_;
+};
+
+}  // namespace pitchlab::hw::lms200

@@ -1,0 +1,237 @@
+#include "pitchlab/hw/emulated_device.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <pty.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+
+namespace pitchlab::hw {
+namespace {
+
+constexpr int kIdlePeriodMs = 5;
+constexpr std::size_t kPacingChunkBytes = 16;
+
+speed_t SpeedCode(int baud) {
+  switch (baud) {
+    case 9600:
+      return B9600;
+    case 19200:
+      return B19200;
+    case 38400:
+      return B38400;
+    case 115200:
+      return B115200;
+    case 500000:
+      return B500000;
+    default:
+      return B0;
+  }
+}
+
+}  // namespace
+
+EmulatedDevice::EmulatedDevice(std::string name, int baud, std::string link_path)
+    : name_(std::move(name)), baud_(baud), link_path_(std::move(link_path)) {
+  if (link_path_.empty()) {
+    char dir[] = "/tmp/pitchlab-hw-XXXXXX";
+    if (::mkdtemp(dir) == nullptr) {
+      throw std::runtime_error("emulator " + name_ +
+                               ": cannot create a folder under /tmp: " + std::strerror(errno));
+    }
+    link_path_ = std::string(dir) + "/" + name_;
+    own_link_dir_ = true;
+  }
+  OpenPty();
+}
+
+EmulatedDevice::~EmulatedDevice() {
+  Stop();
+  ClosePty();
+  std::error_code ignored;
+  std::filesystem::remove(link_path_, ignored);
+  if (own_link_dir_)
+    std::filesystem::remove(std::filesystem::path(link_path_).parent_path(), ignored);
+}
+
+void EmulatedDevice::OpenPty() {
+  int master = -1, slave = -1;
+  char slave_name[256] = {};
+  if (::openpty(&master, &slave, slave_name, nullptr, nullptr) != 0) {
+    throw std::runtime_error("emulator " + name_ + ": openpty failed: " + std::strerror(errno));
+  }
+  termios tio{};
+  ::tcgetattr(slave, &tio);
+  ::cfmakeraw(&tio);
+  ::cfsetispeed(&tio, SpeedCode(baud_));
+  ::cfsetospeed(&tio, SpeedCode(baud_));
+  ::tcsetattr(slave, TCSANOW, &tio);
+  ::fcntl(master, F_SETFL, ::fcntl(master, F_GETFL) | O_NONBLOCK);
+  ::fcntl(master, F_SETFD, FD_CLOEXEC);
+  ::fcntl(slave, F_SETFD, FD_CLOEXEC);
+  std::error_code ignored;
+  std::filesystem::remove(link_path_, ignored);
+  if (::symlink(slave_name, link_path_.c_str()) != 0) {
+    const std::string message = "emulator " + name_ + ": cannot link " + link_path_ + " -> " +
+                                slave_name + ": " + std::strerror(errno);
+    ::close(master);
+    ::close(slave);
+    throw std::runtime_error(message);
+  }
+  held_slave_ = slave;
+  master_ = master;
+  plugged_ = true;
+}
+
+void EmulatedDevice::ClosePty() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  plugged_ = false;
+  const int master = master_.exchange(-1);
+  if (master >= 0) ::close(master);
+  if (held_slave_ >= 0) ::close(held_slave_);
+  held_slave_ = -1;
+}
+
+void EmulatedDevice::Unplug() {
+  ClosePty();
+  std::error_code ignored;
+  std::filesystem::remove(link_path_, ignored);
+}
+
+void EmulatedDevice::Replug() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (plugged_) return;
+  }
+  OpenPty();
+  replugged_ = true;
+}
+
+void EmulatedDevice::SetFaults(const FaultPlan& plan) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  plan_ = plan;
+  rng_.seed(plan.seed);
+}
+
+DeviceStats EmulatedDevice::stats() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return stats_;
+}
+
+void EmulatedDevice::CountRequest(bool well_formed) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++(well_formed ? stats_.requests : stats_.bad_requests);
+}
+
+void EmulatedDevice::Start() {
+  running_ = true;
+  thread_ = std::thread([this] { Loop(); });
+}
+
+void EmulatedDevice::Stop() {
+  running_ = false;
+  if (thread_.joinable()) thread_.join();
+}
+
+bool EmulatedDevice::DriverBaudMatches() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  termios tio{};
+  if (held_slave_ < 0 || ::tcgetattr(held_slave_, &tio) != 0) return false;
+  return ::cfgetispeed(&tio) == SpeedCode(baud_);
+}
+
+void EmulatedDevice::Loop() {
+  std::uint8_t buffer[512];
+  while (running_) {
+    if (replugged_.exchange(false)) OnPowerOn();
+    const int fd = master_;
+    if (fd < 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(kIdlePeriodMs));
+      continue;
+    }
+    pollfd p{fd, POLLIN, 0};
+    const int ready = ::poll(&p, 1, kIdlePeriodMs);
+    if (ready > 0 && (p.revents & POLLIN)) {
+      const ssize_t n = ::read(fd, buffer, sizeof(buffer));
+      if (n > 0) OnBytes(buffer, std::size_t(n));
+    } else if (ready > 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(kIdlePeriodMs));
+    }
+    OnIdle();
+  }
+}
+
+void EmulatedDevice::Send(const std::vector<std::uint8_t>& message) {
+  std::vector<std::uint8_t> bytes = message;
+  FaultPlan::Kind fault = FaultPlan::Kind::kNone;
+  int delay_ms = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++stats_.messages_sent;
+    std::uniform_real_distribution<double> chance(0.0, 1.0);
+    if (plan_.kind != FaultPlan::Kind::kNone && plan_.messages != 0 && !bytes.empty() &&
+        chance(rng_) < plan_.probability) {
+      fault = plan_.kind;
+      delay_ms = plan_.delay_ms;
+      if (plan_.messages > 0) --plan_.messages;
+      ++stats_.faults;
+      std::uniform_int_distribution<std::size_t> pick(0, bytes.size() - 1);
+      const std::size_t at = pick(rng_);
+      switch (fault) {
+        case FaultPlan::Kind::kDrop:
+          bytes.erase(bytes.begin() + long(at));
+          break;
+        case FaultPlan::Kind::kFlip:
+          bytes[at] ^= std::uint8_t(1u << (rng_() % 8));
+          break;
+        case FaultPlan::Kind::kDuplicate:
+          bytes.insert(bytes.begin() + long(at), bytes[at]);
+          break;
+        case FaultPlan::Kind::kSilent:
+          bytes.clear();
+          break;
+        case FaultPlan::Kind::kDelay:
+        case FaultPlan::Kind::kNone:
+          break;
+      }
+    }
+  }
+  if (fault == FaultPlan::Kind::kDelay) {
+    const std::size_t half = bytes.size() / 2;
+    WritePaced(bytes.data(), half);
+    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
+    WritePaced(bytes.data() + half, bytes.size() - half);
+    return;
+  }
+  WritePaced(bytes.data(), bytes.size());
+}
+
+void EmulatedDevice::WritePaced(const std::uint8_t* bytes, std::size_t size) {
+  // Bytes leave at the line rate: 10 bits each (8N1).
+  const auto start = std::chrono::steady_clock::now();
+  const double byte_s = 10.0 / double(baud_);
+  std::size_t sent = 0;
+  while (sent < size && running_) {
+    const int fd = master_;
+    if (fd < 0) return;  // unplugged mid-message
+    const std::size_t chunk = std::min(kPacingChunkBytes, size - sent);
+    const ssize_t n = ::write(fd, bytes + sent, chunk);
+    if (n < 0 && errno != EAGAIN && errno != EINTR) return;
+    if (n < 0) {
+      // Nobody reads: the line buffer is full, like an overrun; drop the rest of the message.
+      if (errno == EAGAIN) return;
+      continue;
+    }
+    sent += std::size_t(n);
+    std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                              std::chrono::duration<double>(sent * byte_s)));
+  }
+}
+
+}  // namespace pitchlab::hw
