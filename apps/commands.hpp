@@ -6,6 +6,10 @@ namespace pitchlab::apps {
 
 /// `pitchlab scan`: one full 3D scan of a world written as PCD.
 int RunScan(int argc, char** argv);
+/// `pitchlab register`: Algorithm 1 on two scans.
+int RunRegister(int argc, char** argv);
+/// `pitchlab merge`: scan-to-map merging of a scan sequence.
+int RunMerge(int argc, char** argv);
 /// `pitchlab map`: elevation map from clouds (lossless, ESRI grid, PNG).
 int RunMap(int argc, char** argv);
 /// `pitchlab plan`: traversability path on an elevation map.

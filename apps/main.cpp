@@ -20,6 +20,8 @@ struct Command {
 constexpr Command kCommands[] = {
     {"run", pitchlab::apps::RunRun, "closed-loop stop-scan-go mission, scored, with a report"},
     {"scan", pitchlab::apps::RunScan, "one full 3D scan of a world, written as PCD"},
+    {"register", pitchlab::apps::RunRegister, "align two scans (Algorithm 1), result as JSON"},
+    {"merge", pitchlab::apps::RunMerge, "merge a scan sequence into one map cloud + trajectory"},
     {"map", pitchlab::apps::RunMap, "elevation map from point clouds (Eq. 2-3)"},
     {"plan", pitchlab::apps::RunPlan, "traversability path on an elevation map (Eq. 4-5)"},
     {"hw", pitchlab::apps::RunHw, "hardware: emulate the devices on ptys, read an LMS200"},

@@ -23,6 +23,35 @@
 namespace pitchlab::apps {
 namespace {
 
+// The output folder is filled as a hidden sibling (".NAME.partial") and its files are moved in
+// only once all are written: a failure part way leaves no half-written folder behind.
+class StagedFolder {
+ public:
+  explicit StagedFolder(const std::filesystem::path& out) : out_(out.lexically_normal()) {
+    if (!out_.has_filename()) out_ = out_.parent_path();
+    stage_ = out_.parent_path() / ("." + out_.filename().string() + ".partial");
+    std::filesystem::remove_all(stage_);
+    std::filesystem::create_directories(stage_);
+  }
+  StagedFolder(const StagedFolder&) = delete;
+  StagedFolder& operator=(const StagedFolder&) = delete;
+  ~StagedFolder() {
+    std::error_code ignored;
+    std::filesystem::remove_all(stage_, ignored);
+  }
+  /// Where to write a file of the folder now.
+  std::filesystem::path operator/(const std::string& name) const { return stage_ / name; }
+  /// Moves every file into the output folder (created; files of the same name replaced).
+  void Commit() const {
+    std::filesystem::create_directories(out_);
+    for (const auto& e : std::filesystem::directory_iterator(stage_))
+      std::filesystem::rename(e.path(), out_ / e.path().filename());
+  }
+
+ private:
+  std::filesystem::path out_, stage_;
+};
+
 CliArgs MapArgs() {
   CliArgs args("map",
                "Builds an elevation map from point clouds (PCD; points moved into the world by\n"
@@ -131,13 +160,14 @@ int RunMap(int argc, char** argv) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - insert_start).count();
   const mapping::ElevationLayers layers = mapping::ComputeLayers(map);
 
-  std::filesystem::create_directories(out);
+  const StagedFolder folder(out);
   const auto check = [](Result<void> r) {
     if (!r) throw std::runtime_error(r.error().message);
   };
-  check(mapping::SaveElevationMap(map, (out / "map.plem").string()));
-  check(mapping::WriteEsriAsciiGrid(layers, origin, (out / "elevation.asc").string()));
-  check(mapping::WritePng(mapping::RenderElevationImage(layers), (out / "elevation.png").string()));
+  check(mapping::SaveElevationMap(map, (folder / "map.plem").string()));
+  check(mapping::WriteEsriAsciiGrid(layers, origin, (folder / "elevation.asc").string()));
+  check(mapping::WritePng(mapping::RenderElevationImage(layers),
+                          (folder / "elevation.png").string()));
 
   std::size_t known = 0, drops = 0;
   for (mapping::CellState s : layers.state) {
@@ -175,13 +205,13 @@ int RunMap(int argc, char** argv) {
   summary["wall_time_s"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   {
-    const std::string tmp = (out / "map.json.tmp").string();
-    std::FILE* f = std::fopen(tmp.c_str(), "w");
-    if (!f) throw std::runtime_error(tmp + ": cannot write");
+    const std::string file = (folder / "map.json").string();
+    std::FILE* f = std::fopen(file.c_str(), "w");
+    if (!f) throw std::runtime_error(file + ": cannot write");
     std::fputs((summary.dump(2) + "\n").c_str(), f);
     std::fclose(f);
-    std::filesystem::rename(tmp, out / "map.json");
   }
+  folder.Commit();
   if (args.Flagged("json")) {
     std::cout << summary.dump(2) << "\n";
     return 0;

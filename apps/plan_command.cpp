@@ -21,13 +21,42 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 
+// The output folder is filled as a hidden sibling (".NAME.partial") and its files are moved in
+// only once all are written: a failure part way leaves no half-written folder behind.
+class StagedFolder {
+ public:
+  explicit StagedFolder(const std::filesystem::path& out) : out_(out.lexically_normal()) {
+    if (!out_.has_filename()) out_ = out_.parent_path();
+    stage_ = out_.parent_path() / ("." + out_.filename().string() + ".partial");
+    std::filesystem::remove_all(stage_);
+    std::filesystem::create_directories(stage_);
+  }
+  StagedFolder(const StagedFolder&) = delete;
+  StagedFolder& operator=(const StagedFolder&) = delete;
+  ~StagedFolder() {
+    std::error_code ignored;
+    std::filesystem::remove_all(stage_, ignored);
+  }
+  /// Where to write a file of the folder now.
+  std::filesystem::path operator/(const std::string& name) const { return stage_ / name; }
+  /// Moves every file into the output folder (created; files of the same name replaced).
+  void Commit() const {
+    std::filesystem::create_directories(out_);
+    for (const auto& e : std::filesystem::directory_iterator(stage_))
+      std::filesystem::rename(e.path(), out_ / e.path().filename());
+  }
+
+ private:
+  std::filesystem::path out_, stage_;
+};
+
 CliArgs PlanArgs() {
   CliArgs args(
       "plan",
       "Plans the least-cost path (Eq. 5: W_T*T + W_P*P + W_phix*phi_x + W_phiy*phi_y per\n"
       "edge, 8-connected cells) on an elevation map written by `pitchlab map`, and writes\n"
       "DIR/path.csv, DIR/path.geojson (when the map is georeferenced), DIR/path.png and\n"
-      "DIR/plan.json. No path: the reason is printed and the exit code is 1.");
+      "DIR/plan.json. No path: the reason is printed, the exit code is 1 and no DIR is made.");
   args.Positionals("MAP.plem", "elevation map", 1, 1)
       .Option("start", "x,y", "start in the map frame [m]")
       .Option("goal", "x,y", "goal in the map frame [m]")
@@ -93,46 +122,48 @@ int RunPlan(int argc, char** argv) {
   const auto result = planning::PlanPath(grid, {start[0], start[1]}, {goal[0], goal[1]}, algorithm);
   const auto t2 = std::chrono::steady_clock::now();
 
-  std::filesystem::create_directories(out);
   nlohmann::json summary;
-  mapping::RgbImage image = mapping::RenderElevationImage(layers);
-  if (result) {
-    summary = PathJson(*result);
-    const auto check = [](Result<void> r) {
-      if (!r) throw std::runtime_error(r.error().message);
-    };
-    check(planning::WritePathCsv(*result, (out / "path.csv").string()));
-    if (map->geodetic_origin()) {
-      check(planning::WritePathGeoJson(*result, map->geodetic_origin(),
-                                       (out / "path.geojson").string()));
-    } else {
-      summary["geojson"] = "skipped: the map has no geodetic origin (map it with --world)";
-    }
-    planning::DrawPath(*result, map->geometry(), image);
-  } else {
-    summary = {{"found", false},
-               {"reason", planning::ToString(result.error().reason)},
-               {"message", result.error().message}};
-  }
-  if (auto r = mapping::WritePng(image, (out / "path.png").string()); !r) {
-    throw std::runtime_error(r.error().message);
-  }
   summary["robot"] = config.robot.name;
   summary["start"] = start;
   summary["goal"] = goal;
   summary["traversability_time_s"] = std::chrono::duration<double>(t1 - t0).count();
   summary["search_time_s"] = std::chrono::duration<double>(t2 - t1).count();
+  if (!result) {
+    // No path: the reason on stderr (and stdout with --json), exit 1, no output folder.
+    summary.update({{"found", false},
+                    {"reason", planning::ToString(result.error().reason)},
+                    {"message", result.error().message}});
+    if (args.Flagged("json")) std::cout << summary.dump(2) << "\n";
+    std::cerr << "pitchlab plan: no path (" << planning::ToString(result.error().reason)
+              << "): " << result.error().message << "\n";
+    return 1;
+  }
+  summary.update(PathJson(*result));
+  const StagedFolder folder(out);
+  const auto check = [](Result<void> r) {
+    if (!r) throw std::runtime_error(r.error().message);
+  };
+  check(planning::WritePathCsv(*result, (folder / "path.csv").string()));
+  if (map->geodetic_origin()) {
+    check(planning::WritePathGeoJson(*result, map->geodetic_origin(),
+                                     (folder / "path.geojson").string()));
+  } else {
+    summary["geojson"] = "skipped: the map has no geodetic origin (map it with --world)";
+  }
+  mapping::RgbImage image = mapping::RenderElevationImage(layers);
+  planning::DrawPath(*result, map->geometry(), image);
+  check(mapping::WritePng(image, (folder / "path.png").string()));
   {
-    const std::filesystem::path tmp = out / "plan.json.tmp";
-    std::FILE* f = std::fopen(tmp.c_str(), "w");
-    if (!f) throw std::runtime_error(tmp.string() + ": cannot write");
+    const std::string file = (folder / "plan.json").string();
+    std::FILE* f = std::fopen(file.c_str(), "w");
+    if (!f) throw std::runtime_error(file + ": cannot write");
     std::fputs((summary.dump(2) + "\n").c_str(), f);
     std::fclose(f);
-    std::filesystem::rename(tmp, out / "plan.json");
   }
+  folder.Commit();
   if (args.Flagged("json")) {
     std::cout << summary.dump(2) << "\n";
-  } else if (result) {
+  } else {
     std::printf(
         "path (%s): cost %.4f (roughness %.4f, length %.4f, incl. x %.4f, incl. y %.4f, "
         "unknown %.4f), %.2f m, %zu waypoints, max step %.3f m, max inclination %.1f deg\n"
@@ -141,11 +172,6 @@ int RunPlan(int argc, char** argv) {
         result->parts.inclination_x, result->parts.inclination_y, result->parts.unknown,
         result->length_m, result->waypoints.size(), result->max_step_m,
         result->max_inclination_rad * kRadToDeg, out.string().c_str());
-  }
-  if (!result) {
-    std::cerr << "pitchlab plan: no path (" << planning::ToString(result.error().reason)
-              << "): " << result.error().message << "\n";
-    return 1;
   }
   return 0;
 }

@@ -2,9 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
-#include <queue>
+#include <limits>
+#include <memory>
+#include <type_traits>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include <sstream>
 #include <stdexcept>
+
+#include "bucket_queue.hpp"
+#include "move_cost.hpp"
 
 namespace pitchlab::planning {
 namespace {
@@ -12,26 +20,23 @@ namespace {
 using mapping::CellIndex;
 using mapping::GridGeometry;
 
-struct Offset {
-  int di, dj;
-  double unit;  // 2D length in cells
-};
-// Orthogonal first, then diagonal: the order ListEdges and the searches share.
-constexpr Offset kNeighbours[8] = {{1, 0, 1.0},      {-1, 0, 1.0},     {0, 1, 1.0},
-                                   {0, -1, 1.0},     {1, 1, M_SQRT2},  {1, -1, M_SQRT2},
-                                   {-1, 1, M_SQRT2}, {-1, -1, M_SQRT2}};
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// A* weighs its lower bound by this share: each move then raises f = g + h by at least
+// (1 - share) of the cheapest move, which lets a bucket queue order A* exactly (see Search).
+constexpr double kHeuristicShare = 0.99;
+// A bucket ring longer than this (moves far dearer than the cheapest, e.g. a huge unknown
+// penalty) is replaced by a radix heap [buckets].
+constexpr std::size_t kMaxRing = std::size_t{1} << 21;
 
-// Eq. 4 and 5 for the edge a -> b of 2D length d_m, whether allowed or not.
+// Eq. 4 and 5 for the edge a -> b of 2D length d_m, whether allowed or not, with its parts.
 inline double RawEdgeCost(const TraversabilityGrid& T, std::size_t a, std::size_t b, double d_m,
                           CostParts* parts) {
-  const float za = T.z_m[a], zb = T.z_m[b];
-  const double dz = (std::isfinite(za) && std::isfinite(zb)) ? double(zb) - za : 0.0;
-  const double p = std::sqrt(d_m * d_m + dz * dz);                    // Eq. 4: 3D Euclidean length
-  const double cost = T.enter_cost[b] + T.config.weights.length * p;  // Eq. 5
+  const double cost =
+      MoveCost(T.enter_cost[b], T.z_m[a], T.z_m[b], d_m, T.config.weights.length);
   if (parts) {
     const CostWeights& w = T.config.weights;
-    const bool unknown = !std::isfinite(zb);
-    parts->length += w.length * p;
+    const bool unknown = !std::isfinite(T.z_m[b]);
+    parts->length += cost - T.enter_cost[b];
     if (unknown) {
       parts->unknown += T.enter_cost[b];
     } else {
@@ -43,10 +48,11 @@ inline double RawEdgeCost(const TraversabilityGrid& T, std::size_t a, std::size_
   return cost;
 }
 
-// Edge rule: the target is free and a diagonal does not cut a blocked corner.
-inline bool Allowed(const TraversabilityGrid& T, const CellIndex& a, const Offset& o) {
-  const int b = static_cast<int>(&o - kNeighbours);
-  return T.moves[T.geometry.Linear(a)] >> b & 1;
+// The move index b (see TraversabilityGrid::moves) from a to b, or -1 when not 8-neighbours.
+int MoveBetween(const CellIndex& a, const CellIndex& b) {
+  for (int m = 0; m < 8; ++m)
+    if (a.i + kMoveDi[m] == b.i && a.j + kMoveDj[m] == b.j) return m;
+  return -1;
 }
 
 std::string Where(const Eigen::Vector2d& p) {
@@ -60,13 +66,205 @@ double TiltOf(const TraversabilityGrid& T, std::size_t k) {
   return std::atan(std::sqrt(tx * tx + ty * ty));
 }
 
-Path Reconstruct(const TraversabilityGrid& T, const std::vector<std::int32_t>& parent,
-                 std::size_t start, std::size_t goal, double cost) {
+// One search's labels: tentative cost and a visited bit per cell. No parent pointers: the path is
+// read back from the costs (see Predecessor), which saves a store per relaxation.
+struct Labels {
+  explicit Labels(std::size_t n) : dist(n, kInf), visited((n + 63) / 64, 0) {}
+  bool Visited(std::uint32_t k) const { return visited[k >> 6] >> (k & 63) & 1; }
+  void Visit(std::uint32_t k) { visited[k >> 6] |= std::uint64_t{1} << (k & 63); }
+  std::vector<double> dist;
+  std::vector<std::uint64_t> visited;
+};
+
+// A*'s lower bound: kHeuristicShare times the distance to the goal on an obstacle-free 8-grid
+// whose straight moves cost a' = min(a, b) and diagonal ones b' = min(b, 2a'), with a and b the
+// cheapest straight and diagonal moves of the map. Every real move costs at least its relaxed
+// one, so h is admissible and consistent: h(u) <= c(u,v) + h(v). Zero for Dijkstra.
+struct Heuristic {
+  double straight = 0, diagonal = 0;  // per move [1]
+  int goal_i = 0, goal_j = 0;
+  double operator()(int i, int j) const {
+    const int dx = std::abs(i - goal_i), dy = std::abs(j - goal_j);
+    const int lo = std::min(dx, dy), hi = std::max(dx, dy);
+    return straight * (hi - lo) + diagonal * lo;  // octile distance, weighted
+  }
+};
+
+Heuristic MakeHeuristic(const TraversabilityGrid& T, const CellIndex& goal, bool astar) {
+  Heuristic h{0, 0, goal.i, goal.j};
+  const double a = T.min_straight_cost, b = T.min_diagonal_cost;
+  if (!astar || !std::isfinite(std::min(a, b))) return h;
+  const double a_relaxed = std::min(a, b);
+  h.straight = kHeuristicShare * a_relaxed;
+  h.diagonal = kHeuristicShare * std::min(b, 2 * a_relaxed);
+  return h;
+}
+
+// Relaxes the moves out of one cell (Algorithm 2's inner loop): Eq. 4-5 from the flat per-cell
+// arrays, nothing virtual, raw pointers so the compiler keeps them in registers.
+template <bool kAStar>
+struct Relaxer {
+  const float* z;
+  const float* enter;
+  const std::uint8_t* moves;
+  double* dist;
+  const std::uint64_t* visited;
+  std::ptrdiff_t delta[8];  // linear index step of each move
+  alignas(16) double step_sq[8];  // squared plane length of each move [m^2]
+  double w_length;          // W_P [1/m]
+  int size_x;
+  double inv_size_x;
+  Heuristic h;
+  double h_start;
+
+  template <typename Queue>
+  void operator()(std::uint32_t k, Queue& queue) const {
+    const unsigned allowed = moves[k];
+    const double gk = dist[k];
+    const float zk = z[k];
+    const bool zk_known = std::isfinite(zk);
+    // Gather the 8 neighbours with no data-dependent branch (a move that is not allowed reads
+    // cell k itself, already settled), cost them in one vectorisable loop, then write and queue
+    // only the improved ones.
+    alignas(16) double enter_n[8], dz[8], old[8], nd[8];
+    unsigned open = 0;  // neighbours not settled yet
+    for (int b = 0; b < 8; ++b) {
+      const std::uint32_t kn = (allowed >> b & 1) ? static_cast<std::uint32_t>(k + delta[b]) : k;
+      const float zn = z[kn];
+      enter_n[b] = enter[kn];
+      dz[b] = (zk_known && std::isfinite(zn)) ? double(zn) - zk : 0.0;
+      old[b] = dist[kn];
+      open |= (~static_cast<unsigned>(visited[kn >> 6] >> (kn & 63)) & 1u) << b;
+    }
+    // Eq. 4-5: the very operations of MoveCost, in the same order, so the sums are bit-identical
+    // (IEEE add, multiply and sqrt round the same in a vector lane; no contraction into FMA).
+    unsigned better = 0;
+#if defined(__SSE2__)
+    const __m128d g2 = _mm_set1_pd(gk), w2 = _mm_set1_pd(w_length);
+    for (int b = 0; b < 8; b += 2) {
+      const __m128d d = _mm_load_pd(dz + b);
+      const __m128d len = _mm_sqrt_pd(_mm_add_pd(_mm_load_pd(step_sq + b), _mm_mul_pd(d, d)));
+      const __m128d sum = _mm_add_pd(g2, _mm_add_pd(_mm_load_pd(enter_n + b), _mm_mul_pd(w2, len)));
+      _mm_store_pd(nd + b, sum);
+      better |= static_cast<unsigned>(_mm_movemask_pd(_mm_cmplt_pd(sum, _mm_load_pd(old + b))))
+                << b;
+    }
+#else
+    for (int b = 0; b < 8; ++b) {
+      nd[b] = gk + (enter_n[b] + w_length * std::sqrt(step_sq[b] + dz[b] * dz[b]));
+      better |= static_cast<unsigned>(nd[b] < old[b]) << b;
+    }
+#endif
+    int ci = 0, cj = 0;
+    if constexpr (kAStar) {
+      cj = static_cast<int>(k * inv_size_x);  // k / size_x without a division, then exact:
+      ci = static_cast<int>(k) - cj * size_x;
+      if (ci < 0) ci += size_x, --cj;
+      if (ci >= size_x) ci -= size_x, ++cj;
+    }
+    for (better &= allowed & open; better != 0; better &= better - 1) {
+      const int b = __builtin_ctz(better);
+      const auto kn = static_cast<std::uint32_t>(k + delta[b]);
+      dist[kn] = nd[b];
+      if constexpr (kAStar) {
+        queue.Push(nd[b] + h(ci + kMoveDi[b], cj + kMoveDj[b]) - h_start, kn);
+      } else {
+        queue.Push(nd[b], kn);
+      }
+    }
+  }
+};
+
+// Algorithm 2 from ks until kt is settled; returns the cells settled. Keys are g + h - h(start)
+// (g for Dijkstra): they rise along every move by at least the queue's contract, so they are
+// monotone and the queue may be a bucket queue or a radix heap. Each cell is expanded once.
+template <bool kAStar, typename Queue>
+std::size_t Search(const TraversabilityGrid& T, std::uint32_t ks, std::uint32_t kt,
+                   const Heuristic& h, Queue& queue, Labels& L) {
+  const GridGeometry& g = T.geometry;
+  Relaxer<kAStar> relax{T.z_m.data(), T.enter_cost.data(), T.moves.data(), L.dist.data(),
+                        L.visited.data(), {}, {},
+                        T.config.weights.length, g.size_x, 1.0 / g.size_x, h, 0.0};
+  for (int b = 0; b < 8; ++b) {
+    relax.delta[b] = kMoveDi[b] + static_cast<std::ptrdiff_t>(kMoveDj[b]) * g.size_x;
+    const double step_m = (b < 4 ? 1.0 : M_SQRT2) * g.cell_m;
+    relax.step_sq[b] = step_m * step_m;  // as MoveCost squares it
+  }
+  const CellIndex s = g.FromLinear(ks);
+  if constexpr (kAStar) relax.h_start = h(s.i, s.j);
+  std::size_t expanded = 0;
+  L.dist[ks] = 0.0;
+  queue.Push(0.0, ks);
+  while (!queue.Empty()) {
+    if constexpr (std::is_same_v<Queue, BucketQueue>) {
+      // Every cell in the lowest bucket is final (no move stays inside a bucket): any order.
+      const std::vector<std::uint32_t>& bucket = queue.NextBucket();
+      for (std::size_t n = 0; n < bucket.size(); ++n) {
+        const std::uint32_t k = bucket[n];
+        if (L.Visited(k)) continue;  // a stale entry: the cell was settled at a lower key
+        L.Visit(k);
+        ++expanded;
+        if (k == kt) return expanded;
+        relax(k, queue);
+      }
+    } else {
+      const std::uint32_t k = queue.Pop();
+      if (L.Visited(k)) continue;
+      L.Visit(k);
+      ++expanded;
+      if (k == kt) return expanded;
+      relax(k, queue);
+    }
+  }
+  return expanded;
+}
+
+// Runs Search with a bucket queue whose width is half the least key rise of a move (Dinitz), or
+// a radix heap when the ring of buckets would be too long.
+template <bool kAStar>
+std::size_t RunSearch(const TraversabilityGrid& T, std::uint32_t ks, std::uint32_t kt,
+                      const Heuristic& h, Labels& L) {
+  const double cheapest = std::min(T.min_straight_cost, T.min_diagonal_cost);
+  const double min_rise = kAStar ? (1 - kHeuristicShare) * cheapest : cheapest;
+  const double width = 0.5 * min_rise;
+  const double span = (T.max_edge_cost + h.diagonal) / width + 3;  // a move's largest rise
+  if (std::isfinite(width) && width > 0 && span < double(kMaxRing)) {
+    BucketQueue queue(width, static_cast<std::size_t>(span));
+    return Search<kAStar>(T, ks, kt, h, queue, L);
+  }
+  RadixHeap queue;
+  return Search<kAStar>(T, ks, kt, h, queue, L);
+}
+
+// The settled neighbour u of v that minimises cost(u) + Eq. 5 cost of u -> v: v's parent in the
+// search (the relaxation that set v's cost used exactly that sum, with u already final), or an
+// equally cheap one. Every move costs > 0, so costs fall strictly along the chain back to start.
+std::uint32_t Predecessor(const TraversabilityGrid& T, const Labels& L, std::uint32_t v) {
+  const GridGeometry& g = T.geometry;
+  const CellIndex cv = g.FromLinear(v);
+  std::uint32_t best = v;
+  double best_cost = kInf;
+  for (int b = 0; b < 8; ++b) {
+    const CellIndex cu{cv.i - kMoveDi[b], cv.j - kMoveDj[b]};
+    if (!g.Contains(cu)) continue;
+    const auto u = static_cast<std::uint32_t>(g.Linear(cu));
+    if (!(T.moves[u] >> b & 1) || !L.Visited(u)) continue;
+    const double c = L.dist[u] + MoveCost(T.enter_cost[v], T.z_m[u], T.z_m[v],
+                                          (b < 4 ? 1.0 : M_SQRT2) * g.cell_m,
+                                          T.config.weights.length);
+    if (c < best_cost) best_cost = c, best = u;
+  }
+  if (best == v) throw std::logic_error("plan path: a settled cell has no settled predecessor");
+  return best;
+}
+
+Path Reconstruct(const TraversabilityGrid& T, const Labels& L, std::uint32_t start,
+                 std::uint32_t goal) {
   const GridGeometry& g = T.geometry;
   Path path;
-  path.cost = cost;
-  std::vector<std::size_t> ks;
-  for (std::size_t k = goal; k != start; k = static_cast<std::size_t>(parent[k])) ks.push_back(k);
+  path.cost = L.dist[goal];
+  std::vector<std::uint32_t> ks;
+  for (std::uint32_t k = goal; k != start; k = Predecessor(T, L, k)) ks.push_back(k);
   ks.push_back(start);
   std::reverse(ks.begin(), ks.end());
   for (std::size_t n = 0; n < ks.size(); ++n) {
@@ -127,7 +325,8 @@ tl::expected<Path, NoPath> PlanPath(const TraversabilityGrid& T, const Eigen::Ve
                 "start " + Where(start_m) + " is outside the map");
   if (!g.Contains(t))
     return fail(NoPath::Reason::kGoalOutsideMap, "goal " + Where(goal_m) + " is outside the map");
-  const std::size_t ks = g.Linear(s), kt = g.Linear(t);
+  const auto ks = static_cast<std::uint32_t>(g.Linear(s)),
+             kt = static_cast<std::uint32_t>(g.Linear(t));
   if (!T.Free(ks) && T.blocked[ks] != Blocked::kUnknown)
     return fail(NoPath::Reason::kStartBlocked,
                 "start " + Where(start_m) + " is blocked: " + ToString(T.blocked[ks]));
@@ -136,60 +335,16 @@ tl::expected<Path, NoPath> PlanPath(const TraversabilityGrid& T, const Eigen::Ve
                 "goal " + Where(goal_m) + " is blocked: " + ToString(T.blocked[kt]));
 
   const bool astar = algorithm == Algorithm::kAStar;
-  const double w_len = T.config.weights.length * g.cell_m, c_min = T.min_enter_cost;
-  const auto heuristic = [&](const CellIndex& c) {
-    if (!astar) return 0.0;
-    const int dx = std::abs(c.i - t.i), dy = std::abs(c.j - t.j);
-    const int lo = std::min(dx, dy), hi = std::max(dx, dy);
-    // Octile distance times W_P (P >= 2D length) plus the cheapest entry cost per step: a lower
-    // bound of every remaining edge's cost, and consistent.
-    return w_len * ((hi - lo) + M_SQRT2 * lo) + c_min * hi;
-  };
-  std::vector<double> dist(g.cell_count(), std::numeric_limits<double>::infinity());
-  std::vector<std::int32_t> parent(g.cell_count(), -1);
-  std::vector<std::uint8_t> closed(g.cell_count(), 0);
-  using Entry = std::pair<double, std::uint32_t>;
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
-  dist[ks] = 0.0;
-  open.emplace(heuristic(s), static_cast<std::uint32_t>(ks));
-  std::size_t expanded = 0;
-  const double w_p = T.config.weights.length;
-  double step_m[8];
-  for (int b = 0; b < 8; ++b) step_m[b] = kNeighbours[b].unit * g.cell_m;
-  while (!open.empty()) {
-    const std::uint32_t k = open.top().second;
-    open.pop();
-    if (closed[k]) continue;
-    closed[k] = 1;
-    ++expanded;
-    if (k == kt) break;
-    const CellIndex c = g.FromLinear(k);
-    const std::uint8_t moves = T.moves[k];
-    const float zk = T.z_m[k];
-    for (int b = 0; b < 8; ++b) {
-      if (!(moves >> b & 1)) continue;
-      const Offset& o = kNeighbours[b];
-      const std::size_t kn = k + o.di + static_cast<std::ptrdiff_t>(o.dj) * g.size_x;
-      if (closed[kn]) continue;
-      const float zn = T.z_m[kn];
-      const double dz = (std::isfinite(zk) && std::isfinite(zn)) ? double(zn) - zk : 0.0;
-      const double d = step_m[b];
-      const double edge = T.enter_cost[kn] + w_p * std::sqrt(d * d + dz * dz);  // Eq. 4-5
-      const double nd = dist[k] + edge;
-      if (nd < dist[kn]) {
-        dist[kn] = nd;
-        parent[kn] = static_cast<std::int32_t>(k);
-        open.emplace(nd + heuristic(CellIndex{c.i + o.di, c.j + o.dj}),
-                     static_cast<std::uint32_t>(kn));
-      }
-    }
-  }
-  if (!closed[kt]) {
+  const Heuristic h = MakeHeuristic(T, t, astar);
+  Labels labels(g.cell_count());
+  const std::size_t expanded = astar ? RunSearch<true>(T, ks, kt, h, labels)
+                                     : RunSearch<false>(T, ks, kt, h, labels);
+  if (!labels.Visited(kt)) {
     return fail(NoPath::Reason::kDisconnected,
                 "no path from " + Where(start_m) + " to " + Where(goal_m) +
                     ": the goal is not connected to the start through cells the robot may enter");
   }
-  Path path = Reconstruct(T, parent, ks, kt, dist[kt]);
+  Path path = Reconstruct(T, labels, ks, kt);
   path.algorithm = algorithm;
   path.expanded = expanded;
   return path;
@@ -198,12 +353,9 @@ tl::expected<Path, NoPath> PlanPath(const TraversabilityGrid& T, const Eigen::Ve
 double EdgeCost(const TraversabilityGrid& T, std::size_t a, std::size_t b, CostParts* parts) {
   const GridGeometry& g = T.geometry;
   const CellIndex ca = g.FromLinear(a), cb = g.FromLinear(b);
-  for (const Offset& o : kNeighbours) {
-    if (ca.i + o.di != cb.i || ca.j + o.dj != cb.j) continue;
-    if (!Allowed(T, ca, o)) return std::nan("");
-    return RawEdgeCost(T, a, b, o.unit * g.cell_m, parts);
-  }
-  return std::nan("");
+  const int m = MoveBetween(ca, cb);
+  if (m < 0 || !(T.moves[a] >> m & 1)) return std::nan("");
+  return RawEdgeCost(T, a, b, (m < 4 ? 1.0 : M_SQRT2) * g.cell_m, parts);
 }
 
 std::vector<GraphEdge> ListEdges(const TraversabilityGrid& T) {
@@ -212,11 +364,11 @@ std::vector<GraphEdge> ListEdges(const TraversabilityGrid& T) {
   for (std::size_t k = 0; k < g.cell_count(); ++k) {
     if (!T.Free(k)) continue;
     const CellIndex c = g.FromLinear(k);
-    for (const Offset& o : kNeighbours) {
-      if (!Allowed(T, c, o)) continue;
-      const std::size_t kn = g.Linear({c.i + o.di, c.j + o.dj});
+    for (int m = 0; m < 8; ++m) {
+      if (!(T.moves[k] >> m & 1)) continue;
+      const std::size_t kn = g.Linear({c.i + kMoveDi[m], c.j + kMoveDj[m]});
       edges.push_back({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(kn),
-                       RawEdgeCost(T, k, kn, o.unit * g.cell_m, nullptr)});
+                       RawEdgeCost(T, k, kn, (m < 4 ? 1.0 : M_SQRT2) * g.cell_m, nullptr)});
     }
   }
   return edges;

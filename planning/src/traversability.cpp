@@ -6,7 +6,10 @@
 #include <cmath>
 #include <fstream>
 #include <sstream>
+#include <limits>
 #include <stdexcept>
+
+#include "move_cost.hpp"
 
 namespace pitchlab::planning {
 namespace {
@@ -91,7 +94,8 @@ void InflateHazards(TraversabilityGrid& T) {
 
 // The 8-neighbour move mask of every cell (see TraversabilityGrid::moves).
 void ComputeMoves(TraversabilityGrid& T) {
-  static constexpr int kDi[8] = {1, -1, 0, 0, 1, 1, -1, -1}, kDj[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+  const int* kDi = kMoveDi;
+  const int* kDj = kMoveDj;
   const GridGeometry& g = T.geometry;
   T.moves.assign(g.cell_count(), 0);
   const auto free = [&](int i, int j) { return g.Contains({i, j}) && T.Free(g.Linear({i, j})); };
@@ -104,6 +108,31 @@ void ComputeMoves(TraversabilityGrid& T) {
         m |= static_cast<std::uint8_t>(ok) << b;
       }
       T.moves[g.Linear({i, j})] = m;
+    }
+}
+
+// The extremes of the allowed moves' Eq. 4-5 costs that the searches need: the A* heuristic's
+// per-move lower bounds and the bucket queue's span.
+void ComputeMoveCostRange(TraversabilityGrid& T) {
+  const GridGeometry& g = T.geometry;
+  const double w_p = T.config.weights.length;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  T.min_straight_cost = T.min_diagonal_cost = kInf;
+  T.max_edge_cost = 0;
+  for (int j = 0; j < g.size_y; ++j)
+    for (int i = 0; i < g.size_x; ++i) {
+      const std::size_t k = g.Linear({i, j});
+      const bool source = T.Free(k) || T.blocked[k] == Blocked::kUnknown;
+      if (!source) continue;
+      for (int b = 0; b < 8; ++b) {
+        if (!(T.moves[k] >> b & 1)) continue;
+        const std::size_t kn = g.Linear({i + kMoveDi[b], j + kMoveDj[b]});
+        const double d_m = (b < 4 ? 1.0 : M_SQRT2) * g.cell_m;
+        const double c = MoveCost(T.enter_cost[kn], T.z_m[k], T.z_m[kn], d_m, w_p);
+        double& lo = b < 4 ? T.min_straight_cost : T.min_diagonal_cost;
+        lo = std::min(lo, c);
+        T.max_edge_cost = std::max(T.max_edge_cost, c);
+      }
     }
 }
 
@@ -251,6 +280,7 @@ TraversabilityGrid BuildTraversability(const ElevationLayers& L, const PlannerCo
     }
   InflateHazards(T);
   ComputeMoves(T);
+  ComputeMoveCostRange(T);
   float min_cost = std::numeric_limits<float>::infinity();
   for (std::size_t k = 0; k < n; ++k)
     if (T.Free(k)) min_cost = std::min(min_cost, T.enter_cost[k]);

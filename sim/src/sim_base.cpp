@@ -11,7 +11,8 @@ namespace {
 constexpr double kWheelKi_per_s = 10.0;    // firmware PI: integral gain on wheel speed error
 constexpr double kMaxIntegral_rps = 5.0;   // integral clamp [rad/s]
 constexpr double kStillSpeed_mps = 0.005;  // Stop(): still below this [m/s]
-constexpr double kStillRate_rps = 0.01;    // ... and this [rad/s]
+constexpr double kStillRate_rps = 0.01;
+constexpr double kHoldGain_per_s = 5.0;   // parked: wheel speed per radian off the held angle    // ... and this [rad/s]
 
 double Ramp(double from, double to, double max_delta) {
   return from + std::clamp(to - from, -max_delta, max_delta);
@@ -36,6 +37,10 @@ void OdometryConfig::Validate() const {
     invalid("increment_sigma", increment_sigma, "0 <= s < 1");
   }
   if (!(track_error > -0.5 && track_error < 2)) invalid("track_error", track_error, "-0.5 < e < 2");
+  if (!(gyro_bias_dps >= -10 && gyro_bias_dps <= 10)) invalid("gyro_bias_dps", gyro_bias_dps, "+-10");
+  if (!(gyro_noise_dps_rthz >= 0 && gyro_noise_dps_rthz <= 10)) {
+    invalid("gyro_noise_dps_rthz", gyro_noise_dps_rthz, "0 .. 10");
+  }
   if (!(update_period_s > 0 && update_period_s <= 1)) {
     invalid("update_period_s", update_period_s, "0 < t <= 1");
   }
@@ -59,10 +64,19 @@ double SimBase::effective_track_m() const {
   return sim_.params().track_m * sim_.params().track_factor;
 }
 
+namespace {
+// Heading of base_link's x axis in the horizontal plane [rad].
+double TrueYaw(const Simulation& sim) {
+  const Eigen::Matrix3d R = sim.T_world_base().linear();
+  return std::atan2(R(1, 0), R(0, 0));
+}
+}  // namespace
+
 void SimBase::ResetOdometry() {
   odometry_ = sensors::Odometry{};
   odometry_.stamp_s = sim_.time_s();
   last_ticks_ = Ticks(sim_.WheelAngles(), config_.ticks_per_rev);
+  last_true_yaw_rad_ = TrueYaw(sim_);
   since_update_s_ = 0.0;
   window_.clear();
 }
@@ -96,7 +110,9 @@ Result<sensors::Odometry> SimBase::Stop(double timeout_s) {
     if (command_.isZero() && speeds[0] < kStillSpeed_mps && speeds[1] < kStillRate_rps) break;
     if (sim_.time_s() - t0 > timeout_s) {
       return Fail(Error::Code::kTimeout,
-                  "base did not stop within " + std::to_string(timeout_s) + " s");
+                  "base did not stop within " + std::to_string(timeout_s) + " s (still at " +
+                      std::to_string(speeds[0]) + " m/s, " + std::to_string(speeds[1]) +
+                      " rad/s)");
     }
   }
   return ReadOdometry();
@@ -109,8 +125,14 @@ void SimBase::BeforeStep() {
   command_[0] = Ramp(command_[0], target_[0], p.max_accel_mps2 * dt);
   command_[1] = Ramp(command_[1], target_[1], p.max_yaw_accel_rps2 * dt);
   const double half_track = effective_track_m() / 2;
-  const Eigen::Vector2d ref_rps((command_[0] - command_[1] * half_track) / p.wheel_radius_m,
-                                (command_[0] + command_[1] * half_track) / p.wheel_radius_m);
+  Eigen::Vector2d ref_rps((command_[0] - command_[1] * half_track) / p.wheel_radius_m,
+                          (command_[0] + command_[1] * half_track) / p.wheel_radius_m);
+  // Parked, the firmware holds the wheels where they stopped (a position loop), so the robot
+  // does not roll down a slope while it scans.
+  const bool parked = command_.isZero() && target_.isZero();
+  if (parked && !holding_) hold_angles_ = sim_.WheelAngles();
+  holding_ = parked;
+  if (parked) ref_rps = kHoldGain_per_s * (hold_angles_ - sim_.WheelAngles());
   const Eigen::Vector2d error = ref_rps - sim_.WheelSpeeds();
   integral_rps_ = (integral_rps_ + kWheelKi_per_s * dt * error)
                       .cwiseMax(-kMaxIntegral_rps)
@@ -138,7 +160,16 @@ void SimBase::IntegrateOdometry() {
     ds[1] *= 1.0 + config_.increment_sigma * normal_(rng_);
   }
   const double track = effective_track_m() * (1.0 + config_.track_error);
-  const double d_center = (ds[0] + ds[1]) / 2, d_yaw = (ds[1] - ds[0]) / track;
+  const double d_center = (ds[0] + ds[1]) / 2;
+  double d_yaw = (ds[1] - ds[0]) / track;
+  if (config_.gyro) {  // the body's true turn, plus the gyro's bias and white noise
+    const double yaw = TrueYaw(sim_);
+    const double dt = since_update_s_;
+    d_yaw = std::remainder(yaw - last_true_yaw_rad_, 2.0 * M_PI) +
+            (config_.gyro_bias_dps * dt +
+             config_.gyro_noise_dps_rthz * std::sqrt(dt) * normal_(rng_)) * M_PI / 180.0;
+    last_true_yaw_rad_ = yaw;
+  }
   const double heading = odometry_.yaw_rad + d_yaw / 2;
   odometry_.x_m += d_center * std::cos(heading);
   odometry_.y_m += d_center * std::sin(heading);

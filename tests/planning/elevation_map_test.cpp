@@ -7,6 +7,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <mujoco/mujoco.h>
 #include <random>
 
 #include "pitchlab/mapping/elevation_io.hpp"
@@ -320,6 +322,82 @@ TEST(ElevationTruth, DownwardRaysGiveTheTrueSurfaceAndCompareReportsErrors) {
   EXPECT_NEAR(rep.rmse_m, 0.02, 1e-4);
   EXPECT_NEAR(rep.mean_error_m, 0.02, 1e-4);
 }
+
+// Over a plane floor: a table (top 0.72-0.75 m, one leg), a tree (sphere crown of radius 1 m
+// centred 3 m up, a 0.1 m capsule trunk into it), a building on a slab (faces touching), a car
+// cabin on its chassis (faces touching, chassis 0.25 m above the floor) and a low box shelf
+// (underside 0.3 m up: less headroom than the robot needs).
+constexpr char kScene[] = R"(
+<mujoco model="overhangs">
+  <worldbody>
+    <geom name="floor" type="plane" size="0 0 1"/>
+    <geom name="table_top" type="box" pos="1 1 0.735" size="0.6 0.4 0.015"/>
+    <geom name="table_leg" type="box" pos="0.45 0.65 0.36" size="0.02 0.02 0.36"/>
+    <geom name="crown" type="sphere" pos="4.05 1.05 3" size="1"/>
+    <geom name="trunk" type="capsule" fromto="4.05 1.05 0 4.05 1.05 3" size="0.1"/>
+    <geom name="slab" type="box" pos="1 4 -1" size="0.8 0.8 1.14"/>
+    <geom name="building" type="box" pos="1 4 1.64" size="0.5 0.5 1.5"/>
+    <geom name="chassis" type="box" pos="4 4 0.55" size="0.8 0.5 0.3"/>
+    <geom name="cabin" type="box" pos="4 4 1.15" size="0.5 0.4 0.3"/>
+    <geom name="shelf" type="box" pos="6.5 1 0.4" size="0.3 0.3 0.1"/>
+  </worldbody>
+</mujoco>)";
+
+class Scene {
+ public:
+  Scene() {
+    const auto file = std::filesystem::temp_directory_path() / "pitchlab_overhangs.xml";
+    std::ofstream(file) << kScene;
+    char error[1000] = "";
+    model_ = mj_loadXML(file.c_str(), nullptr, error, sizeof(error));
+    if (!model_) throw std::runtime_error(std::string("overhang scene: ") + error);
+    data_ = mj_makeData(model_);
+    mj_forward(model_, data_);
+    caster_ = sensors::MakeEmbreeRayCaster(model_, data_, sensors::RayCasterOptions{"", true});
+  }
+  ~Scene() {
+    caster_.reset();
+    mj_deleteData(data_);
+    mj_deleteModel(model_);
+  }
+  const sensors::RayCaster& caster() const { return *caster_; }
+
+ private:
+  mjModel* model_ = nullptr;
+  mjData* data_ = nullptr;
+  std::unique_ptr<sensors::RayCaster> caster_;
+};
+
+TEST(ElevationTruth, FloorUnderAnOverhangCountsNotTheOverhang) {
+  constexpr double kRayTolM = 1e-4;  // float rays cast from 200 m up
+  const Scene scene;
+  const GridGeometry g = GridGeometry::FromArea(0, 0, 8, 5.5, 0.1);
+  const ElevationLayers headroom = ComputeLayers(ComputeTrueElevationMap(scene.caster(), g));
+  TruthConfig first_hit;
+  first_hit.min_headroom_m = 0;
+  const ElevationLayers from_above =
+      ComputeLayers(ComputeTrueElevationMap(scene.caster(), g, first_hit));
+  const auto at = [&](const ElevationLayers& L, double x, double y) {
+    return L.mean_z[g.Linear(g.IndexOf(x, y))];
+  };
+  // Under the table top and the crown: the floor (the first hit from above was the overhang).
+  EXPECT_NEAR(at(from_above, 1.2, 1.1), 0.75, kRayTolM);
+  EXPECT_NEAR(at(headroom, 1.2, 1.1), 0.0, kRayTolM);
+  EXPECT_NEAR(at(from_above, 4.55, 1.05), 3 + std::sqrt(1 - 0.5 * 0.5), 0.02);
+  EXPECT_NEAR(at(headroom, 4.55, 1.05), 0.0, kRayTolM);
+  // Through the trunk (inside the crown), the building on its slab, the cabin on its chassis and
+  // the shelf too low to drive under: the first surface from above, as before.
+  EXPECT_NEAR(at(headroom, 4.05, 1.05), at(from_above, 4.05, 1.05), kRayTolM);
+  EXPECT_GT(at(headroom, 4.05, 1.05), 3.9);
+  EXPECT_NEAR(at(headroom, 1.05, 4.05), 3.14, kRayTolM);
+  EXPECT_NEAR(at(headroom, 4.05, 4.05), 1.45, kRayTolM);
+  EXPECT_NEAR(at(headroom, 4.65, 4.05), 0.85, kRayTolM);  // chassis beside the cabin
+  EXPECT_NEAR(at(headroom, 6.55, 1.05), 0.5, kRayTolM);
+  // The slab's top beside the building, and open floor, are unchanged.
+  EXPECT_NEAR(at(headroom, 1.65, 4.05), 0.14, kRayTolM);
+  EXPECT_NEAR(at(headroom, 7.55, 5.05), 0.0, kRayTolM);
+}
+
 
 }  // namespace
 }  // namespace pitchlab::mapping

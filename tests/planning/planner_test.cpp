@@ -150,6 +150,27 @@ TEST(Planner, DijkstraAStarAndBglAgreeOnRandomTerrain) {
   }
 }
 
+TEST(Planner, HugeUnknownPenaltyStillGivesTheOptimalCost) {
+  // Moves into unknown cells cost 1e6: the bucket ring would be too long, so the search falls
+  // back to its radix heap; both searches must still agree with BGL.
+  const ElevationLayers L = MakeLayers(40, 30, 0.1, [](int i, int j) {
+    if (i == 20 && j != 3) return std::nan("");  // an unknown wall with one known gap
+    return 0.02 * std::sin(0.4 * i) * std::cos(0.3 * j);
+  });
+  PlannerConfig cfg = PointRobot();
+  cfg.unknown = UnknownPolicy::kPenalise;
+  cfg.unknown_penalty = 1e6;
+  const TraversabilityGrid T = BuildTraversability(L, cfg);
+  const Eigen::Vector2d s = Centre(T, 2, 25), t = Centre(T, 37, 25);
+  const double peer = BglCost(T, T.geometry.Linear({2, 25}), T.geometry.Linear({37, 25}));
+  for (Algorithm a : {Algorithm::kDijkstra, Algorithm::kAStar}) {
+    const auto path = PlanPath(T, s, t, a);
+    ASSERT_TRUE(path) << path.error().message;
+    EXPECT_NEAR(path->cost, peer, kCostRelTol * peer);
+    EXPECT_DOUBLE_EQ(path->parts.unknown, 0.0);  // through the gap, not the wall
+  }
+}
+
 TEST(Planner, GapNarrowerThanTheRobotIsNotPassed) {
   // A 0.5 m wall across the map (x = 2 m) with a 9-cell (0.45 m) and an 11-cell (0.55 m) gap.
   const double cell = 0.05;

@@ -65,7 +65,9 @@ TEST(SimBase, P3DxTurnsNinetyDegreesAtHalfARadianPerSecondForPiSeconds) {
   ASSERT_TRUE(odo) << odo.error().message;
   const double turned = Yaw(s.start.inverse() * s.sim->T_world_base());
   const double ramp_loss = 0.5 * 0.5 / (2 * s.sim->params().max_yaw_accel_rps2);
-  EXPECT_NEAR(turned, M_PI / 2 - ramp_loss, 3.0 * M_PI / 180);
+  // Each wheel touches the floor at two points that scrub when turning on the spot; with the
+  // firm elliptic friction cones (no creep on slopes) that costs the DX ~5 deg of the 86 here.
+  EXPECT_NEAR(turned, M_PI / 2 - ramp_loss, 7.0 * M_PI / 180);
   EXPECT_NEAR(odo->yaw_rad, turned, kOdometryAgreement * turned);
   const Eigen::Vector3d moved = s.start.inverse() * s.sim->T_world_base().translation();
   EXPECT_LT(moved.norm(), 0.02);  // turns on the spot

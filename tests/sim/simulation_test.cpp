@@ -125,6 +125,11 @@ TEST(Simulation, PlacementOnAnEvenSlopeSettlesTiltedLikeTheSlope) {
   const double tilt_deg = std::acos(pose->linear()(2, 2)) * 180.0 / M_PI;
   constexpr double kTiltTolerance_deg = 1.0;
   EXPECT_NEAR(tilt_deg, 10.0, kTiltTolerance_deg);
+  // Parked for as long as a 3D scan takes, it stays put (soft contacts alone creep mm/s).
+  const Eigen::Vector3d before = sim->T_world_base().translation();
+  sim->StepFor(16.0);
+  constexpr double kCreep_m = 0.005;
+  EXPECT_LT((sim->T_world_base().translation() - before).norm(), kCreep_m);
 }
 
 TEST(Simulation, PlacementOutsideTheBoundsIsAClearError) {

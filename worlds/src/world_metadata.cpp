@@ -87,6 +87,11 @@ WorldMetadata ReadWorldMetadata(const mjModel* model) {
     if (v.size() != 3) Bad(kDefaultStartField, v, "3 values: x_m y_m yaw_deg");
     metadata.default_start = StartPose{v[0], v[1], v[2] * kDegToRad};
   }
+  if (const auto goal = Numeric(model, kDefaultGoalField)) {
+    const auto& v = *goal;
+    if (v.size() != 2) Bad(kDefaultGoalField, v, "2 values: x_m y_m");
+    metadata.default_goal = GoalPoint{v[0], v[1]};
+  }
   return metadata;
 }
 
@@ -113,6 +118,11 @@ std::string FormatMetadataMjcf(const WorldMetadata& metadata) {
   }
   out << "    <numeric name=\"" << kDefaultStartField << "\" data=\"" << FormatFixed(s.x_m, 4)
       << " " << FormatFixed(s.y_m, 4) << " " << FormatFixed(s.yaw_rad / kDegToRad, 3) << "\"/>\n";
+  if (metadata.default_goal) {
+    out << "    <numeric name=\"" << kDefaultGoalField << "\" data=\""
+        << FormatFixed(metadata.default_goal->x_m, 4) << " "
+        << FormatFixed(metadata.default_goal->y_m, 4) << "\"/>\n";
+  }
   out << "  </custom>\n";
   return out.str();
 }

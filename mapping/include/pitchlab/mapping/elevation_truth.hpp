@@ -19,12 +19,29 @@ struct TruthConfig {
   int samples_per_side = 3;  ///< k x k vertical rays per cell, on a regular sub-grid [1]
   double ray_top_z_m = 200;  ///< rays start at this height (above everything) [m]
   double max_depth_m = 400;  ///< and go down this far at most [m]
+  /// Free height under an overhang for the floor beneath to count instead [m]: the P3 with its
+  /// LMS200 on the default mount is ~0.6 m tall (mirror 0.54 m above base_link), so under a
+  /// higher canopy, table or balcony the robot and its laser see (and drive on) the floor.
+  /// 0 disables: the first surface from above counts, whatever is below it.
+  double min_headroom_m = 0.6;
+  int max_overhangs = 3;  ///< overhang layers looked through per vertical line [1]
 };
 
-/// The true elevation map over `geometry`: every downward ray's first hit is inserted as a point,
-/// so the truth has the same layers (mean, min, max, roughness, inclination) as an estimate.
-/// Cells where no ray hits (off the world) stay unknown. The first surface from above counts
-/// (a desk top, not the floor beneath it: what a robot's laser sees from the side may differ).
+/// The true elevation map over `geometry`: for each of the k x k vertical lines per cell, the
+/// surface a ground robot stands on is inserted as a point, so the truth has the same layers
+/// (mean, min, max, roughness, inclination) as an estimate. Cells where no ray hits (off the
+/// world) stay unknown.
+///
+/// Which surface (rays only, no scene knowledge): the first hit from above, unless it is an
+/// overhang, i.e. along the line (1) the next hit below is the same geom again (its underside:
+/// a closed solid in mid-air, nothing else inside it), (2) no other geom's face touches that
+/// underside (two short probes up and down; a face on a face, like a building on its slab or a
+/// car cabin on its chassis, is one solid), (3) the next surface below is at least
+/// `min_headroom_m` lower, and (4) that surface is a top: below it the ray meets the same geom
+/// again (its bottom), or nothing and it is one-sided (a plane: a ray from just under it does
+/// not see it). Then that floor counts, and is tested the same way
+/// (up to `max_overhangs` layers). A tree's crown over open ground is an overhang; the line
+/// through its trunk is not (the trunk is inside the crown), nor is a solid building.
 ElevationMap ComputeTrueElevationMap(const sensors::RayCaster& caster, const GridGeometry& geometry,
                                      const TruthConfig& config = {});
 

@@ -2,6 +2,7 @@
 // Traversability (Eq. 3-5 inputs): which cells a P3 may stand on, and what entering each costs.
 // Built once per plan from the elevation map's layers; the graph search only reads flat arrays.
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -73,6 +74,10 @@ enum class Blocked : std::uint8_t {
 };
 const char* ToString(Blocked b);
 
+/// The 8 moves of a cell, in the order of TraversabilityGrid::moves: x and y steps [cell].
+inline constexpr int kMoveDi[8] = {1, -1, 0, 0, 1, 1, -1, -1};
+inline constexpr int kMoveDj[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+
 /// The planning graph's per-cell data: 8-connected cells of the map's geometry.
 struct TraversabilityGrid {
   mapping::GridGeometry geometry;
@@ -85,7 +90,12 @@ struct TraversabilityGrid {
   /// Bit b set: the move to neighbour b is allowed (target free, no blocked corner cut); order
   /// +x, -x, +y, -y, (+x+y), (+x-y), (-x+y), (-x-y). Computed for every cell.
   std::vector<std::uint8_t> moves;
-  float min_enter_cost = 0;  ///< over free cells, for the A* heuristic [1]
+  /// Eq. 4-5 costs of the moves out of cells a search may expand (free cells, and unknown ones as
+  /// a start):
+  double min_straight_cost = 0;  ///< cheapest move along x or y, +inf if none [1]
+  double min_diagonal_cost = 0;  ///< cheapest diagonal move, +inf if none [1]
+  double max_edge_cost = 0;      ///< dearest allowed move, 0 if none [1]
+  float min_enter_cost = 0;      ///< cheapest entry cost of a free cell [1]
 
   bool Free(std::size_t k) const { return blocked[k] == Blocked::kFree; }
 };

@@ -30,12 +30,20 @@ struct StartPose {
   double yaw_rad = 0.0;  ///< heading about z, counter-clockwise from +x [rad]
 };
 
+/// A point on the ground the robot should reach.
+struct GoalPoint {
+  double x_m = 0.0;  ///< [m]
+  double y_m = 0.0;  ///< [m]
+};
+
 /// What a world says about itself through its MuJoCo custom fields (`pitchlab:*`).
 struct WorldMetadata {
   std::string description;                       ///< one line, empty when absent
   std::optional<GeodeticPoint> geodetic_origin;  ///< the world origin on WGS84, if georeferenced
   Bounds2d bounds;                               ///< where a robot may be placed [m]
   StartPose default_start;                       ///< a free, flat spot
+  /// Where the default closed-loop run drives to, if the world names one.
+  std::optional<GoalPoint> default_goal;
 };
 
 /// Custom field names, shared by the writers and the reader.
@@ -46,6 +54,8 @@ inline constexpr const char* kGeodeticOriginField = "pitchlab:geodetic_origin";
 inline constexpr const char* kBoundsField = "pitchlab:bounds";
 /// Numeric field "x_m y_m yaw_deg".
 inline constexpr const char* kDefaultStartField = "pitchlab:default_start";
+/// Numeric field "x_m y_m": the default run's goal.
+inline constexpr const char* kDefaultGoalField = "pitchlab:default_goal";
 
 /// Reads the metadata of a compiled world. Absent fields get defaults (no description, no geodetic
 /// origin, bounds = the model's extent around its centre, start at the origin), so any MJCF is a

@@ -1,0 +1,287 @@
+#include "mission.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+#include "pitchlab/mapping/elevation_layers.hpp"
+#include "pitchlab/mapping/point_cloud.hpp"
+
+namespace pitchlab::apps {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kMinProgress_m = 0.05;   // less than this over stuck_timeout_s is no progress
+constexpr double kFootprintHalf_m = 0.2;  // ground known under the robot: it stands on it
+constexpr double kStopTime_s = 0.5;       // braking before a scan
+constexpr double kEscapeRadius_m = 1.0;   // how far a start inside a hazard margin looks out
+
+double Yaw(const Eigen::Isometry3d& T) { return std::atan2(T.linear()(1, 0), T.linear()(0, 0)); }
+
+// Odometry increment since `ref`, applied to the pose estimated at `ref`.
+Eigen::Isometry3d Propagate(const Eigen::Isometry3d& T_world_base_at_ref,
+                            const sensors::Odometry& ref, const sensors::Odometry& now) {
+  return T_world_base_at_ref * (ref.Pose().inverse() * now.Pose());
+}
+
+// The first `length_m` of the path's (x, y) polyline.
+std::vector<Eigen::Vector2d> PathPrefix(const planning::Path& path, double length_m) {
+  std::vector<Eigen::Vector2d> out;
+  double arc = 0;
+  for (const planning::Waypoint& w : path.waypoints) {
+    const Eigen::Vector2d p(w.x_m, w.y_m);
+    if (!out.empty()) {
+      const double seg = (p - out.back()).norm();
+      if (arc + seg > length_m) {
+        out.push_back(out.back() + (p - out.back()) * ((length_m - arc) / seg));
+        break;
+      }
+      arc += seg;
+    }
+    out.push_back(p);
+  }
+  return out;
+}
+
+class Mission {
+ public:
+  Mission(sensors::ScanSource& source, sensors::MobileBase& base, const MissionConfig& config,
+          const MissionProbes& probes, const MissionObserver& observer)
+      : source_(source), base_(base), config_(config), probes_(probes), observer_(observer),
+        builder_(config.registration) {}
+
+  MissionResult Run(const Eigen::Isometry3d& T_world_start);
+
+ private:
+  bool Stop(int k);  // false: the mission ends (result_.reason says why)
+  void UpdateElevation(const StopRecord& stop);
+  void Plan(StopRecord& stop) const;
+  bool Drive(const planning::Path& path);
+  bool OverBudget();
+  void Progress(const std::string& text) const {
+    if (observer_.on_progress) observer_.on_progress(text);
+  }
+
+  sensors::ScanSource& source_;
+  sensors::MobileBase& base_;
+  const MissionConfig& config_;
+  const MissionProbes& probes_;
+  const MissionObserver& observer_;
+  mapping::MapBuilder builder_;
+  MissionResult result_;
+  Eigen::Isometry3d T_world_map_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_world_base_ = Eigen::Isometry3d::Identity();  // estimate at odo_ref_
+  sensors::Odometry odo_ref_;
+};
+
+MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
+  result_.start_s = probes_.now_s();
+  result_.elevation = mapping::ElevationMap(config_.map_area);
+  T_world_map_ = T_world_base_ = T_world_start;
+  Result<sensors::Odometry> odo = base_.ReadOdometry();
+  if (!odo) {
+    result_.reason = "base: " + odo.error().message;
+  } else {
+    odo_ref_ = *odo;
+    result_.reason = "stop limit reached (" + std::to_string(config_.max_stops) + " stops)";
+    for (int k = 0; k < config_.max_stops && Stop(k); ++k) {
+    }
+  }
+  result_.end_s = probes_.now_s();
+  result_.map_cloud_world = mapping::TransformCloud(builder_.MapCloud(), T_world_map_);
+  return std::move(result_);
+}
+
+bool Mission::OverBudget() {
+  if (probes_.now_s() - result_.start_s <= config_.time_budget_s) return false;
+  result_.reason = "time budget of " + std::to_string(config_.time_budget_s) + " s spent";
+  return true;
+}
+
+bool Mission::Stop(int k) {
+  if (OverBudget()) return false;
+  StopRecord stop;
+  stop.index = k;
+  Result<sensors::Scan3D> scan = source_.Acquire();
+  if (!scan) {
+    result_.reason = "scan at stop " + std::to_string(k) + " failed: " + scan.error().message;
+    return false;
+  }
+  stop.scan = std::move(*scan);
+  stop.stamp_s = stop.scan.stamp_s;
+  if (probes_.true_pose) stop.T_world_base_true = probes_.true_pose();
+  Result<sensors::Odometry> odo = base_.ReadOdometry();
+  if (!odo) {
+    result_.reason = "base: " + odo.error().message;
+    return false;
+  }
+  stop.T_world_base_odom = Propagate(T_world_base_, odo_ref_, *odo);
+  // Algorithm 1 against the map, odometry as the prior (none for the scan that starts the map).
+  const std::optional<Eigen::Isometry3d> prior =
+      k == 0 ? std::nullopt
+             : std::optional<Eigen::Isometry3d>(T_world_map_.inverse() * stop.T_world_base_odom);
+  Result<mapping::MergeStep> merge = builder_.Add(mapping::CloudFromScan(stop.scan), prior);
+  if (merge) stop.merge = *merge;
+  if (!merge) stop.merge.registration.reason = merge.error().message;
+  // A failed registration is never merged: the pose comes from odometry and the map keeps
+  // what it had.
+  stop.T_world_base = stop.merge.merged ? T_world_map_ * stop.merge.T_map_base
+                                        : stop.T_world_base_odom;
+  T_world_base_ = stop.T_world_base;
+  odo_ref_ = *odo;
+  if (stop.merge.merged) UpdateElevation(stop);
+  stop.distance_to_goal_m = (config_.goal_m - stop.T_world_base.translation().head<2>()).norm();
+  const bool arrived = stop.distance_to_goal_m <= config_.goal_tolerance_m;
+  if (!arrived) Plan(stop);
+  result_.stops.push_back(std::move(stop));
+  const StopRecord& s = result_.stops.back();
+  if (observer_.on_stop) observer_.on_stop(s, result_);
+  char line[200];
+  std::snprintf(line, sizeof(line), "stop %d: %.1f m to goal, registration %s, %s", k,
+                s.distance_to_goal_m,
+                s.merge.merged ? mapping::ToString(s.merge.registration.path) : "FAILED",
+                arrived ? "goal reached" : s.plan ? "path planned" : "no path");
+  Progress(line);
+  if (arrived) {
+    result_.success = true;
+    result_.reason = "goal reached";
+    return false;
+  }
+  if (!s.plan) {
+    result_.reason = "no path at stop " + std::to_string(k) + ": " + s.plan_error;
+    return false;
+  }
+  return Drive(*s.plan);
+}
+
+void Mission::UpdateElevation(const StopRecord& stop) {
+  const Eigen::Isometry3f T = stop.T_world_base.cast<float>();
+  const Eigen::Vector3f laser = (stop.T_world_base * config_.mount.BaseToLaser(0.0)).translation()
+                                    .cast<float>();
+  result_.elevation.Insert(stop.scan.points, T, laser);
+  // The laser cannot see under the robot, but the robot stands on that ground.
+  std::vector<Eigen::Vector3f> ground;
+  for (double x = -kFootprintHalf_m; x <= kFootprintHalf_m + 1e-9; x += 0.1) {
+    for (double y = -kFootprintHalf_m; y <= kFootprintHalf_m + 1e-9; y += 0.1) {
+      ground.push_back(T * Eigen::Vector3f(float(x), float(y), 0.0f));
+    }
+  }
+  result_.elevation.InsertPoints(ground.data(), ground.size());
+}
+
+// The robot may stand where the footprint rule forbids a path to go (a hazard seen late, drift):
+// the nearest free cell it can reach in a straight line, crossing no step, slope or drop.
+std::optional<Eigen::Vector2d> EscapeCell(const planning::TraversabilityGrid& grid,
+                                          const Eigen::Vector2d& from) {
+  const mapping::GridGeometry& g = grid.geometry;
+  const int reach = static_cast<int>(std::ceil(kEscapeRadius_m / g.cell_m));
+  const mapping::CellIndex c = g.IndexOf(from.x(), from.y());
+  std::optional<Eigen::Vector2d> best;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (int j = c.j - reach; j <= c.j + reach; ++j) {
+    for (int i = c.i - reach; i <= c.i + reach; ++i) {
+      if (!g.Contains({i, j}) || !grid.Free(g.Linear({i, j}))) continue;
+      const Eigen::Vector2d to = g.CenterOf({i, j});
+      const double d = (to - from).norm();
+      if (d >= best_d || d > kEscapeRadius_m) continue;
+      bool clear = true;
+      for (double t = 0; t <= 1.0 && clear; t += 0.5 * g.cell_m / std::max(d, g.cell_m)) {
+        const Eigen::Vector2d p = from + t * (to - from);
+        const planning::Blocked b = grid.blocked[g.Linear(g.IndexOf(p.x(), p.y()))];
+        clear = b == planning::Blocked::kFree || b == planning::Blocked::kNearHazard ||
+                b == planning::Blocked::kUnknown;
+      }
+      if (clear) best = to, best_d = d;
+    }
+  }
+  return best;
+}
+
+void Mission::Plan(StopRecord& stop) const {
+  const mapping::ElevationLayers layers = mapping::ComputeLayers(result_.elevation);
+  planning::PlannerConfig planner = config_.planner;
+  planner.robot.width_m += 2.0 * config_.safety_margin_m;  // the follower cuts corners a little
+  const planning::TraversabilityGrid grid = planning::BuildTraversability(layers, planner);
+  const Eigen::Vector2d here = stop.T_world_base.translation().head<2>();
+  auto path = planning::PlanPath(grid, here, config_.goal_m, config_.algorithm);
+  if (!path && path.error().reason == planning::NoPath::Reason::kStartBlocked) {
+    if (const auto escape = EscapeCell(grid, here)) {
+      path = planning::PlanPath(grid, *escape, config_.goal_m, config_.algorithm);
+      if (path) {  // drive out to the free cell first
+        path->waypoints.insert(path->waypoints.begin(),
+                               planning::Waypoint{here.x(), here.y(), path->waypoints[0].z_m});
+      }
+    }
+  }
+  if (path) {
+    stop.plan = std::move(*path);
+  } else {
+    stop.plan_error = path.error().message;
+  }
+}
+
+bool Mission::Drive(const planning::Path& path) {
+  PurePursuit follower(PathPrefix(path, config_.drive_per_stop_m), config_.follower);
+  const sensors::Odometry start = odo_ref_;
+  sensors::Odometry odo = odo_ref_;
+  Eigen::Vector2d progress_xy(odo.x_m, odo.y_m);
+  double progress_s = probes_.now_s();
+  while (true) {
+    if (OverBudget()) return false;
+    const Eigen::Isometry3d T_est = Propagate(T_world_base_, start, odo);
+    const DriveCommand cmd =
+        follower.Command(T_est.translation().x(), T_est.translation().y(), Yaw(T_est));
+    if (cmd.done) break;
+    Result<sensors::Odometry> next = base_.Drive(cmd.v_mps, cmd.omega_rps, config_.control_period_s);
+    if (!next) {
+      result_.reason = "base: " + next.error().message;
+      return false;
+    }
+    result_.odometry_distance_m += std::hypot(next->x_m - odo.x_m, next->y_m - odo.y_m);
+    odo = *next;
+    TrajectorySample sample{probes_.now_s(), Propagate(T_world_base_, start, odo), std::nullopt};
+    if (probes_.true_pose) sample.T_world_base_true = probes_.true_pose();
+    result_.trajectory.push_back(sample);
+    if (probes_.tilt_rad) {
+      const double tilt = probes_.tilt_rad();
+      result_.max_tilt_rad = std::max(result_.max_tilt_rad, tilt);
+      if (tilt > config_.max_tilt_deg * kPi / 180) {
+        result_.reason = "tipping over: tilt " + std::to_string(tilt * 180 / kPi) + " deg";
+        return false;
+      }
+    }
+    if ((Eigen::Vector2d(odo.x_m, odo.y_m) - progress_xy).norm() > kMinProgress_m) {
+      progress_xy = Eigen::Vector2d(odo.x_m, odo.y_m);
+      progress_s = probes_.now_s();
+    } else if (probes_.now_s() - progress_s > config_.stuck_timeout_s) {
+      result_.reason = "stuck: no progress for " + std::to_string(config_.stuck_timeout_s) + " s";
+      return false;
+    }
+  }
+  Result<sensors::Odometry> stopped = base_.Drive(0.0, 0.0, kStopTime_s);
+  if (!stopped) {
+    result_.reason = "base: " + stopped.error().message;
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+MissionResult RunMission(sensors::ScanSource& source, sensors::MobileBase& base,
+                         const Eigen::Isometry3d& T_world_start, const MissionConfig& config,
+                         const MissionProbes& probes, const MissionObserver& observer) {
+  if (!probes.now_s) throw std::invalid_argument("mission: a clock (probes.now_s) is required");
+  config.follower.Validate();
+  config.planner.Validate();
+  config.registration.Validate();
+  if (config.map_area.cell_count() == 0) throw std::invalid_argument("mission: empty map area");
+  if (!(config.drive_per_stop_m > 0) || config.max_stops < 1 || !(config.goal_tolerance_m > 0)) {
+    throw std::invalid_argument("mission: drive_per_stop_m, max_stops, goal_tolerance_m must be > 0");
+  }
+  Mission mission(source, base, config, probes, observer);
+  return mission.Run(T_world_start);
+}
+
+}  // namespace pitchlab::apps

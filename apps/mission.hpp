@@ -1,0 +1,96 @@
+#pragma once
+// The closed-loop stop-scan-go mission (DESIGN.md pipeline step 6): stop, scan, register against
+// the map (odometry as prior), update the elevation map, plan to the goal, drive a prefix of the
+// path, repeat. Written against the seam interfaces only, so simulation and hardware share it.
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "path_follower.hpp"
+#include "pitchlab/mapping/elevation_map.hpp"
+#include "pitchlab/mapping/map_builder.hpp"
+#include "pitchlab/planning/planner.hpp"
+#include "pitchlab/planning/traversability.hpp"
+#include "pitchlab/sensors/mobile_base.hpp"
+#include "pitchlab/sensors/pitching_scanner.hpp"
+
+namespace pitchlab::apps {
+
+struct MissionConfig {
+  Eigen::Vector2d goal_m = Eigen::Vector2d::Zero();  ///< goal in the world frame [m]
+  double goal_tolerance_m = 0.5;   ///< success within this of the goal [m]
+  double drive_per_stop_m = 4.0;   ///< path length driven between two scans [m]
+  int max_stops = 40;              ///< scans at most [1]
+  double time_budget_s = 1800.0;   ///< mission time at most (simulated or real) [s]
+  double max_tilt_deg = 30.0;      ///< beyond this the robot is tipping over [deg]
+  double stuck_timeout_s = 8.0;    ///< no progress while commanded for this long: stuck [s]
+  double control_period_s = 0.1;   ///< path follower rate [s]
+  /// Clearance kept beyond the robot's half width when planning, for tracking error [m].
+  double safety_margin_m = 0.1;
+  PurePursuitConfig follower;
+  planning::PlannerConfig planner;
+  planning::Algorithm algorithm = planning::Algorithm::kAStar;
+  mapping::MapConfig registration;  ///< scan-to-map merging
+  mapping::GridGeometry map_area;   ///< the elevation map's grid, world frame
+  sensors::MountConfig mount;       ///< for the laser origin of clearance rays
+};
+
+/// What the loop reads besides the seam interfaces. `now_s` is required; the others may be empty.
+struct MissionProbes {
+  std::function<double()> now_s;  ///< the run's clock (simulated or steady) [s]
+  std::function<double()> tilt_rad;  ///< attitude sensor: angle of base_link's z from vertical
+  /// Ground truth (simulation only): scoring, never steering.
+  std::function<Eigen::Isometry3d()> true_pose;
+};
+
+/// One stop of the mission, as it happened.
+struct StopRecord {
+  int index = 0;
+  double stamp_s = 0;                  ///< when the scan started [s]
+  sensors::Scan3D scan;                ///< points in base_link
+  mapping::MergeStep merge;            ///< registration against the map
+  Eigen::Isometry3d T_world_base_odom = Eigen::Isometry3d::Identity();  ///< odometry's pose
+  Eigen::Isometry3d T_world_base = Eigen::Isometry3d::Identity();       ///< the estimate used
+  std::optional<Eigen::Isometry3d> T_world_base_true;                  ///< simulation only
+  std::optional<planning::Path> plan;  ///< to the goal, world frame
+  std::string plan_error;              ///< why there was no plan
+  double distance_to_goal_m = 0;       ///< from the estimate [m]
+};
+
+/// A pose of the robot while driving (sampled every control period).
+struct TrajectorySample {
+  double stamp_s = 0;
+  Eigen::Isometry3d T_world_base_est = Eigen::Isometry3d::Identity();
+  std::optional<Eigen::Isometry3d> T_world_base_true;
+};
+
+struct MissionResult {
+  bool success = false;
+  std::string reason;                    ///< "goal reached" or why it stopped
+  std::vector<StopRecord> stops;
+  std::vector<TrajectorySample> trajectory;
+  mapping::ElevationMap elevation;       ///< estimated, world frame
+  mapping::PointCloud map_cloud_world;   ///< merged scans, world frame
+  double start_s = 0, end_s = 0;         ///< clock at start and end [s]
+  double odometry_distance_m = 0;        ///< driven, by odometry [m]
+  double max_tilt_rad = 0;               ///< largest tilt seen by the attitude probe [rad]
+};
+
+/// Called after each stop is planned (for output as it happens) and with progress text.
+struct MissionObserver {
+  std::function<void(const StopRecord&, const MissionResult&)> on_stop;
+  std::function<void(const std::string&)> on_progress;
+};
+
+/// Runs the mission from the robot's current pose `T_world_start` (known at start: the map frame
+/// is the first scan's base_link placed there). Device errors end the mission with a reason; bad
+/// configuration throws std::invalid_argument.
+MissionResult RunMission(sensors::ScanSource& source, sensors::MobileBase& base,
+                         const Eigen::Isometry3d& T_world_start, const MissionConfig& config,
+                         const MissionProbes& probes, const MissionObserver& observer = {});
+
+}  // namespace pitchlab::apps

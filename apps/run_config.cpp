@@ -1,0 +1,121 @@
+#include "run_config.hpp"
+
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+#include <yaml-cpp/yaml.h>
+
+namespace pitchlab::apps {
+namespace {
+
+constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+
+void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettings& s) {
+  if (!node) return;
+  if (!node.IsMap()) throw std::invalid_argument(source + ": 'run' must be a map");
+  MissionConfig& m = s.mission;
+  const std::map<std::string, double*> numbers = {
+      {"goal_tolerance_m", &m.goal_tolerance_m}, {"drive_per_stop_m", &m.drive_per_stop_m},
+      {"time_budget_s", &m.time_budget_s},       {"max_tilt_deg", &m.max_tilt_deg},
+      {"stuck_timeout_s", &m.stuck_timeout_s},   {"control_period_s", &m.control_period_s},
+      {"cell_m", &s.cell_m},                     {"safety_margin_m", &m.safety_margin_m},                     {"lookahead_m", &m.follower.lookahead_m},
+      {"max_speed_mps", &m.follower.max_speed_mps},
+      {"max_yaw_rate_rps", &m.follower.max_yaw_rate_rps}};
+  for (const auto& kv : node) {
+    const std::string key = kv.first.as<std::string>();
+    try {
+      if (key == "max_stops") {
+        m.max_stops = kv.second.as<int>();
+      } else if (key == "algorithm") {
+        m.algorithm = planning::ParseAlgorithm(kv.second.as<std::string>());
+      } else if (auto it = numbers.find(key); it != numbers.end()) {
+        *it->second = kv.second.as<double>();
+      } else {
+        throw std::invalid_argument("is not a known setting");
+      }
+    } catch (const YAML::Exception&) {
+      throw std::invalid_argument(source + ": run." + key + " has the wrong type");
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(source + ": run." + key + " " + e.what());
+    }
+  }
+  if (!(s.cell_m >= 0.02 && s.cell_m <= 2.0)) {
+    throw std::invalid_argument(source + ": run.cell_m = " + std::to_string(s.cell_m) +
+                                " is outside 0.02 .. 2 m");
+  }
+  if (m.max_stops < 1 || !(m.drive_per_stop_m > 0) || !(m.goal_tolerance_m > 0) ||
+      !(m.time_budget_s > 0) || !(m.control_period_s > 0)) {
+    throw std::invalid_argument(source +
+                                ": run: max_stops, drive_per_stop_m, goal_tolerance_m, "
+                                "time_budget_s and control_period_s must be positive");
+  }
+}
+
+}  // namespace
+
+RunSettings ParseRunSettings(const std::string& yaml_text, const std::string& source,
+                             sim::P3Model model) {
+  RunSettings s;
+  MissionConfig& m = s.mission;
+  // The mission explores: unknown cells are allowed at a price, not forbidden.
+  m.planner.unknown = planning::UnknownPolicy::kPenalise;
+  m.planner.robot =
+      planning::RobotLimits::Preset(model == sim::P3Model::kP3AT ? "p3at" : "p3dx");
+  YAML::Node root;
+  try {
+    root = yaml_text.empty() ? YAML::Node() : YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument(source + ": not valid YAML: " + e.what());
+  }
+  if (root.IsMap()) {
+    ReadRunSection(root["run"], source, s);
+    if (root["planner"]) {
+      const planning::UnknownPolicy policy = m.planner.unknown;
+      const planning::RobotLimits robot = m.planner.robot;
+      m.planner = planning::ParsePlannerConfig(YAML::Dump(root["planner"]), source + ": planner");
+      // Keys the section leaves out keep the run's defaults, not the planner tool's.
+      if (!root["planner"]["unknown"]) m.planner.unknown = policy;
+      if (!root["planner"]["robot"]) m.planner.robot = robot;
+    }
+    m.registration.registration = mapping::ParseRegistrationConfig(yaml_text, source);
+  }
+  m.follower.Validate();
+  return s;
+}
+
+std::string RunSettingsToYaml(const RunSettings& s) {
+  const MissionConfig& m = s.mission;
+  const planning::PlannerConfig& p = m.planner;
+  std::ostringstream os;
+  os.precision(17);
+  os << "run:\n"
+     << "  goal_tolerance_m: " << m.goal_tolerance_m << "\n"
+     << "  drive_per_stop_m: " << m.drive_per_stop_m << "\n"
+     << "  max_stops: " << m.max_stops << "\n"
+     << "  time_budget_s: " << m.time_budget_s << "\n"
+     << "  max_tilt_deg: " << m.max_tilt_deg << "\n"
+     << "  stuck_timeout_s: " << m.stuck_timeout_s << "\n"
+     << "  control_period_s: " << m.control_period_s << "\n"
+     << "  cell_m: " << s.cell_m << "\n"
+     << "  safety_margin_m: " << m.safety_margin_m << "\n"
+     << "  algorithm: " << planning::ToString(m.algorithm) << "\n"
+     << "  lookahead_m: " << m.follower.lookahead_m << "\n"
+     << "  max_speed_mps: " << m.follower.max_speed_mps << "\n"
+     << "  max_yaw_rate_rps: " << m.follower.max_yaw_rate_rps << "\n"
+     << "planner:\n"
+     << "  robot: " << p.robot.name << "\n"
+     << "  step_max_m: " << p.robot.step_max_m << "\n"
+     << "  max_inclination_deg: " << p.robot.max_inclination_rad / kDegToRad << "\n"
+     << "  width_m: " << p.robot.width_m << "\n"
+     << "  weights: {roughness: " << p.weights.roughness << ", length: " << p.weights.length
+     << ", inclination_x: " << p.weights.inclination_x
+     << ", inclination_y: " << p.weights.inclination_y << "}\n"
+     << "  unknown: " << (p.unknown == planning::UnknownPolicy::kForbid ? "forbid" : "penalise")
+     << "\n"
+     << "  unknown_penalty: " << p.unknown_penalty << "\n"
+     << mapping::RegistrationConfigToYaml(m.registration.registration);
+  return os.str();
+}
+
+}  // namespace pitchlab::apps

@@ -1,0 +1,302 @@
+#include "run_outputs.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <stdexcept>
+
+#include <GeographicLib/LocalCartesian.hpp>
+
+#include "html_report.hpp"
+#include "pitchlab/mapping/elevation_io.hpp"
+#include "pitchlab/planning/path_io.hpp"
+#include "pitchlab/sensors/scan_pcd.hpp"
+
+namespace pitchlab::apps {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+constexpr int kStripWidth_px = 260;
+
+template <typename T>
+void Check(const Result<T>& r) {
+  if (!r) throw std::runtime_error(r.error().message);
+}
+
+nlohmann::json PoseJson(const Eigen::Isometry3d& T) {
+  const Eigen::Vector3d t = T.translation();
+  const Eigen::Matrix3d R = T.linear();
+  return {{"x_m", t.x()},
+          {"y_m", t.y()},
+          {"z_m", t.z()},
+          {"roll_deg", std::atan2(R(2, 1), R(2, 2)) * kRadToDeg},
+          {"pitch_deg", std::asin(std::clamp(-R(2, 0), -1.0, 1.0)) * kRadToDeg},
+          {"yaw_deg", std::atan2(R(1, 0), R(0, 0)) * kRadToDeg}};
+}
+
+std::string Fixed(double v, int digits = 3) {
+  if (!std::isfinite(v)) return "-";
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
+  return buf;
+}
+
+// A 3 px line through the map points, on a picture rendered from `g`.
+void DrawPolyline(mapping::RgbImage& image, const mapping::GridGeometry& g,
+                  const std::vector<Eigen::Vector2d>& points_m, std::uint8_t r, std::uint8_t gr,
+                  std::uint8_t b) {
+  for (std::size_t k = 1; k < points_m.size(); ++k) {
+    const Eigen::Vector2d a = mapping::MapToPixel(g, image, points_m[k - 1].x(), points_m[k - 1].y());
+    const Eigen::Vector2d c = mapping::MapToPixel(g, image, points_m[k].x(), points_m[k].y());
+    const int steps = std::max(1, static_cast<int>(std::ceil((c - a).norm())));
+    for (int s = 0; s <= steps; ++s) {
+      const Eigen::Vector2d p = a + (c - a) * (double(s) / steps);
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int x = static_cast<int>(p.x()) + dx, y = static_cast<int>(p.y()) + dy;
+          if (x >= 0 && y >= 0 && x < image.width && y < image.height) image.Set(x, y, r, gr, b);
+        }
+      }
+    }
+  }
+}
+
+std::vector<Eigen::Vector2d> EstimatedXy(const MissionResult& r) {
+  std::vector<Eigen::Vector2d> xy;
+  for (const TrajectorySample& s : r.trajectory) xy.push_back(s.T_world_base_est.translation().head<2>());
+  return xy;
+}
+
+std::vector<Eigen::Vector2d> TrueXy(const MissionResult& r) {
+  std::vector<Eigen::Vector2d> xy;
+  for (const TrajectorySample& s : r.trajectory) {
+    if (s.T_world_base_true) xy.push_back(s.T_world_base_true->translation().head<2>());
+  }
+  return xy;
+}
+
+void WriteTrajectoryCsv(const std::filesystem::path& file, const MissionResult& r, bool truth) {
+  std::ostringstream os;
+  os.precision(10);
+  os << "stamp_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg\n";
+  for (const TrajectorySample& s : r.trajectory) {
+    if (truth && !s.T_world_base_true) continue;
+    const nlohmann::json p = PoseJson(truth ? *s.T_world_base_true : s.T_world_base_est);
+    os << s.stamp_s << "," << p["x_m"].get<double>() << "," << p["y_m"].get<double>() << ","
+       << p["z_m"].get<double>() << "," << p["roll_deg"].get<double>() << ","
+       << p["pitch_deg"].get<double>() << "," << p["yaw_deg"].get<double>() << "\n";
+  }
+  WriteTextFile(file, os.str());
+}
+
+void WriteTrajectoryGeoJson(const std::filesystem::path& file, const MissionResult& r,
+                            const mapping::GeodeticOrigin& origin) {
+  const GeographicLib::LocalCartesian enu(origin.latitude_deg, origin.longitude_deg,
+                                          origin.height_m);
+  nlohmann::json features = nlohmann::json::array();
+  for (bool truth : {false, true}) {
+    nlohmann::json coords = nlohmann::json::array();
+    for (const TrajectorySample& s : r.trajectory) {
+      if (truth && !s.T_world_base_true) continue;
+      const Eigen::Vector3d p = (truth ? *s.T_world_base_true : s.T_world_base_est).translation();
+      double lat, lon, h;
+      enu.Reverse(p.x(), p.y(), p.z(), lat, lon, h);
+      coords.push_back({lon, lat, h});
+    }
+    if (coords.size() < 2) continue;
+    features.push_back({{"type", "Feature"},
+                        {"properties", {{"name", truth ? "true trajectory" : "estimated trajectory"}}},
+                        {"geometry", {{"type", "LineString"}, {"coordinates", coords}}}});
+  }
+  WriteTextFile(file, nlohmann::json{{"type", "FeatureCollection"}, {"features", features}}.dump(1));
+}
+
+nlohmann::json RegistrationJson(const StopRecord& stop) {
+  const mapping::RegistrationResult& reg = stop.merge.registration;
+  nlohmann::json matrix = nlohmann::json::array();
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) matrix.push_back(stop.merge.T_map_base.matrix()(i, j));
+  nlohmann::json j = {{"stop", stop.index},
+                      {"stamp_s", stop.stamp_s},
+                      {"merged", stop.merge.merged},
+                      {"success", reg.success},
+                      {"reason", reg.reason},
+                      {"path", mapping::ToString(reg.path)},
+                      {"fitness_m2", reg.fitness_m2},
+                      {"rmse_m", reg.rmse_m},
+                      {"inlier_ratio", reg.inlier_ratio},
+                      {"iterations", reg.iterations},
+                      {"timings_s",
+                       {{"voxel", reg.timings.voxel_s}, {"normals", reg.timings.normals_s},
+                        {"features", reg.timings.features_s},
+                        {"initial_alignment", reg.timings.initial_alignment_s},
+                        {"icp", reg.timings.icp_s}, {"total", reg.timings.total_s}}},
+                      {"T_map_base", matrix},
+                      {"estimate", PoseJson(stop.T_world_base)},
+                      {"odometry", PoseJson(stop.T_world_base_odom)}};
+  if (stop.T_world_base_true) {
+    const Eigen::Isometry3d d = stop.T_world_base_true->inverse() * stop.T_world_base;
+    j["truth"] = PoseJson(*stop.T_world_base_true);
+    j["error"] = {{"translation_m", d.translation().norm()},
+                  {"rotation_deg", Eigen::AngleAxisd(d.linear()).angle() * kRadToDeg}};
+  }
+  return j;
+}
+
+mapping::RgbImage RenderWithPath(const mapping::ElevationMap& map,
+                                 const std::optional<planning::Path>& path) {
+  const mapping::ElevationLayers layers = mapping::ComputeLayers(map);
+  mapping::ImageOptions options;
+  options.max_side_px = 1024;
+  mapping::RgbImage image = mapping::RenderElevationImage(layers, options);
+  if (path) planning::DrawPath(*path, map.geometry(), image);
+  return image;
+}
+
+}  // namespace
+
+void WriteStopOutputs(RunFolder& folder, const StopRecord& stop, const MissionResult& so_far,
+                      const std::optional<mapping::GeodeticOrigin>& origin) {
+  char dir[32];
+  std::snprintf(dir, sizeof(dir), "stops/%03d/", stop.index);
+  const std::string d = dir;
+  Check(sensors::WriteScanPcd(stop.scan, folder.File(d + "scan.pcd").string()));
+  WriteTextFile(folder.File(d + "registration.json"), RegistrationJson(stop).dump(2));
+  if (stop.plan) {
+    Check(planning::WritePathCsv(*stop.plan, folder.File(d + "path.csv").string()));
+    if (origin) {
+      Check(planning::WritePathGeoJson(*stop.plan, origin, folder.File(d + "path.geojson").string()));
+    }
+  }
+  Check(mapping::WritePng(RenderWithPath(so_far.elevation, stop.plan),
+                          folder.File(d + "map.png").string()));
+}
+
+nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
+                          const std::optional<RunScore>& score) {
+  const double sim_s = r.end_s - r.start_s;
+  nlohmann::json m = {{"success", r.success},
+                      {"reason", r.reason},
+                      {"world", c.world},
+                      {"robot", c.robot},
+                      {"seed", c.seed},
+                      {"start", {{"x_m", c.start.x()}, {"y_m", c.start.y()},
+                                 {"yaw_deg", c.start.z() * kRadToDeg}}},
+                      {"goal", {{"x_m", c.goal.x()}, {"y_m", c.goal.y()}}},
+                      {"stops", r.stops.size()},
+                      {"sim_time_s", sim_s},
+                      {"wall_time_s", c.wall_time_s},
+                      {"real_time_factor", c.wall_time_s > 0 ? sim_s / c.wall_time_s : 0.0},
+                      {"odometry_distance_m", r.odometry_distance_m},
+                      {"max_tilt_deg", r.max_tilt_rad * kRadToDeg}};
+  std::size_t failed = 0;
+  for (const StopRecord& s : r.stops) failed += !s.merge.merged && s.index > 0;
+  m["registration_failures"] = failed;
+  if (!r.stops.empty()) m["final_estimate"] = PoseJson(r.stops.back().T_world_base);
+  if (score) {
+    m["distance_m"] = score->true_distance_m;
+    m["final_pose_error"] = {{"translation_m", score->final_translation_error_m},
+                             {"rotation_deg", score->final_rotation_error_deg}};
+    m["final_true_distance_to_goal_m"] = score->final_distance_to_goal_m;
+    m["max_registration_error"] = {{"translation_m", score->max_registration_translation_error_m},
+                                   {"rotation_deg", score->max_registration_rotation_error_deg}};
+    m["max_tilt_deg"] = score->max_true_tilt_deg;
+    m["path_cost_on_true_map"] = score->driven_cost_on_true_map;
+    m["true_optimal_cost"] =
+        score->true_optimal_cost ? nlohmann::json(*score->true_optimal_cost) : nlohmann::json();
+    if (!score->true_optimum_note.empty()) m["true_optimum_note"] = score->true_optimum_note;
+    m["cost_ratio"] = score->cost_ratio && r.success ? nlohmann::json(*score->cost_ratio)
+                                                     : nlohmann::json();
+    m["forbidden_cells_crossed"] = score->forbidden_cells_crossed;
+    if (std::isfinite(score->closest_hazard_m)) {
+      m["closest_approach_to_forbidden_m"] = score->closest_hazard_m;
+      m["closest_approach_at"] = {{"x_m", score->closest_hazard_at.x()},
+                                  {"y_m", score->closest_hazard_at.y()}};
+    } else {
+      m["closest_approach_to_forbidden_m"] = nullptr;
+    }
+  }
+  return m;
+}
+
+void WriteFinalOutputs(RunFolder& folder, const RunContext& c, const MissionResult& r,
+                       const std::optional<RunScore>& score, const mapping::ElevationLayers* truth,
+                       const std::optional<planning::Path>& truth_optimum) {
+  WriteTextFile(folder.File("config.yaml"), c.config_yaml);
+  sensors::Scan3D cloud;
+  for (const Eigen::Vector3f& p : r.map_cloud_world) {
+    sensors::ScanPoint q;
+    q.x = p.x(), q.y = p.y(), q.z = p.z();
+    cloud.points.push_back(q);
+  }
+  Check(sensors::WriteScanPcd(cloud, folder.File("map_cloud.pcd").string()));
+  Check(mapping::SaveElevationMap(r.elevation, folder.File("elevation.plem").string()));
+  const mapping::ElevationLayers layers = mapping::ComputeLayers(r.elevation);
+  Check(mapping::WriteEsriAsciiGrid(layers, c.geodetic_origin, folder.File("elevation.asc").string()));
+  WriteTrajectoryCsv(folder.File("trajectory_estimated.csv"), r, false);
+  WriteTrajectoryCsv(folder.File("trajectory_true.csv"), r, true);
+  if (c.geodetic_origin) {
+    WriteTrajectoryGeoJson(folder.File("trajectories.geojson"), r, *c.geodetic_origin);
+  }
+  // The picture: estimated map, last plan (red), estimated (orange) and true (blue) trajectory.
+  mapping::ImageOptions options;
+  options.max_side_px = 1400;
+  mapping::RgbImage image = mapping::RenderElevationImage(layers, options);
+  for (const StopRecord& s : r.stops) {
+    if (s.plan) planning::DrawPath(*s.plan, r.elevation.geometry(), image);
+  }
+  DrawPolyline(image, r.elevation.geometry(), EstimatedXy(r), 255, 140, 0);
+  DrawPolyline(image, r.elevation.geometry(), TrueXy(r), 30, 80, 255);
+  Check(mapping::WritePng(image, folder.File("elevation.png").string()));
+  if (truth) {
+    mapping::RgbImage truth_image = mapping::RenderElevationImage(*truth, options);
+    if (truth_optimum) planning::DrawPath(*truth_optimum, truth->geometry, truth_image);
+    DrawPolyline(truth_image, truth->geometry, TrueXy(r), 30, 80, 255);
+    Check(mapping::WritePng(truth_image, folder.File("truth_elevation.png").string()));
+  }
+  const nlohmann::json metrics = RunMetrics(c, r, score);
+  WriteTextFile(folder.File("metrics.json"), metrics.dump(2));
+
+  HtmlReport report("pitchlab run: " + c.world + (r.success ? " (success)" : " (failed)"));
+  std::vector<std::pair<std::string, std::string>> rows;
+  for (const auto& [key, value] : metrics.items()) {
+    rows.emplace_back(key, value.is_string() ? value.get<std::string>() : value.dump());
+  }
+  report.KeyValues(rows);
+  report.Heading("Map and trajectories");
+  report.Paragraph("Estimated elevation map with every planned path (red), the estimated "
+                   "trajectory (orange) and the true one (blue). Unknown cells are checkered.");
+  report.Png(ReadBinaryFile(folder.File("elevation.png")), "estimated elevation map", 900);
+  if (truth) {
+    report.Png(ReadBinaryFile(folder.File("truth_elevation.png")),
+               "true elevation map, true optimal path (red), true trajectory (blue)", 900);
+  }
+  report.Plot({{"estimated", "#e08000", EstimatedXy(r), false}, {"true", "#1e50ff", TrueXy(r), true}},
+              "trajectories (world frame, metres)");
+  report.Heading("Stops");
+  std::vector<std::vector<std::string>> table;
+  std::vector<std::pair<std::string, std::string>> strip;
+  for (const StopRecord& s : r.stops) {
+    const Eigen::Vector3d e = s.T_world_base.translation();
+    std::string err = "-";
+    if (s.T_world_base_true) {
+      err = Fixed((s.T_world_base_true->translation() - e).norm());
+    }
+    table.push_back({std::to_string(s.index), Fixed(s.stamp_s, 1), Fixed(e.x(), 2), Fixed(e.y(), 2),
+                     err, s.merge.merged ? mapping::ToString(s.merge.registration.path) : "failed",
+                     Fixed(s.merge.registration.rmse_m, 4), Fixed(s.distance_to_goal_m, 2),
+                     s.plan ? Fixed(s.plan->cost, 1) : (s.plan_error.empty() ? "-" : "none")});
+    char dir[32];
+    std::snprintf(dir, sizeof(dir), "stops/%03d/map.png", s.index);
+    strip.emplace_back(ReadBinaryFile(folder.File(dir)), "stop " + std::to_string(s.index));
+  }
+  report.Table({"stop", "t [s]", "x [m]", "y [m]", "error [m]", "registration", "rmse [m]",
+                "to goal [m]", "plan cost"},
+               table);
+  report.PngStrip(strip, kStripWidth_px);
+  report.Heading("Configuration");
+  report.Preformatted(c.config_yaml);
+  WriteTextFile(folder.File("report.html"), report.Render());
+}
+
+}  // namespace pitchlab::apps

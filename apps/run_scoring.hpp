@@ -1,0 +1,38 @@
+#pragma once
+// Scores a simulated mission against ground truth: pose errors, the driven path costed on the
+// true map against the true optimum, closest approach to a truly forbidden cell, tilt.
+
+#include <optional>
+#include <string>
+
+#include "mission.hpp"
+#include "pitchlab/planning/planner.hpp"
+#include "pitchlab/planning/traversability.hpp"
+
+namespace pitchlab::apps {
+
+struct RunScore {
+  double final_translation_error_m = 0;  ///< last estimate vs truth [m]
+  double final_rotation_error_deg = 0;   ///< [deg]
+  double max_registration_translation_error_m = 0;  ///< over stops merged by registration [m]
+  double max_registration_rotation_error_deg = 0;   ///< [deg]
+  double true_distance_m = 0;            ///< driven, by ground truth [m]
+  double final_distance_to_goal_m = 0;   ///< true position to goal [m]
+  double max_true_tilt_deg = 0;          ///< [deg]
+  std::optional<double> true_optimal_cost;  ///< start to goal on the true map (none: no path)
+  std::string true_optimum_note;            ///< why there is none
+  double driven_cost_on_true_map = 0;       ///< the true trajectory's cells, costed by Eq. 5
+  std::optional<double> cost_ratio;         ///< driven / optimal (>= 1 up to discretisation)
+  std::size_t forbidden_cells_crossed = 0;  ///< truly forbidden cells under the true trajectory
+  /// Smallest distance from the robot's centre to a truly hazardous cell (step, steep, drop) [m];
+  /// infinity when none is within 5 m of the trajectory.
+  double closest_hazard_m = 0;
+  Eigen::Vector2d closest_hazard_at{0, 0};  ///< where the robot was then [m]
+};
+
+/// `truth` is the true traversability over the mission's map area; `start_m`/`goal_m` world [m].
+RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGrid& truth,
+                  const Eigen::Vector2d& start_m, const Eigen::Vector2d& goal_m,
+                  planning::Algorithm algorithm);
+
+}  // namespace pitchlab::apps

@@ -1,0 +1,75 @@
+#pragma once
+// Pairwise scan registration, the paper's Algorithm 1: voxel grid, normals, features, sample-
+// consensus initial alignment, non-linear ICP (Levenberg-Marquardt); with an odometry prior, a
+// geometric constraint around it and a constant-velocity fallback.
+
+#include <optional>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "pitchlab/mapping/point_cloud.hpp"
+#include "pitchlab/mapping/registration_config.hpp"
+#include "pitchlab/sensors/result.hpp"
+
+namespace pitchlab::mapping {
+
+/// Where the initial alignment handed to ICP came from.
+enum class RegistrationPath {
+  kFeatures,  ///< sample consensus on feature correspondences
+  kOdometry,  ///< the odometry prior (features off, failed or outside the constraint)
+  kFallback,  ///< constant velocity: the previous pair's motion (features failed / ambiguous)
+};
+
+/// "features", "odometry", "fallback".
+const char* ToString(RegistrationPath path);
+
+/// What the caller knows before aligning. Both transforms are T_target_source.
+struct RegistrationPrior {
+  std::optional<Eigen::Isometry3d> odometry;         ///< odometry's guess; enables the constraint
+  std::optional<Eigen::Isometry3d> previous_motion;  ///< last pair's estimate (constant velocity)
+};
+
+/// Wall time per stage [s] (for both clouds together).
+struct StageTimings {
+  double voxel_s = 0, normals_s = 0, features_s = 0, initial_alignment_s = 0, icp_s = 0,
+         total_s = 0;
+};
+
+/// Outcome of one registration. `success` false means: do not merge; `reason` says why.
+struct RegistrationResult {
+  Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();  ///< maps source into target
+  bool success = false;
+  std::string reason;  ///< why it failed, or how it succeeded ("features", notes)
+  RegistrationPath path = RegistrationPath::kFeatures;
+  double fitness_m2 = 0;    ///< mean squared distance of inlier pairs (PCL's fitness) [m^2]
+  double rmse_m = 0;        ///< RMS point-to-plane error of the inlier pairs [m]
+  double inlier_ratio = 0;  ///< source points within inlier_distance_m of the target [1]
+  double degeneracy = 0;    ///< weakest / strongest constraint direction (1 = isotropic) [1]
+  int sac_inliers = 0;      ///< correspondences agreeing with the initial alignment [1]
+  int iterations = 0;       ///< ICP iterations run [1]
+  StageTimings timings;
+};
+
+/// Aligns `source` to `target` (both [m], each in its own base_link). Bad input (empty, non-finite
+/// points, too few points after the voxel grid) is an Error (kInvalidArgument); an alignment that
+/// fails (no overlap, features ambiguous without a fallback, constraint violated) is a result
+/// with success == false and the reason. Deterministic: the same input gives the same output.
+[[nodiscard]] Result<RegistrationResult> Register(const PointCloud& target,
+                                                  const PointCloud& source,
+                                                  const RegistrationPrior& prior,
+                                                  const RegistrationConfig& config);
+
+/// Rotation angle of `T` [deg] and translation norm [m]: the error measure against ground truth.
+struct PoseError {
+  double rotation_deg = 0;
+  double translation_m = 0;
+};
+/// Error of `estimate` against `truth` (both T_target_source): angle and norm of truth^-1 estimate.
+PoseError ComparePoses(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth);
+
+/// x, y, z [m], roll, pitch, yaw [deg] (fixed-axis XYZ, as ROS) -> transform.
+Eigen::Isometry3d PoseFromXyzRpyDeg(double x, double y, double z, double roll_deg, double pitch_deg,
+                                    double yaw_deg);
+
+}  // namespace pitchlab::mapping

@@ -1,0 +1,80 @@
+#pragma once
+// Settings of the registration pipeline (Algorithm 1), one plain aggregate loadable from the YAML
+// section `registration:`. Lengths in metres, angles in degrees (user boundary), as named.
+
+#include <string>
+
+namespace pitchlab::mapping {
+
+/// Which implementation runs the feature, initial-alignment and ICP stages.
+enum class RegistrationBackend {
+  kFast,  ///< ours: hashed voxels, own FPFH, correspondence RANSAC, point-to-plane LM (default)
+  kPcl,   ///< PCL's NormalEstimation, FPFHEstimation/NARF, SampleConsensusInitialAlignment, ICP-NL
+};
+
+/// Descriptor used for the sample-consensus initial alignment (the paper's Table 1).
+enum class FeatureKind {
+  kFpfh,  ///< Fast Point Feature Histograms (33 bins)
+  kNarf,  ///< Normal-Aligned Radial Features on a range image (PCL backend only)
+  kNone,  ///< no feature alignment: ICP starts from the odometry prior / constant velocity
+};
+
+/// Every knob of Register(); defaults suit a 72k-point LMS200 scan indoors and outdoors.
+struct RegistrationConfig {
+  RegistrationBackend backend = RegistrationBackend::kFast;
+  FeatureKind features = FeatureKind::kFpfh;
+
+  // Voxel grid (paper: downsampling factor 5-10).
+  double icp_voxel_m = 0.1;      ///< voxel edge of the clouds ICP aligns [m]
+  double feature_voxel_m = 0.3;  ///< voxel edge of the clouds features are computed on [m]
+
+  // Normals and features.
+  double normal_radius_m = 0.75;     ///< neighbourhood of the feature cloud's normals [m]
+  double icp_normal_radius_m = 0.3;  ///< neighbourhood of the ICP target's normals [m]
+  double feature_radius_m = 1.5;     ///< FPFH / NARF support radius [m]
+  int max_neighbors = 40;            ///< neighbours used per feature at most [1]
+  int max_feature_points = 2500;     ///< keypoints (evenly sampled) matched per cloud at most [1]
+
+  // Sample-consensus initial alignment.
+  int sac_iterations = 20000;        ///< hypotheses drawn at most [1]
+  double sac_inlier_m = 0.6;         ///< a correspondence agrees within this distance [m]
+  double sac_edge_similarity = 0.9;  ///< prerejection: sampled edge lengths agree to this ratio [1]
+  int sac_min_inliers = 10;          ///< fewer agreeing correspondences: alignment failed [1]
+  /// Weakest / strongest point-to-plane constraint (translation or rotation) below this: the
+  /// solution is probed for degeneracy (a corridor, an open plane) by restarting ICP off it [1].
+  double degeneracy_ratio = 0.05;
+  double degeneracy_probe_m = 1.0;     ///< restart offset of the probe; it must come back [m]
+  double degeneracy_probe_deg = 10.0;  ///< restart rotation of the probe about a weak axis [deg]
+
+  // Non-linear ICP (Levenberg-Marquardt).
+  int icp_max_iterations = 40;       ///< [1]
+  double icp_epsilon = 1e-5;         ///< stop when the relative error change is below this [1]
+  double icp_max_distance_m = 0.5;   ///< correspondences farther apart are ignored at first [m]
+  double icp_min_distance_m = 0.15;  ///< ... the gate shrinks to this as ICP converges [m]
+  int icp_max_points = 3000;         ///< source points ICP uses at most (evenly sampled) [1]
+
+  // Priors, constraint and acceptance.
+  double constraint_translation_m = 2.5;   ///< result within this of the prior, when given [m]
+  double constraint_rotation_deg = 35.0;   ///< ... and within this rotation of it [deg]
+  bool constant_velocity_fallback = true;  ///< use the previous motion when alignment fails
+  double inlier_distance_m = 0.1;  ///< a source point is an inlier within this of the target [m]
+  double min_inlier_ratio = 0.3;   ///< fewer inliers: failure (no overlap / misaligned) [1]
+  double max_rmse_m = 0.06;        ///< inlier RMS point-to-plane error above this: failure [m]
+
+  /// Throws std::invalid_argument naming the field and value.
+  void Validate() const;
+};
+
+/// Reads the section `registration` of a YAML document over the defaults (other sections are left
+/// alone). An unknown key, a wrong type or an invalid value throws std::invalid_argument naming
+/// `source`, `registration.<key>` and the value.
+RegistrationConfig ParseRegistrationConfig(const std::string& yaml_text, const std::string& source);
+
+/// Reads a YAML file with ParseRegistrationConfig; throws std::invalid_argument naming the path
+/// when it cannot be read.
+RegistrationConfig LoadRegistrationConfig(const std::string& path);
+
+/// The config as a `registration:` YAML section, readable back by ParseRegistrationConfig.
+std::string RegistrationConfigToYaml(const RegistrationConfig& config);
+
+}  // namespace pitchlab::mapping

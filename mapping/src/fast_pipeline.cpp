@@ -1,0 +1,403 @@
+#include "fast_pipeline.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+namespace pitchlab::mapping {
+namespace {
+
+constexpr int kBins = 11;  // per FPFH sub-histogram (pcl::FPFHSignature33)
+constexpr float kPi = 3.14159265358979f;
+
+// pcl::computePairFeatures: the Darboux-frame angles between two oriented points.
+bool PairFeatures(const Eigen::Vector3f& p1, const Eigen::Vector3f& n1, const Eigen::Vector3f& p2,
+                  const Eigen::Vector3f& n2, float& f1, float& f2, float& f3) {
+  Eigen::Vector3f dp = p2 - p1;
+  const float d = dp.norm();
+  if (d <= 0) return false;
+  Eigen::Vector3f a = n1, b = n2;
+  const float angle1 = a.dot(dp) / d, angle2 = b.dot(dp) / d;
+  if (std::acos(std::fabs(angle1)) > std::acos(std::fabs(angle2))) {
+    std::swap(a, b);
+    dp = -dp;
+    f3 = -angle2;
+  } else {
+    f3 = angle1;
+  }
+  Eigen::Vector3f v = dp.cross(a);
+  const float vn = v.norm();
+  if (vn <= 0) return false;
+  v /= vn;
+  const Eigen::Vector3f w = a.cross(v);
+  f2 = v.dot(b);
+  f1 = std::atan2(w.dot(b), a.dot(b));
+  return true;
+}
+
+int Bin(float unit) { return std::clamp(static_cast<int>(std::floor(unit * kBins)), 0, kBins - 1); }
+
+Eigen::Isometry3d Exp(const Eigen::Matrix<double, 6, 1>& delta) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  const Eigen::Vector3d w = delta.head<3>();
+  const double angle = w.norm();
+  if (angle > 1e-12) T.linear() = Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+  T.translation() = delta.tail<3>();
+  return T;
+}
+
+// Rigid fit of source onto target points (Umeyama, no scale).
+Eigen::Isometry3d FitRigid(const PointCloud& source, const PointCloud& target,
+                           const std::vector<Correspondence>& corrs) {
+  Eigen::Matrix3Xd s(3, corrs.size()), t(3, corrs.size());
+  for (std::size_t i = 0; i < corrs.size(); ++i) {
+    s.col(i) = source[corrs[i].source].cast<double>();
+    t.col(i) = target[corrs[i].target].cast<double>();
+  }
+  Eigen::Isometry3d T;
+  T.matrix() = Eigen::umeyama(s, t, false);
+  return T;
+}
+
+int CountInliers(const PointCloud& source, const PointCloud& target,
+                 const std::vector<Correspondence>& corrs, const Eigen::Isometry3d& T,
+                 float inlier_m, std::vector<Correspondence>* inliers) {
+  const Eigen::Isometry3f Tf = T.cast<float>();
+  const float r2 = inlier_m * inlier_m;
+  int n = 0;
+  for (const Correspondence& c : corrs) {
+    if ((Tf * source[c.source] - target[c.target]).squaredNorm() < r2) {
+      ++n;
+      if (inliers) inliers->push_back(c);
+    }
+  }
+  return n;
+}
+
+// Correspondences of `source` under T: (transformed point, target index) within the gate.
+struct Pair {
+  Eigen::Vector3d p, t, n;
+};
+const VoxelHashIndex& IndexFor(const IcpTarget& target, float gate_m) {
+  return gate_m <= target.fine_cell_m ? target.fine : target.coarse;
+}
+
+void FindPairs(const IcpTarget& target, const PointCloud& source, const Eigen::Isometry3d& T,
+               float gate_m, std::vector<Pair>& pairs) {
+  pairs.clear();
+  const Eigen::Isometry3f Tf = T.cast<float>();
+  const VoxelHashIndex& index = IndexFor(target, gate_m);
+  for (const Eigen::Vector3f& s : source) {
+    const Eigen::Vector3f p = Tf * s;
+    float d2 = 0;
+    const int j = index.Nearest(p, gate_m, d2);
+    if (j < 0 || !target.normals[j].allFinite()) continue;
+    pairs.push_back(
+        {p.cast<double>(), target.points[j].cast<double>(), target.normals[j].cast<double>()});
+  }
+}
+
+}  // namespace
+
+bool PriorRegion::Contains(const Eigen::Isometry3d& T) const {
+  const Eigen::Isometry3d d = T_target_source.inverse() * T;
+  return d.translation().norm() <= translation_m &&
+         Eigen::AngleAxisd(d.linear()).angle() <= rotation_rad;
+}
+
+Normals EstimateNormals(const PointCloud& cloud, const VoxelHashIndex& index, float radius_m,
+                        const Eigen::Vector3f& viewpoint) {
+  Normals normals(cloud.size(), Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()));
+  std::vector<int> nn;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    nn.clear();
+    index.Radius(cloud[i], radius_m, nn);
+    if (nn.size() < 5) continue;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int j : nn) mean += cloud[j].cast<double>();
+    mean /= static_cast<double>(nn.size());
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (int j : nn) {
+      const Eigen::Vector3d d = cloud[j].cast<double>() - mean;
+      cov += d * d.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+    eig.computeDirect(cov);
+    Eigen::Vector3f n = eig.eigenvectors().col(0).cast<float>();
+    if (n.dot(viewpoint - cloud[i]) < 0) n = -n;
+    normals[i] = n;
+  }
+  return normals;
+}
+
+FeatureMatrix ComputeFpfh(const PointCloud& cloud, const Normals& normals,
+                          const VoxelHashIndex& index, float radius_m, int max_neighbors,
+                          const std::vector<int>& keypoints) {
+  const int n = static_cast<int>(cloud.size());
+  std::vector<std::vector<int>> neighbors(n);
+  FeatureMatrix spfh = FeatureMatrix::Zero(n, 3 * kBins);
+  std::vector<int> nn;
+  for (int i = 0; i < n; ++i) {  // simplified point feature histograms
+    if (!normals[i].allFinite()) continue;
+    nn.clear();
+    index.Radius(cloud[i], radius_m, nn);
+    std::vector<int>& kept = neighbors[i];
+    const int stride = std::max<int>(1, static_cast<int>(nn.size()) / max_neighbors);
+    for (std::size_t k = 0; k < nn.size(); k += stride) {
+      if (nn[k] != i && normals[nn[k]].allFinite()) kept.push_back(nn[k]);
+    }
+    if (kept.empty()) continue;
+    const float incr = 100.0f / static_cast<float>(kept.size());
+    for (int j : kept) {
+      float f1, f2, f3;
+      if (!PairFeatures(cloud[i], normals[i], cloud[j], normals[j], f1, f2, f3)) continue;
+      spfh(i, Bin((f1 + kPi) / (2 * kPi))) += incr;
+      spfh(i, kBins + Bin((f2 + 1) * 0.5f)) += incr;
+      spfh(i, 2 * kBins + Bin((f3 + 1) * 0.5f)) += incr;
+    }
+  }
+  FeatureMatrix fpfh = FeatureMatrix::Zero(static_cast<int>(keypoints.size()), 3 * kBins);
+  for (std::size_t row = 0; row < keypoints.size(); ++row) {  // own SPFH + neighbours' by 1 / d
+    const int i = keypoints[row];
+    if (neighbors[i].empty()) continue;
+    Eigen::RowVectorXf h = spfh.row(i);
+    for (int j : neighbors[i]) {
+      const float d = (cloud[j] - cloud[i]).norm();
+      if (d > 0) h += spfh.row(j) / (d * static_cast<float>(neighbors[i].size()));
+    }
+    for (int s = 0; s < 3; ++s) {
+      const float sum = h.segment(s * kBins, kBins).sum();
+      if (sum > 0) h.segment(s * kBins, kBins) *= 100.0f / sum;
+    }
+    fpfh.row(static_cast<int>(row)) = h;
+  }
+  return fpfh;
+}
+
+std::vector<Correspondence> MatchFeatures(const FeatureMatrix& source,
+                                          const FeatureMatrix& target) {
+  const int ns = static_cast<int>(source.rows()), nt = static_cast<int>(target.rows());
+  std::vector<int> best_t(ns, -1), best_s(nt, -1);
+  std::vector<float> best_t_d(ns, std::numeric_limits<float>::max());
+  std::vector<float> best_s_d(nt, std::numeric_limits<float>::max());
+  const Eigen::VectorXf tn = target.rowwise().squaredNorm();
+  const Eigen::VectorXf sn = source.rowwise().squaredNorm();
+  constexpr int kBlock = 256;
+  for (int b = 0; b < ns; b += kBlock) {  // |s - t|^2 = |s|^2 + |t|^2 - 2 s.t, in blocks
+    const int rows = std::min(kBlock, ns - b);
+    Eigen::MatrixXf d = -2.0f * source.middleRows(b, rows) * target.transpose();
+    for (int r = 0; r < rows; ++r) {
+      const int i = b + r;
+      if (sn(i) <= 0) continue;
+      for (int j = 0; j < nt; ++j) {
+        if (tn(j) <= 0) continue;
+        const float dist = d(r, j) + sn(i) + tn(j);
+        if (dist < best_t_d[i]) best_t_d[i] = dist, best_t[i] = j;
+        if (dist < best_s_d[j]) best_s_d[j] = dist, best_s[j] = i;
+      }
+    }
+  }
+  std::vector<Correspondence> corrs;
+  for (int i = 0; i < ns; ++i) {
+    if (best_t[i] >= 0 && best_s[best_t[i]] == i) corrs.push_back({i, best_t[i]});
+  }
+  return corrs;
+}
+
+SacResult SampleConsensus(const PointCloud& source, const PointCloud& target,
+                          const std::vector<Correspondence>& corrs,
+                          const RegistrationConfig& config,
+                          const std::optional<PriorRegion>& region) {
+  SacResult best;
+  const int n = static_cast<int>(corrs.size());
+  if (n < 3) return best;
+  std::mt19937 rng(20120917);  // fixed: the same input gives the same output
+  std::uniform_int_distribution<int> pick(0, n - 1);
+  const float sim = static_cast<float>(config.sac_edge_similarity);
+  const float min_edge = static_cast<float>(2.0 * config.feature_voxel_m);
+  const float inlier_m = static_cast<float>(config.sac_inlier_m);
+  long needed = config.sac_iterations;
+  for (long it = 0; it < needed; ++it) {
+    const int idx[3] = {pick(rng), pick(rng), pick(rng)};
+    if (idx[0] == idx[1] || idx[1] == idx[2] || idx[0] == idx[2]) continue;
+    bool ok = true;
+    for (int e = 0; e < 3 && ok; ++e) {  // prerejection: a rigid motion keeps edge lengths
+      const Correspondence& a = corrs[idx[e]];
+      const Correspondence& b = corrs[idx[(e + 1) % 3]];
+      const float ls = (source[a.source] - source[b.source]).norm();
+      const float lt = (target[a.target] - target[b.target]).norm();
+      ok = std::min(ls, lt) >= sim * std::max(ls, lt) && ls >= min_edge;
+    }
+    if (!ok) continue;
+    const std::vector<Correspondence> sample = {corrs[idx[0]], corrs[idx[1]], corrs[idx[2]]};
+    const Eigen::Isometry3d T = FitRigid(source, target, sample);
+    if (!T.matrix().allFinite() || (region && !region->Contains(T))) continue;
+    const int inliers = CountInliers(source, target, corrs, T, inlier_m, nullptr);
+    if (inliers <= best.inliers) continue;
+    best = {true, T, inliers};
+    const double w = static_cast<double>(inliers) / n;  // adaptive stop at 99.9 % confidence
+    const double k = std::log(1e-3) / std::log(std::max(1e-12, 1.0 - w * w * w));
+    needed = std::min<long>(needed, static_cast<long>(it + 1 + 4 * k));
+  }
+  if (!best.found) return best;
+  for (int refit = 0; refit < 3; ++refit) {  // least squares on the inliers
+    std::vector<Correspondence> inliers;
+    CountInliers(source, target, corrs, best.T_target_source, inlier_m, &inliers);
+    if (inliers.size() < 3) break;
+    const Eigen::Isometry3d T = FitRigid(source, target, inliers);
+    if (region && !region->Contains(T)) break;
+    best.T_target_source = T;
+    best.inliers = CountInliers(source, target, corrs, T, inlier_m, nullptr);
+  }
+  best.found = best.inliers >= config.sac_min_inliers;
+  return best;
+}
+
+IcpResult PointToPlaneLm(const IcpTarget& target, const PointCloud& source,
+                         const Eigen::Isometry3d& init, const RegistrationConfig& config,
+                         const Weakness& frozen) {
+  using Vector6d = Eigen::Matrix<double, 6, 1>;
+  using Matrix6d = Eigen::Matrix<double, 6, 6>;
+  Eigen::Matrix3d keep_t = Eigen::Matrix3d::Identity();  // projectors onto the free directions
+  Eigen::Matrix3d keep_r = Eigen::Matrix3d::Identity();
+  if (frozen.translation) keep_t -= *frozen.translation * frozen.translation->transpose();
+  if (frozen.rotation_axis) keep_r -= *frozen.rotation_axis * frozen.rotation_axis->transpose();
+  IcpResult result;
+  result.T_target_source = init;
+  double gate = config.icp_max_distance_m, lambda = 1e-4, prev_mean = -1;
+  std::vector<Pair> pairs;
+  for (int iter = 0; iter < config.icp_max_iterations; ++iter) {
+    FindPairs(target, source, result.T_target_source, static_cast<float>(gate), pairs);
+    if (pairs.size() < 6) break;
+    const double huber = std::max(0.02, gate / 5);
+    auto weight = [huber](double r) { return std::fabs(r) <= huber ? 1.0 : huber / std::fabs(r); };
+    Matrix6d H = Matrix6d::Zero();
+    Vector6d g = Vector6d::Zero();
+    double err = 0;
+    for (const Pair& q : pairs) {  // r = n.(p - t); dr/d(omega) = p x n, dr/dv = n
+      const double r = q.n.dot(q.p - q.t), w = weight(r);
+      Vector6d J;
+      J << q.p.cross(q.n), q.n;
+      H += w * J * J.transpose();
+      g += w * J * r;
+      err += w * r * r;
+    }
+    bool stepped = false;
+    for (int tries = 0; tries < 8 && !stepped; ++tries) {  // Levenberg-Marquardt damping
+      Matrix6d A = H;
+      A.diagonal() += lambda * H.diagonal();
+      Vector6d delta = A.ldlt().solve(-g);
+      delta.head<3>() = keep_r * delta.head<3>();
+      delta.tail<3>() = keep_t * delta.tail<3>();
+      const Eigen::Isometry3d D = Exp(delta);
+      double new_err = 0;
+      for (const Pair& q : pairs) {
+        const double r = q.n.dot(D * q.p - q.t);
+        new_err += weight(r) * r * r;
+      }
+      if (new_err <= err) {
+        result.T_target_source = D * result.T_target_source;
+        lambda = std::max(1e-7, lambda / 10);
+        stepped = true;
+      } else {
+        lambda *= 10;
+      }
+    }
+    ++result.iterations;
+    const double mean = err / static_cast<double>(pairs.size());
+    const bool at_final_gate = gate <= config.icp_min_distance_m + 1e-9;
+    if (at_final_gate && prev_mean >= 0 &&
+        (!stepped ||
+         std::fabs(prev_mean - mean) <= config.icp_epsilon * std::max(prev_mean, 1e-12))) {
+      break;  // Algorithm 1: error change below epsilon
+    }
+    prev_mean = at_final_gate ? mean : -1;
+    gate = std::max(config.icp_min_distance_m, gate * 0.7);
+  }
+  const IcpResult score = Evaluate(target, source, result.T_target_source, config);
+  result.rmse_m = score.rmse_m;
+  result.fitness_m2 = score.fitness_m2;
+  result.inlier_ratio = score.inlier_ratio;
+  result.degeneracy = score.degeneracy;
+  return result;
+}
+
+namespace {
+// Scores of `T` over the inlier pairs, and the translation (sum n n^T) and rotation (sum of
+// (p - centroid) x n, outer product) constraint matrices.
+std::pair<Eigen::Matrix3d, Eigen::Matrix3d> ScorePairs(const IcpTarget& target,
+                                                       const PointCloud& source,
+                                                       const Eigen::Isometry3d& T,
+                                                       const RegistrationConfig& config,
+                                                       IcpResult& out) {
+  std::vector<Pair> pairs;
+  FindPairs(target, source, T, static_cast<float>(config.inlier_distance_m), pairs);
+  Eigen::Matrix3d Ct = Eigen::Matrix3d::Zero(), Cr = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const Pair& q : pairs) centroid += q.p;
+  if (!pairs.empty()) centroid /= static_cast<double>(pairs.size());
+  double sq_plane = 0, sq_point = 0;
+  for (const Pair& q : pairs) {
+    const double r = q.n.dot(q.p - q.t);
+    sq_plane += r * r;
+    sq_point += (q.p - q.t).squaredNorm();
+    Ct += q.n * q.n.transpose();
+    const Eigen::Vector3d m = (q.p - centroid).cross(q.n);
+    Cr += m * m.transpose();
+  }
+  out.T_target_source = T;
+  out.inlier_ratio = source.empty() ? 0.0 : static_cast<double>(pairs.size()) / source.size();
+  out.rmse_m = pairs.empty() ? 0.0 : std::sqrt(sq_plane / pairs.size());
+  out.fitness_m2 = pairs.empty() ? 0.0 : sq_point / pairs.size();
+  return {Ct, Cr};
+}
+
+// Weakest eigenvector of C when its eigenvalue is below ratio x the strongest; also the ratio.
+std::optional<Eigen::Vector3d> Weakest(const Eigen::Matrix3d& C, double ratio, double* value) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(C);
+  const double max_ev = eig.eigenvalues()(2);
+  const double r = max_ev > 0 ? eig.eigenvalues()(0) / max_ev : 0.0;
+  if (value) *value = r;
+  if (r < ratio) return Eigen::Vector3d(eig.eigenvectors().col(0));
+  return std::nullopt;
+}
+}  // namespace
+
+IcpResult Evaluate(const IcpTarget& target, const PointCloud& source, const Eigen::Isometry3d& T,
+                   const RegistrationConfig& config) {
+  IcpResult out;
+  const auto [Ct, Cr] = ScorePairs(target, source, T, config, out);
+  double t_ratio = 0, r_ratio = 0;
+  Weakest(Ct, 0.0, &t_ratio);
+  Weakest(Cr, 0.0, &r_ratio);
+  out.degeneracy = std::min(t_ratio, r_ratio);
+  return out;
+}
+
+Weakness WeakDirections(const IcpTarget& target, const PointCloud& source,
+                        const Eigen::Isometry3d& T, const RegistrationConfig& config) {
+  IcpResult unused;
+  const auto [Ct, Cr] = ScorePairs(target, source, T, config, unused);
+  return {Weakest(Ct, config.degeneracy_ratio, nullptr),
+          Weakest(Cr, config.degeneracy_ratio, nullptr)};
+}
+
+std::vector<int> EvenIndices(std::size_t size, int max_points) {
+  const int n = std::min<int>(static_cast<int>(size), max_points);
+  std::vector<int> out(n);
+  const double step = static_cast<double>(size) / n;
+  for (int i = 0; i < n; ++i) out[i] = static_cast<int>(i * step);
+  return out;
+}
+
+PointCloud EvenSubsample(const PointCloud& cloud, int max_points) {
+  PointCloud out;
+  for (int i : EvenIndices(cloud.size(), max_points)) out.push_back(cloud[i]);
+  return out;
+}
+
+}  // namespace pitchlab::mapping

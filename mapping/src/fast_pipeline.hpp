@@ -1,0 +1,99 @@
+#pragma once
+// Our own implementation of the registration stages (backend "fast"): PCA normals, FPFH,
+// correspondence RANSAC with edge prerejection, point-to-plane ICP with Levenberg-Marquardt.
+
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "pitchlab/mapping/point_cloud.hpp"
+#include "pitchlab/mapping/registration_config.hpp"
+#include "voxel_hash.hpp"
+
+namespace pitchlab::mapping {
+
+using Normals = std::vector<Eigen::Vector3f>;  // NaN where a point has too few neighbours
+using FeatureMatrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+/// PCA normals over `radius_m`, oriented towards `viewpoint` (the sensor, in the cloud's frame).
+Normals EstimateNormals(const PointCloud& cloud, const VoxelHashIndex& index, float radius_m,
+                        const Eigen::Vector3f& viewpoint);
+
+/// FPFH (Rusu 2009, as pcl::FPFHEstimation): one 33-bin row per keypoint (an index into `cloud`,
+/// whose points all serve as neighbours); zero rows without normals.
+FeatureMatrix ComputeFpfh(const PointCloud& cloud, const Normals& normals,
+                          const VoxelHashIndex& index, float radius_m, int max_neighbors,
+                          const std::vector<int>& keypoints);
+
+struct Correspondence {
+  int source, target;
+};
+/// Mutual nearest neighbours in feature space (rows with all zeros are skipped).
+std::vector<Correspondence> MatchFeatures(const FeatureMatrix& source, const FeatureMatrix& target);
+
+/// Region the answer must fall in (the geometric constraint around the odometry prior).
+struct PriorRegion {
+  Eigen::Isometry3d T_target_source;
+  double translation_m, rotation_rad;
+  bool Contains(const Eigen::Isometry3d& T) const;
+};
+
+struct SacResult {
+  bool found = false;
+  Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();
+  int inliers = 0;
+};
+/// RANSAC over correspondences: 3-point samples, edge-length prerejection, inlier count, refit.
+SacResult SampleConsensus(const PointCloud& source, const PointCloud& target,
+                          const std::vector<Correspondence>& corrs,
+                          const RegistrationConfig& config,
+                          const std::optional<PriorRegion>& region);
+
+/// The target side of ICP: points, normals, a hash for the widest gate and a fine one for the
+/// final gates (queries with a radius <= fine_cell_m use `fine`).
+struct IcpTarget {
+  const PointCloud& points;
+  const Normals& normals;
+  const VoxelHashIndex& coarse;
+  const VoxelHashIndex& fine;
+  float fine_cell_m;
+};
+
+struct IcpResult {
+  Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();
+  int iterations = 0;
+  double rmse_m = 0, fitness_m2 = 0, inlier_ratio = 0, degeneracy = 0;
+};
+
+/// Directions the scene constrains weakly (unit vectors in the target frame).
+struct Weakness {
+  std::optional<Eigen::Vector3d> translation;    ///< e.g. along a corridor
+  std::optional<Eigen::Vector3d> rotation_axis;  ///< e.g. yaw on an open plane
+  bool any() const { return translation || rotation_axis; }
+};
+
+/// Point-to-plane ICP, each iteration a Levenberg-Marquardt step on fixed correspondences; stops
+/// when the relative error change < epsilon or after icp_max_iterations. The `frozen` directions
+/// are kept at the initial guess (solution remapping).
+IcpResult PointToPlaneLm(const IcpTarget& target, const PointCloud& source,
+                         const Eigen::Isometry3d& init, const RegistrationConfig& config,
+                         const Weakness& frozen);
+
+/// Scores `T` without moving it: inliers within inlier_distance_m, RMS point-to-plane error, and
+/// the weakest/strongest eigenvalue ratio of the translation constraint (sum of n n^T).
+IcpResult Evaluate(const IcpTarget& target, const PointCloud& source, const Eigen::Isometry3d& T,
+                   const RegistrationConfig& config);
+
+/// The translation direction and rotation axis the target constrains most weakly at `T`, each
+/// when its eigenvalue ratio (weakest / strongest of its 3x3 block) is below degeneracy_ratio.
+Weakness WeakDirections(const IcpTarget& target, const PointCloud& source,
+                        const Eigen::Isometry3d& T, const RegistrationConfig& config);
+
+/// Evenly spaced indices into a cloud of `size` points, at most `max_points` of them.
+std::vector<int> EvenIndices(std::size_t size, int max_points);
+/// The points at EvenIndices.
+PointCloud EvenSubsample(const PointCloud& cloud, int max_points);
+
+}  // namespace pitchlab::mapping

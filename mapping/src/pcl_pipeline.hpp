@@ -1,0 +1,37 @@
+#pragma once
+// PCL's implementations of the registration stages (backend "pcl"), behind our cloud type so that
+// PCL's headers stay in pcl_pipeline.cpp.
+
+#include <Eigen/Geometry>
+
+#include "pitchlab/mapping/point_cloud.hpp"
+#include "pitchlab/mapping/registration_config.hpp"
+
+namespace pitchlab::mapping {
+
+struct PclAlignment {
+  bool found = false;
+  Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();
+  int correspondences = 0;                          // feature correspondences SAC-IA worked with
+  double normals_s = 0, features_s = 0, sac_s = 0;  // stage wall times [s]
+};
+
+/// pcl::NormalEstimation + pcl::FPFHEstimation (or range image + NARF keypoints/descriptors) and
+/// pcl::SampleConsensusInitialAlignment on the feature clouds (voxelized already).
+PclAlignment PclInitialAlignment(const PointCloud& target, const PointCloud& source,
+                                 const RegistrationConfig& config);
+
+struct PclIcp {
+  Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();
+  int iterations = 0;
+  bool converged = false;
+};
+
+/// pcl::IterativeClosestPointNonLinear (Levenberg-Marquardt) from `init`.
+PclIcp PclIcpNonLinear(const PointCloud& target, const PointCloud& source,
+                       const Eigen::Isometry3d& init, const RegistrationConfig& config);
+
+/// pcl::VoxelGrid (the PCL default pipeline's downsampling, for the baseline).
+PointCloud PclVoxelGrid(const PointCloud& cloud, double leaf_m);
+
+}  // namespace pitchlab::mapping

@@ -1,0 +1,199 @@
+#include "pitchlab/mapping/registration_config.hpp"
+
+#include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+#include <yaml-cpp/yaml.h>
+
+namespace pitchlab::mapping {
+namespace {
+
+constexpr char kSection[] = "registration";
+
+[[noreturn]] void Throw(const std::string& source, const std::string& key,
+                        const std::string& what) {
+  throw std::invalid_argument(source + ": " + kSection + "." + key + " " + what);
+}
+
+std::string BackendName(RegistrationBackend b) {
+  return b == RegistrationBackend::kPcl ? "pcl" : "fast";
+}
+
+std::string FeatureName(FeatureKind f) {
+  switch (f) {
+    case FeatureKind::kFpfh:
+      return "fpfh";
+    case FeatureKind::kNarf:
+      return "narf";
+    case FeatureKind::kNone:
+      return "none";
+  }
+  return "?";
+}
+
+// One handler per key; visits every field of the config (so reading and writing cannot diverge).
+template <typename Visitor>
+void VisitFields(RegistrationConfig& c, Visitor&& v) {
+  v("icp_voxel_m", c.icp_voxel_m);
+  v("feature_voxel_m", c.feature_voxel_m);
+  v("normal_radius_m", c.normal_radius_m);
+  v("icp_normal_radius_m", c.icp_normal_radius_m);
+  v("feature_radius_m", c.feature_radius_m);
+  v("max_neighbors", c.max_neighbors);
+  v("max_feature_points", c.max_feature_points);
+  v("sac_iterations", c.sac_iterations);
+  v("sac_inlier_m", c.sac_inlier_m);
+  v("sac_edge_similarity", c.sac_edge_similarity);
+  v("sac_min_inliers", c.sac_min_inliers);
+  v("degeneracy_ratio", c.degeneracy_ratio);
+  v("degeneracy_probe_m", c.degeneracy_probe_m);
+  v("degeneracy_probe_deg", c.degeneracy_probe_deg);
+  v("icp_max_iterations", c.icp_max_iterations);
+  v("icp_epsilon", c.icp_epsilon);
+  v("icp_max_distance_m", c.icp_max_distance_m);
+  v("icp_min_distance_m", c.icp_min_distance_m);
+  v("icp_max_points", c.icp_max_points);
+  v("constraint_translation_m", c.constraint_translation_m);
+  v("constraint_rotation_deg", c.constraint_rotation_deg);
+  v("constant_velocity_fallback", c.constant_velocity_fallback);
+  v("inlier_distance_m", c.inlier_distance_m);
+  v("min_inlier_ratio", c.min_inlier_ratio);
+  v("max_rmse_m", c.max_rmse_m);
+}
+
+void ReadEnums(const std::string& key, const YAML::Node& n, RegistrationConfig& c,
+               const std::string& source) {
+  const std::string s = n.IsScalar() ? n.Scalar() : "<non-scalar>";
+  if (key == "backend") {
+    if (s == "fast")
+      c.backend = RegistrationBackend::kFast;
+    else if (s == "pcl")
+      c.backend = RegistrationBackend::kPcl;
+    else
+      Throw(source, key, "must be fast or pcl ('" + s + "')");
+  } else {
+    if (s == "fpfh")
+      c.features = FeatureKind::kFpfh;
+    else if (s == "narf")
+      c.features = FeatureKind::kNarf;
+    else if (s == "none")
+      c.features = FeatureKind::kNone;
+    else
+      Throw(source, key, "must be fpfh, narf or none ('" + s + "')");
+  }
+}
+
+}  // namespace
+
+void RegistrationConfig::Validate() const {
+  auto require = [](bool ok, const char* field, double value, const char* what) {
+    if (!ok) {
+      std::ostringstream os;
+      os << "registration." << field << " = " << value << ": " << what;
+      throw std::invalid_argument(os.str());
+    }
+  };
+  require(icp_voxel_m > 0, "icp_voxel_m", icp_voxel_m, "must be > 0");
+  require(feature_voxel_m > 0, "feature_voxel_m", feature_voxel_m, "must be > 0");
+  require(normal_radius_m > 0, "normal_radius_m", normal_radius_m, "must be > 0");
+  require(icp_normal_radius_m > 0, "icp_normal_radius_m", icp_normal_radius_m, "must be > 0");
+  require(feature_radius_m > normal_radius_m * 0.5, "feature_radius_m", feature_radius_m,
+          "must exceed half the normal radius");
+  require(max_neighbors >= 5, "max_neighbors", max_neighbors, "must be >= 5");
+  require(max_feature_points >= 10, "max_feature_points", max_feature_points, "must be >= 10");
+  require(sac_iterations >= 1, "sac_iterations", sac_iterations, "must be >= 1");
+  require(sac_inlier_m > 0, "sac_inlier_m", sac_inlier_m, "must be > 0");
+  require(sac_edge_similarity > 0 && sac_edge_similarity < 1, "sac_edge_similarity",
+          sac_edge_similarity, "must be in (0, 1)");
+  require(sac_min_inliers >= 3, "sac_min_inliers", sac_min_inliers, "must be >= 3");
+  require(degeneracy_ratio >= 0 && degeneracy_ratio < 1, "degeneracy_ratio", degeneracy_ratio,
+          "must be in [0, 1)");
+  require(degeneracy_probe_m > 0, "degeneracy_probe_m", degeneracy_probe_m, "must be > 0");
+  require(degeneracy_probe_deg > 0 && degeneracy_probe_deg < 90, "degeneracy_probe_deg",
+          degeneracy_probe_deg, "must be in (0, 90)");
+  require(icp_max_iterations >= 1, "icp_max_iterations", icp_max_iterations, "must be >= 1");
+  require(icp_epsilon > 0, "icp_epsilon", icp_epsilon, "must be > 0");
+  require(icp_max_distance_m > 0, "icp_max_distance_m", icp_max_distance_m, "must be > 0");
+  require(icp_min_distance_m > 0 && icp_min_distance_m <= icp_max_distance_m, "icp_min_distance_m",
+          icp_min_distance_m, "must be in (0, icp_max_distance_m]");
+  require(icp_max_points >= 50, "icp_max_points", icp_max_points, "must be >= 50");
+  require(constraint_translation_m > 0, "constraint_translation_m", constraint_translation_m,
+          "must be > 0");
+  require(constraint_rotation_deg > 0 && constraint_rotation_deg <= 180, "constraint_rotation_deg",
+          constraint_rotation_deg, "must be in (0, 180]");
+  require(inlier_distance_m > 0, "inlier_distance_m", inlier_distance_m, "must be > 0");
+  require(min_inlier_ratio >= 0 && min_inlier_ratio <= 1, "min_inlier_ratio", min_inlier_ratio,
+          "must be in [0, 1]");
+  require(max_rmse_m > 0, "max_rmse_m", max_rmse_m, "must be > 0");
+  if (backend == RegistrationBackend::kFast && features == FeatureKind::kNarf) {
+    throw std::invalid_argument("registration.features = narf needs registration.backend = pcl");
+  }
+}
+
+RegistrationConfig ParseRegistrationConfig(const std::string& yaml_text,
+                                           const std::string& source) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument(source + ": not YAML: " + e.what());
+  }
+  RegistrationConfig config;
+  const YAML::Node node = root.IsMap() ? root[kSection] : YAML::Node();
+  if (!node) return config;
+  if (!node.IsMap()) throw std::invalid_argument(source + ": '" + kSection + "' must be a map");
+
+  std::map<std::string, std::function<void(const YAML::Node&)>> handlers;
+  VisitFields(config, [&](const char* key, auto& field) {
+    handlers[key] = [&field, key, &source](const YAML::Node& n) {
+      try {
+        field = n.as<std::decay_t<decltype(field)>>();
+      } catch (const YAML::Exception&) {
+        Throw(source, key,
+              "has the wrong type ('" + (n.IsScalar() ? n.Scalar() : "<non-scalar>") + "')");
+      }
+    };
+  });
+  for (const char* key : {"backend", "features"}) {
+    handlers[key] = [&config, key, &source](const YAML::Node& n) {
+      ReadEnums(key, n, config, source);
+    };
+  }
+  for (const auto& kv : node) {
+    const std::string key = kv.first.as<std::string>();
+    auto it = handlers.find(key);
+    if (it == handlers.end()) Throw(source, key, "is not a known setting");
+    it->second(kv.second);
+  }
+  try {
+    config.Validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(source + ": " + e.what());
+  }
+  return config;
+}
+
+RegistrationConfig LoadRegistrationConfig(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument(path + ": cannot be read");
+  std::stringstream text;
+  text << in.rdbuf();
+  return ParseRegistrationConfig(text.str(), path);
+}
+
+std::string RegistrationConfigToYaml(const RegistrationConfig& config) {
+  YAML::Emitter out;
+  out << YAML::BeginMap << YAML::Key << kSection << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "backend" << YAML::Value << BackendName(config.backend);
+  out << YAML::Key << "features" << YAML::Value << FeatureName(config.features);
+  RegistrationConfig copy = config;
+  VisitFields(
+      copy, [&](const char* key, auto& field) { out << YAML::Key << key << YAML::Value << field; });
+  out << YAML::EndMap << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+}  // namespace pitchlab::mapping

@@ -1,0 +1,145 @@
+// End to end through the `pitchlab` binary: scan -> map --world -> plan --json, every file read
+// back, and bad input to `plan` refused with a clear error, exit code 1 and no output folder.
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "pitchlab/mapping/elevation_io.hpp"
+
+namespace pitchlab {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string Slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+// One office scan and its map, made once for the suite (a scan takes seconds).
+class MapPlanCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = fs::temp_directory_path() / "pitchlab_cli_map_plan";
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    const CliRun scan =
+        Run("scan --world office --json --quiet --out " + (dir_ / "office.pcd").string());
+    ASSERT_EQ(scan.exit_code, 0) << scan.err;
+    const auto pose = nlohmann::json::parse(scan.out)["pose"];
+    start_x_ = pose["x_m"].get<double>();
+    start_y_ = pose["y_m"].get<double>();
+    map_run_ = Run("map " + (dir_ / "office.pcd").string() +
+                   " --world office --cell 0.1 --json --out " + (dir_ / "map").string());
+  }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
+
+  static CliRun Run(const std::string& args) {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string command = std::string(PITCHLAB_CLI) + " " + args + " >" + out.string() +
+                                " 2>" + err.string();
+    const int status = std::system(command.c_str());
+    CliRun run;
+    run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    run.out = Slurp(out);
+    run.err = Slurp(err);
+    return run;
+  }
+  static std::string Point(double x, double y) {
+    return std::to_string(x) + "," + std::to_string(y);
+  }
+
+  static inline fs::path dir_;
+  static inline double start_x_ = 0, start_y_ = 0;
+  static inline CliRun map_run_;
+};
+
+TEST_F(MapPlanCli, ScanMapPlanWritesFilesThatParse) {
+  ASSERT_EQ(map_run_.exit_code, 0) << map_run_.err;
+  ASSERT_FALSE(map_run_.out.empty()) << map_run_.err;
+  const nlohmann::json map = nlohmann::json::parse(map_run_.out);
+  EXPECT_GT(map["known_cells"].get<int>(), 100);
+  EXPECT_TRUE(map.contains("truth"));
+  EXPECT_EQ(nlohmann::json::parse(Slurp(dir_ / "map" / "map.json"))["cell_m"], 0.1);
+  const auto loaded = mapping::LoadElevationMap((dir_ / "map" / "map.plem").string());
+  ASSERT_TRUE(loaded) << loaded.error().message;
+  EXPECT_EQ(loaded->geometry().size_x, map["size_x"].get<int>());
+  EXPECT_EQ(Slurp(dir_ / "map" / "elevation.asc").rfind("ncols", 0), 0u);
+  EXPECT_FALSE(Slurp(dir_ / "map" / "elevation.prj").empty());
+  EXPECT_EQ(Slurp(dir_ / "map" / "elevation.png").substr(0, 8), "\x89PNG\r\n\x1a\n");
+
+  // 1.5 m ahead of the robot (facing +x at the office's start). The laser does not see the
+  // floor right around the robot, so unknown cells are penalised, not forbidden.
+  const fs::path plan_dir = dir_ / "plan";
+  const CliRun plan = Run("plan " + (dir_ / "map" / "map.plem").string() + " --start " +
+                          Point(start_x_, start_y_) + " --goal " +
+                          Point(start_x_ + 1.5, start_y_) +
+                          " --unknown penalise --json --out " + plan_dir.string());
+  ASSERT_EQ(plan.exit_code, 0) << plan.err;
+  ASSERT_TRUE(fs::exists(plan_dir / "plan.json")) << plan.out;
+  const nlohmann::json result = nlohmann::json::parse(plan.out);
+  EXPECT_TRUE(result["found"].get<bool>());
+  EXPECT_GT(result["cost"].get<double>(), 0);
+  EXPECT_GE(result["length_m"].get<double>(), 1.4);
+  EXPECT_EQ(nlohmann::json::parse(Slurp(plan_dir / "plan.json"))["cost"], result["cost"]);
+  std::ifstream csv(plan_dir / "path.csv");
+  std::string header, line;
+  std::getline(csv, header);
+  EXPECT_EQ(header, "index,x_m,y_m,z_m,cum_length_m");
+  std::size_t rows = 0;
+  while (std::getline(csv, line)) rows += !line.empty();
+  EXPECT_EQ(rows, result["waypoints"].get<std::size_t>());
+  if (map.contains("geodetic_origin")) {  // GeoJSON needs the world's geodetic origin
+    const nlohmann::json geo = nlohmann::json::parse(Slurp(plan_dir / "path.geojson"));
+    EXPECT_EQ(geo["features"][0]["geometry"]["coordinates"].size(), rows);
+  } else {
+    EXPECT_FALSE(fs::exists(plan_dir / "path.geojson"));
+    EXPECT_NE(result["geojson"].get<std::string>().find("no geodetic origin"), std::string::npos);
+  }
+  EXPECT_EQ(Slurp(plan_dir / "path.png").substr(0, 8), "\x89PNG\r\n\x1a\n");
+  for (const auto& e : fs::directory_iterator(dir_))
+    EXPECT_EQ(e.path().filename().string().find(".partial"), std::string::npos) << e.path();
+}
+
+TEST_F(MapPlanCli, BadInputGivesAClearErrorANonZeroExitAndNoFolder) {
+  ASSERT_EQ(map_run_.exit_code, 0) << map_run_.err;
+  const std::string map = (dir_ / "map" / "map.plem").string();
+  const std::string start = Point(start_x_, start_y_);
+  const struct {
+    std::string args, message;
+  } cases[] = {
+      {(dir_ / "missing.plem").string() + " --start " + start + " --goal " + start, "missing"},
+      {map + " --start -500,0 --goal " + start, "start_outside_map"},
+      {map + " --start " + start + " --goal " + Point(start_x_, start_y_ + 1e3),
+       "goal_outside_map"},
+      // 1 m to the robot's left: next to the corridor wall, inside the footprint's margin.
+      {map + " --start " + start + " --goal " + Point(start_x_, start_y_ + 1), "goal_blocked"},
+      // Ahead, but unknown cells (never seen around the robot) are forbidden by default.
+      {map + " --start " + start + " --goal " + Point(start_x_ + 1.5, start_y_), "disconnected"},
+  };
+  for (const auto& c : cases) {
+    const fs::path out = dir_ / "bad_plan";
+    const CliRun run = Run("plan " + c.args + " --out " + out.string());
+    EXPECT_NE(run.exit_code, 0) << c.args;
+    EXPECT_NE(run.err.find(c.message), std::string::npos) << c.args << "\n" << run.err;
+    EXPECT_FALSE(fs::exists(out)) << c.args;
+  }
+}
+
+}  // namespace
+}  // namespace pitchlab

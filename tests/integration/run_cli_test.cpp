@@ -1,0 +1,140 @@
+// The closed loop end to end through the `pitchlab run` binary, in a small yard world.
+
+#include <sys/wait.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include "pitchlab/mapping/elevation_io.hpp"
+#include "pitchlab/sensors/scan_pcd.hpp"
+
+namespace pitchlab {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kYard = fs::path(PITCHLAB_SOURCE_DIR) / "tests/data/worlds/yard.xml";
+
+std::string Slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+struct CliResult {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+class RunCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = fs::temp_directory_path() / ("pitchlab_run_cli_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
+
+  static CliResult Exec(const std::string& args) {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const int status = std::system((std::string(PITCHLAB_CLI) + " " + args + " >" +
+                                    out.string() + " 2>" + err.string())
+                                       .c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(out), Slurp(err)};
+  }
+  // Folders in the scratch folder other than the successful run's: a failed run leaves none,
+  // not even its hidden staging folder.
+  static int Leftovers() {
+    int n = 0;
+    for (const auto& e : fs::directory_iterator(dir_)) {
+      n += e.is_directory() && e.path().filename().string().rfind("ok", 0) != 0;
+    }
+    return n;
+  }
+  static fs::path dir_;
+};
+fs::path RunCli::dir_;
+
+TEST_F(RunCli, AMissionAroundABlockReachesTheGoalAndWritesEveryOutput) {
+  const fs::path run = dir_ / "ok_yard";
+  const CliResult r = Exec("run --world " + kYard.string() + " --seed 3 --json --quiet --out " +
+                     run.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  const nlohmann::json metrics = nlohmann::json::parse(Slurp(run / "metrics.json"));
+  EXPECT_EQ(metrics, nlohmann::json::parse(r.out));
+  EXPECT_TRUE(metrics["success"].get<bool>()) << metrics["reason"];
+  constexpr double kGoalTolerance_m = 0.5, kPoseBound_m = 0.15;
+  EXPECT_LT(metrics["final_true_distance_to_goal_m"].get<double>(), kGoalTolerance_m + kPoseBound_m);
+  EXPECT_LT(metrics["final_pose_error"]["translation_m"].get<double>(), kPoseBound_m);
+  EXPECT_LT(metrics["max_registration_error"]["translation_m"].get<double>(), kPoseBound_m);
+  EXPECT_GT(metrics["closest_approach_to_forbidden_m"].get<double>(), 0.0);  // never on a hazard
+  EXPECT_GT(metrics["distance_m"].get<double>(), 11.0);  // around the block, not through it
+  EXPECT_GE(metrics["cost_ratio"].get<double>(), 0.95);
+  EXPECT_LT(metrics["cost_ratio"].get<double>(), 1.5);
+
+  // Every file is present and opens in what reads it.
+  const int stops = metrics["stops"].get<int>();
+  ASSERT_GE(stops, 2);
+  for (int k = 0; k < stops; ++k) {
+    char stop[32];
+    std::snprintf(stop, sizeof(stop), "stops/%03d/", k);
+    ASSERT_TRUE(sensors::ReadScanPcd((run / stop / "scan.pcd").string())) << stop;
+    EXPECT_NO_THROW(nlohmann::json::parse(Slurp(run / stop / "registration.json"))) << stop;
+    EXPECT_EQ(Slurp(run / stop / "map.png").substr(1, 3), "PNG") << stop;
+  }
+  EXPECT_TRUE(fs::exists(run / "stops/000/path.csv"));
+  EXPECT_NO_THROW(nlohmann::json::parse(Slurp(run / "stops/000/path.geojson")));
+  const auto cloud = sensors::ReadScanPcd((run / "map_cloud.pcd").string());
+  ASSERT_TRUE(cloud);
+  EXPECT_GT(cloud->points.size(), 1000u);
+  EXPECT_TRUE(mapping::LoadElevationMap((run / "elevation.plem").string()));
+  EXPECT_NE(Slurp(run / "elevation.asc").find("ncols"), std::string::npos);
+  EXPECT_NE(Slurp(run / "elevation.prj").find("PROJCS"), std::string::npos);
+  for (const char* png : {"elevation.png", "truth_elevation.png"}) {
+    EXPECT_EQ(Slurp(run / png).substr(1, 3), "PNG") << png;
+  }
+  for (const char* csv : {"trajectory_estimated.csv", "trajectory_true.csv"}) {
+    const std::string text = Slurp(run / csv);
+    EXPECT_EQ(text.rfind("stamp_s,x_m,y_m,z_m", 0), 0u) << csv;
+    EXPECT_GT(std::count(text.begin(), text.end(), '\n'), 20) << csv;
+  }
+  const nlohmann::json geo = nlohmann::json::parse(Slurp(run / "trajectories.geojson"));
+  EXPECT_EQ(geo["features"].size(), 2u);
+  const YAML::Node config = YAML::LoadFile((run / "config.yaml").string());
+  EXPECT_EQ(config["seed"].as<int>(), 3);
+  const std::string html = Slurp(run / "report.html");
+  EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+}
+
+struct BadRun {
+  std::string args, message;
+};
+
+TEST_F(RunCli, BadInputGivesAClearErrorAndLeavesNoRunFolder) {
+  std::ofstream(dir_ / "bad.yaml") << "run: {drive_per_stop_m: -1}\n";
+  const std::string yard = " --world " + kYard.string();
+  const BadRun cases[] = {
+      {"--world atlantis", "unknown world 'atlantis'"},
+      {yard + " --goal 40,0", "off the map"},
+      {yard + " --goal 0,1", "unreachable"},  // inside the block
+      {yard + " --config " + (dir_ / "bad.yaml").string(), "drive_per_stop_m"},
+      {yard + " --start -5.5,0", "needs 3 comma-separated numbers"},
+  };
+  for (const BadRun& c : cases) {
+    const CliResult r = Exec("run --quiet " + c.args + " --out " + (dir_ / "bad_run").string());
+    EXPECT_NE(r.exit_code, 0) << c.args;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << " said: " << r.err;
+    EXPECT_EQ(Leftovers(), 0) << c.args;
+  }
+}
+
+}  // namespace
+}  // namespace pitchlab

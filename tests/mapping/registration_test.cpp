@@ -1,0 +1,206 @@
+// Register() on real simulated scans (known transforms, real pairs with ground truth), on bad
+// input, and on the corridor, where only the constant-velocity fallback can carry the estimate.
+
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "pitchlab/mapping/registration.hpp"
+#include "sim_scans.hpp"
+
+namespace pitchlab::mapping {
+namespace {
+
+using testing::SimulatedScan;
+
+constexpr double kMaxRotationError_deg = 0.5;
+constexpr double kMaxTranslationError_m = 0.03;
+constexpr double kNoiseSigma_m = 0.005;
+
+// `T_target_source` applied to `cloud_target` gives the source cloud seen from the moved robot,
+// every other point (so no point is shared) with fresh seeded noise.
+PointCloud MovedCopy(const PointCloud& cloud_target, const Eigen::Isometry3d& T_target_source,
+                     unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> noise(0.0f, static_cast<float>(kNoiseSigma_m));
+  const Eigen::Isometry3f T_source_target = T_target_source.inverse().cast<float>();
+  PointCloud out;
+  for (std::size_t i = 1; i < cloud_target.size(); i += 2) {
+    out.push_back(T_source_target * cloud_target[i] +
+                  Eigen::Vector3f(noise(rng), noise(rng), noise(rng)));
+  }
+  return out;
+}
+
+PointCloud EveryOther(const PointCloud& cloud) {
+  PointCloud out;
+  for (std::size_t i = 0; i < cloud.size(); i += 2) out.push_back(cloud[i]);
+  return out;
+}
+
+void ExpectNear(const RegistrationResult& r, const Eigen::Isometry3d& truth) {
+  const PoseError e = ComparePoses(r.T_target_source, truth);
+  EXPECT_LT(e.rotation_deg, kMaxRotationError_deg) << r.reason;
+  EXPECT_LT(e.translation_m, kMaxTranslationError_m) << r.reason;
+}
+
+struct KnownMotion {
+  const char* world;
+  double x_m, y_m, yaw_deg;  // where the scan is taken
+};
+
+class KnownTransformOnRealScans : public ::testing::TestWithParam<KnownMotion> {};
+
+TEST_P(KnownTransformOnRealScans, IsRecoveredWithinHalfADegreeAndThreeCentimetres) {
+  const KnownMotion m = GetParam();
+  const PointCloud cloud = CloudFromScan(SimulatedScan(m.world, m.x_m, m.y_m, m.yaw_deg));
+  // Up to the 1 m / 15 deg offsets, with some roll and pitch (uneven ground).
+  const Eigen::Isometry3d truth = PoseFromXyzRpyDeg(0.8, -0.5, 0.05, 2.0, -3.0, 15.0);
+  Result<RegistrationResult> r =
+      Register(EveryOther(cloud), MovedCopy(cloud, truth, 7), {}, RegistrationConfig{});
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_TRUE(r->success) << r->reason;
+  EXPECT_EQ(r->path, RegistrationPath::kFeatures);
+  EXPECT_GT(r->iterations, 0);
+  EXPECT_GT(r->timings.total_s, 0.0);
+  ExpectNear(*r, truth);
+}
+
+INSTANTIATE_TEST_SUITE_P(Worlds, KnownTransformOnRealScans,
+                         ::testing::Values(KnownMotion{"office", -8, 0, 0},
+                                           KnownMotion{"cluttered", -4.5, -3.8, 0},
+                                           KnownMotion{"urban", 0, 0, 0},
+                                           KnownMotion{"terrain", 0, 0, 0}),
+                         [](const auto& info) { return std::string(info.param.world); });
+
+TEST(Register, TwoRealScansFromDifferentPosesMatchGroundTruth) {
+  const sensors::Scan3D a = SimulatedScan("office", -8, 0, 0, 1);
+  const sensors::Scan3D b = SimulatedScan("office", -7.2, 0.3, 12, 2);
+  ASSERT_TRUE(a.has_truth && b.has_truth);
+  const Eigen::Isometry3d truth = a.T_world_base.inverse() * b.T_world_base;
+  Result<RegistrationResult> r = Register(CloudFromScan(a), CloudFromScan(b), {}, {});
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_TRUE(r->success) << r->reason;
+  ExpectNear(*r, truth);
+}
+
+TEST(Register, WithAnOdometryPriorTheResultStaysInsideItsRegion) {
+  const sensors::Scan3D a = SimulatedScan("office", -8, 0, 0, 1);
+  const sensors::Scan3D b = SimulatedScan("office", -7.2, 0.3, 12, 2);
+  const Eigen::Isometry3d truth = a.T_world_base.inverse() * b.T_world_base;
+  RegistrationPrior prior;
+  prior.odometry = truth * PoseFromXyzRpyDeg(0.3, 0.2, 0, 0, 0, 5);  // odometry drifted
+  Result<RegistrationResult> r = Register(CloudFromScan(a), CloudFromScan(b), prior, {});
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_TRUE(r->success) << r->reason;
+  ExpectNear(*r, truth);
+}
+
+TEST(Register, AnOdometryPriorFarFromTheTruthIsAReportedConstraintFailure) {
+  const PointCloud cloud = CloudFromScan(SimulatedScan("office", -8, 0, 0));
+  const Eigen::Isometry3d truth = PoseFromXyzRpyDeg(0.5, 0.0, 0, 0, 0, 5);
+  RegistrationPrior prior;
+  prior.odometry = PoseFromXyzRpyDeg(0.5, 0, 0, 0, 0, 95);  // 90 deg off: outside any region
+  RegistrationConfig config;
+  config.constraint_rotation_deg = 20;
+  Result<RegistrationResult> r =
+      Register(EveryOther(cloud), MovedCopy(cloud, truth, 3), prior, config);
+  ASSERT_TRUE(r) << r.error().message;
+  if (r->success) {  // whatever it found lies inside the region around the prior
+    EXPECT_LE(ComparePoses(r->T_target_source, *prior.odometry).rotation_deg, 20.0);
+  } else {
+    EXPECT_FALSE(r->reason.empty());
+  }
+  EXPECT_GT(ComparePoses(r->T_target_source, truth).rotation_deg, 10.0) << "constraint ignored";
+}
+
+TEST(Register, AnEmptyCloudIsAnInvalidArgument) {
+  const PointCloud some = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  Result<RegistrationResult> r = Register({}, some, {}, {});
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, Error::Code::kInvalidArgument);
+  EXPECT_NE(r.error().message.find("target cloud is empty"), std::string::npos);
+}
+
+TEST(Register, NanPointsAreAnInvalidArgumentNamingTheCount) {
+  PointCloud cloud = CloudFromScan(SimulatedScan("office", -8, 0, 0));
+  PointCloud bad = cloud;
+  bad[10].x() = std::numeric_limits<float>::quiet_NaN();
+  bad[20].z() = std::numeric_limits<float>::infinity();
+  Result<RegistrationResult> r = Register(cloud, bad, {}, {});
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, Error::Code::kInvalidArgument);
+  EXPECT_NE(r.error().message.find("source cloud has 2 of"), std::string::npos)
+      << r.error().message;
+}
+
+TEST(Register, ThreePointsAreAnInvalidArgument) {
+  const PointCloud cloud = CloudFromScan(SimulatedScan("office", -8, 0, 0));
+  const PointCloud three = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  Result<RegistrationResult> r = Register(cloud, three, {}, {});
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, Error::Code::kInvalidArgument);
+  EXPECT_NE(r.error().message.find("source cloud has 3 points"), std::string::npos)
+      << r.error().message;
+}
+
+TEST(Register, ScansWithNoOverlapAreAReportedFailureNotASuccess) {
+  const PointCloud office = CloudFromScan(SimulatedScan("office", -8, 0, 0));
+  const PointCloud terrain = CloudFromScan(SimulatedScan("terrain", 0, 0, 0));
+  RegistrationPrior prior;
+  prior.previous_motion = PoseFromXyzRpyDeg(0.5, 0, 0, 0, 0, 0);
+  Result<RegistrationResult> r = Register(office, terrain, prior, {});
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_FALSE(r->success);
+  EXPECT_FALSE(r->reason.empty());
+}
+
+TEST(Register, TheCorridorTakesTheConstantVelocityFallback) {
+  const sensors::Scan3D a = SimulatedScan("corridor", -10, 0, 0, 1);
+  const sensors::Scan3D b = SimulatedScan("corridor", -9, 0, 0, 2);
+  const Eigen::Isometry3d truth = a.T_world_base.inverse() * b.T_world_base;
+  RegistrationPrior prior;
+  prior.previous_motion = PoseFromXyzRpyDeg(1.0, 0, 0, 0, 0, 0);  // the last pair's motion
+  Result<RegistrationResult> r = Register(CloudFromScan(a), CloudFromScan(b), prior, {});
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_TRUE(r->success) << r->reason;
+  EXPECT_EQ(r->path, RegistrationPath::kFallback) << r->reason;
+  EXPECT_NE(r->reason.find("fallback"), std::string::npos) << r->reason;
+  ExpectNear(*r, truth);
+}
+
+TEST(Register, TheCorridorWithoutAFallbackIsAReportedFailure) {
+  const sensors::Scan3D a = SimulatedScan("corridor", -10, 0, 0, 1);
+  const sensors::Scan3D b = SimulatedScan("corridor", -9, 0, 0, 2);
+  Result<RegistrationResult> r = Register(CloudFromScan(a), CloudFromScan(b), {}, {});
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_FALSE(r->success) << r->reason;
+  EXPECT_NE(r->reason.find("ambiguous"), std::string::npos) << r->reason;
+}
+
+TEST(Register, ThePclBackendAlsoRecoversAKnownTransform) {
+  const PointCloud cloud = CloudFromScan(SimulatedScan("office", -8, 0, 0));
+  const Eigen::Isometry3d truth = PoseFromXyzRpyDeg(0.4, 0.2, 0, 0, 0, 8);
+  RegistrationConfig config;
+  config.backend = RegistrationBackend::kPcl;
+  config.sac_iterations = 500;
+  Result<RegistrationResult> r =
+      Register(EveryOther(cloud), MovedCopy(cloud, truth, 5), {}, config);
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_TRUE(r->success) << r->reason;
+  ExpectNear(*r, truth);
+}
+
+TEST(Register, TheSameInputGivesTheSameOutput) {
+  const PointCloud cloud = CloudFromScan(SimulatedScan("cluttered", -4.5, -3.8, 0));
+  const Eigen::Isometry3d truth = PoseFromXyzRpyDeg(0.3, 0.1, 0, 0, 0, 6);
+  const PointCloud source = MovedCopy(cloud, truth, 11);
+  Result<RegistrationResult> a = Register(cloud, source, {}, {});
+  Result<RegistrationResult> b = Register(cloud, source, {}, {});
+  ASSERT_TRUE(a && b);
+  EXPECT_TRUE(a->T_target_source.matrix() == b->T_target_source.matrix());
+}
+
+}  // namespace
+}  // namespace pitchlab::mapping

@@ -1,0 +1,48 @@
+#pragma once
+// Real simulated scans for the mapping tests: SimRig in a built-in world, cached as PCD in the
+// build tree (CTest runs every case in its own process; a scan takes seconds to simulate).
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "pitchlab/sensors/scan_pcd.hpp"
+#include "pitchlab/sim/sim_rig.hpp"
+
+namespace pitchlab::mapping::testing {
+
+/// A full seed-pattern scan (361 x 200, 5 mm noise) of `world` from (x, y, yaw); throws on failure.
+inline sensors::Scan3D SimulatedScan(const std::string& world, double x_m, double y_m,
+                                     double yaw_deg, std::uint64_t seed = 1) {
+  std::ostringstream name;
+  name << world << "_" << x_m << "_" << y_m << "_" << yaw_deg << "_s" << seed << ".pcd";
+  const std::filesystem::path dir = PITCHLAB_MAPPING_SCAN_CACHE;
+  const std::filesystem::path path = dir / name.str();
+  if (std::filesystem::exists(path)) {
+    Result<sensors::Scan3D> cached = sensors::ReadScanPcd(path.string());
+    if (cached) return *cached;
+  }
+  sim::SimRigConfig config;
+  config.lms200.seed = seed;
+  sim::SimRig rig(std::string(PITCHLAB_WORLDS_DIR) + "/" + world + ".xml", config);
+  Result<Eigen::Isometry3d> pose = rig.PlaceRobot(x_m, y_m, yaw_deg * M_PI / 180.0);
+  if (!pose) throw std::runtime_error(world + ": " + pose.error().message);
+  Result<sensors::Scan3D> scan = rig.Acquire();
+  if (!scan) throw std::runtime_error(world + ": " + scan.error().message);
+  // Parallel CTest processes may simulate the same scan: each writes its own file, then renames.
+  std::filesystem::create_directories(dir);
+  const std::string mine = path.string() + "." + std::to_string(::getpid()) + ".pcd";
+  Result<void> written = sensors::WriteScanPcd(*scan, mine);
+  if (!written) throw std::runtime_error(written.error().message);
+  std::filesystem::rename(mine, path);
+  // Read back so a fresh and a cached run see the same bytes (VIEWPOINT precision included).
+  Result<sensors::Scan3D> again = sensors::ReadScanPcd(path.string());
+  if (!again) throw std::runtime_error(again.error().message);
+  return *again;
+}
+
+}  // namespace pitchlab::mapping::testing
