@@ -16,13 +16,34 @@ constexpr double kMinProgress_m = 0.05;   // less than this over stuck_timeout_s
 constexpr double kFootprintHalf_m = 0.2;  // ground known under the robot: it stands on it
 constexpr double kStopTime_s = 0.5;       // braking before a scan
 constexpr double kEscapeRadius_m = 1.0;   // how far a start inside a hazard margin looks out
+constexpr double kGoalApproach_m = 2.0;   // a blocked goal farther than this: approach it
+constexpr double kHeadingTolerance_rad = 3.0 * kPi / 180;  // turning in place ends within this
+constexpr double kTurnGain_per_s = 2.0;   // yaw rate per radian of heading error
 
 double Yaw(const Eigen::Isometry3d& T) { return std::atan2(T.linear()(1, 0), T.linear()(0, 0)); }
 
-// Odometry increment since `ref`, applied to the pose estimated at `ref`.
+// Odometry increment since `ref` applied to the pose estimated at `ref`, in the horizontal plane:
+// x, y and yaw move by the odometry's planar motion; z, roll and pitch keep the estimate's (wheel
+// odometry says nothing about them, and composing a planar turn onto a tilted frame would leak
+// the tilt into the heading).
 Eigen::Isometry3d Propagate(const Eigen::Isometry3d& T_world_base_at_ref,
                             const sensors::Odometry& ref, const sensors::Odometry& now) {
-  return T_world_base_at_ref * (ref.Pose().inverse() * now.Pose());
+  const Eigen::Matrix3d R = T_world_base_at_ref.linear();
+  const double yaw = std::atan2(R(1, 0), R(0, 0));
+  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+  const double roll = std::atan2(R(2, 1), R(2, 2));
+  const double c = std::cos(ref.yaw_rad), s = std::sin(ref.yaw_rad);
+  const double dx = now.x_m - ref.x_m, dy = now.y_m - ref.y_m;
+  const Eigen::Vector2d step_base(c * dx + s * dy, -s * dx + c * dy);  // in ref's frame
+  const Eigen::Vector2d step_world = Eigen::Rotation2Dd(yaw) * step_base;
+  const double new_yaw = yaw + std::remainder(now.yaw_rad - ref.yaw_rad, 2.0 * kPi);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = T_world_base_at_ref.translation() + Eigen::Vector3d(step_world.x(), step_world.y(), 0);
+  T.linear() = (Eigen::AngleAxisd(new_yaw, Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
+  return T;
 }
 
 // The first `length_m` of the path's (x, y) polyline.
@@ -57,7 +78,14 @@ class Mission {
   bool Stop(int k);  // false: the mission ends (result_.reason says why)
   void UpdateElevation(const StopRecord& stop);
   void Plan(StopRecord& stop) const;
-  bool Drive(const planning::Path& path);
+  bool Drive(const StopRecord& stop);
+  bool Follow(const std::vector<Eigen::Vector2d>& prefix);
+  bool TurnTo(double yaw_rad);
+  bool Rebase();  // the map frame = base_link where the robot is now (before the first scan)
+  void RecordSample(const sensors::Odometry& odo);
+  Eigen::Isometry3d Estimate(const sensors::Odometry& odo) const {
+    return Propagate(T_world_base_, odo_ref_, odo);
+  }
   bool OverBudget();
   void Progress(const std::string& text) const {
     if (observer_.on_progress) observer_.on_progress(text);
@@ -73,6 +101,7 @@ class Mission {
   Eigen::Isometry3d T_world_map_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_world_base_ = Eigen::Isometry3d::Identity();  // estimate at odo_ref_
   sensors::Odometry odo_ref_;
+  bool last_stop_turned_only_ = false;  // the previous stop only turned to look ahead
 };
 
 MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
@@ -85,7 +114,11 @@ MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
   } else {
     odo_ref_ = *odo;
     result_.reason = "stop limit reached (" + std::to_string(config_.max_stops) + " stops)";
-    for (int k = 0; k < config_.max_stops && Stop(k); ++k) {
+    // The laser sees 180 deg ahead: the first scan should look where the robot will go.
+    const Eigen::Vector2d to_goal = config_.goal_m - T_world_start.translation().head<2>();
+    if (TurnTo(std::atan2(to_goal.y(), to_goal.x())) && Rebase()) {
+      for (int k = 0; k < config_.max_stops && Stop(k); ++k) {
+      }
     }
   }
   result_.end_s = probes_.now_s();
@@ -130,7 +163,11 @@ bool Mission::Stop(int k) {
                                         : stop.T_world_base_odom;
   T_world_base_ = stop.T_world_base;
   odo_ref_ = *odo;
-  if (stop.merge.merged) UpdateElevation(stop);
+  // A scan whose registration failed is never merged into the map cloud; the elevation map
+  // still takes it at the odometry pose (said in the stop record), or an unregistrable stretch
+  // of terrain would stay unknown and the robot could never plan across it.
+  stop.elevation_from_odometry = !stop.merge.merged;
+  UpdateElevation(stop);
   stop.distance_to_goal_m = (config_.goal_m - stop.T_world_base.translation().head<2>()).norm();
   const bool arrived = stop.distance_to_goal_m <= config_.goal_tolerance_m;
   if (!arrived) Plan(stop);
@@ -152,7 +189,7 @@ bool Mission::Stop(int k) {
     result_.reason = "no path at stop " + std::to_string(k) + ": " + s.plan_error;
     return false;
   }
-  return Drive(*s.plan);
+  return Drive(s);
 }
 
 void Mission::UpdateElevation(const StopRecord& stop) {
@@ -173,9 +210,10 @@ void Mission::UpdateElevation(const StopRecord& stop) {
 // The robot may stand where the footprint rule forbids a path to go (a hazard seen late, drift):
 // the nearest free cell it can reach in a straight line, crossing no step, slope or drop.
 std::optional<Eigen::Vector2d> EscapeCell(const planning::TraversabilityGrid& grid,
-                                          const Eigen::Vector2d& from) {
+                                          const Eigen::Vector2d& from,
+                                          double radius_m = kEscapeRadius_m) {
   const mapping::GridGeometry& g = grid.geometry;
-  const int reach = static_cast<int>(std::ceil(kEscapeRadius_m / g.cell_m));
+  const int reach = static_cast<int>(std::ceil(radius_m / g.cell_m));
   const mapping::CellIndex c = g.IndexOf(from.x(), from.y());
   std::optional<Eigen::Vector2d> best;
   double best_d = std::numeric_limits<double>::infinity();
@@ -184,7 +222,7 @@ std::optional<Eigen::Vector2d> EscapeCell(const planning::TraversabilityGrid& gr
       if (!g.Contains({i, j}) || !grid.Free(g.Linear({i, j}))) continue;
       const Eigen::Vector2d to = g.CenterOf({i, j});
       const double d = (to - from).norm();
-      if (d >= best_d || d > kEscapeRadius_m) continue;
+      if (d >= best_d || d > radius_m) continue;
       bool clear = true;
       for (double t = 0; t <= 1.0 && clear; t += 0.5 * g.cell_m / std::max(d, g.cell_m)) {
         const Eigen::Vector2d p = from + t * (to - from);
@@ -214,25 +252,113 @@ void Mission::Plan(StopRecord& stop) const {
       }
     }
   }
-  if (path) {
-    stop.plan = std::move(*path);
-  } else {
+  if (!path && path.error().reason == planning::NoPath::Reason::kGoalBlocked &&
+      (config_.goal_m - here).norm() > kGoalApproach_m) {
+    // From afar a blocked goal cell is often a hazard seen sparsely; head for the nearest free
+    // cell near it, and let closer scans settle what is there.
+    if (const auto near = EscapeCell(grid, config_.goal_m, kGoalApproach_m)) {
+      path = planning::PlanPath(grid, here, *near, config_.algorithm);
+    }
+  }
+  if (!path) {
     stop.plan_error = path.error().message;
+    return;
+  }
+  // How far the plan runs over ground the laser has seen (the robot's own cells count).
+  stop.plan_known_m = 0;
+  for (std::size_t i = 1; i < path->waypoints.size(); ++i) {
+    const planning::Waypoint& w = path->waypoints[i];
+    const mapping::CellIndex c = grid.geometry.IndexOf(w.x_m, w.y_m);
+    if (!std::isfinite(grid.z_m[grid.geometry.Linear(c)])) break;
+    const planning::Waypoint& v = path->waypoints[i - 1];
+    stop.plan_known_m += std::hypot(w.x_m - v.x_m, w.y_m - v.y_m);
+  }
+  stop.plan = std::move(*path);
+}
+
+// Heading of the path just after arc length `arc_m` (looking one metre on).
+double PathHeading(const planning::Path& path, double arc_m) {
+  const std::vector<Eigen::Vector2d> upto = PathPrefix(path, arc_m);
+  const std::vector<Eigen::Vector2d> beyond = PathPrefix(path, arc_m + 1.0);
+  const Eigen::Vector2d d = beyond.back() - upto.back();
+  if (d.norm() > 1e-6) return std::atan2(d.y(), d.x());
+  const Eigen::Vector2d e = upto.back() - upto.front();
+  return std::atan2(e.y(), e.x());
+}
+
+bool Mission::Drive(const StopRecord& stop) {
+  const planning::Path& path = *stop.plan;
+  // Drive over what was seen, stopping short of the first unobserved cell; when that is too
+  // close, only turn to face the path so the next scan sees it (once: then drive a little).
+  double length = std::min(config_.drive_per_stop_m, stop.plan_known_m - config_.unknown_margin_m);
+  const bool turn_only = length < config_.unknown_margin_m && !last_stop_turned_only_;
+  if (!turn_only) length = std::max(length, std::min(config_.drive_per_stop_m, 1.0));
+  last_stop_turned_only_ = turn_only;
+  if (!turn_only && !Follow(PathPrefix(path, length))) return false;
+  if (!TurnTo(PathHeading(path, turn_only ? 0.0 : length))) return false;
+  Result<sensors::Odometry> stopped = base_.Drive(0.0, 0.0, kStopTime_s);
+  if (!stopped) {
+    result_.reason = "base: " + stopped.error().message;
+    return false;
+  }
+  return true;
+}
+
+bool Mission::Rebase() {
+  Result<sensors::Odometry> odo = base_.ReadOdometry();
+  if (!odo) {
+    result_.reason = "base: " + odo.error().message;
+    return false;
+  }
+  T_world_map_ = T_world_base_ = Estimate(*odo);
+  odo_ref_ = *odo;
+  return true;
+}
+
+bool Mission::TurnTo(double yaw_rad) {
+  const double start_s = probes_.now_s();
+  while (true) {
+    if (OverBudget()) return false;
+    Result<sensors::Odometry> odo = base_.ReadOdometry();
+    if (!odo) {
+      result_.reason = "base: " + odo.error().message;
+      return false;
+    }
+    const double error = std::remainder(yaw_rad - Yaw(Estimate(*odo)), 2.0 * kPi);
+    if (std::abs(error) < kHeadingTolerance_rad) return true;
+    if (probes_.now_s() - start_s > config_.stuck_timeout_s) {
+      result_.reason = "stuck: cannot turn to " + std::to_string(yaw_rad * 180 / kPi) + " deg";
+      return false;
+    }
+    const double omega = std::clamp(kTurnGain_per_s * error, -config_.follower.max_yaw_rate_rps,
+                                    config_.follower.max_yaw_rate_rps);
+    Result<sensors::Odometry> next = base_.Drive(0.0, omega, config_.control_period_s);
+    if (!next) {
+      result_.reason = "base: " + next.error().message;
+      return false;
+    }
+    RecordSample(*next);
   }
 }
 
-bool Mission::Drive(const planning::Path& path) {
-  PurePursuit follower(PathPrefix(path, config_.drive_per_stop_m), config_.follower);
-  const sensors::Odometry start = odo_ref_;
+void Mission::RecordSample(const sensors::Odometry& odo) {
+  TrajectorySample sample{probes_.now_s(), Estimate(odo), std::nullopt};
+  if (probes_.true_pose) sample.T_world_base_true = probes_.true_pose();
+  result_.trajectory.push_back(sample);
+}
+
+bool Mission::Follow(const std::vector<Eigen::Vector2d>& prefix) {
+  PurePursuit follower(prefix, config_.follower);
   sensors::Odometry odo = odo_ref_;
+  if (Result<sensors::Odometry> now = base_.ReadOdometry(); now) odo = *now;
   Eigen::Vector2d progress_xy(odo.x_m, odo.y_m);
   double progress_s = probes_.now_s();
   while (true) {
     if (OverBudget()) return false;
-    const Eigen::Isometry3d T_est = Propagate(T_world_base_, start, odo);
+    const Eigen::Isometry3d T_est = Estimate(odo);
     const DriveCommand cmd =
         follower.Command(T_est.translation().x(), T_est.translation().y(), Yaw(T_est));
-    if (cmd.done) break;
+    if (cmd.done) return true;
     Result<sensors::Odometry> next = base_.Drive(cmd.v_mps, cmd.omega_rps, config_.control_period_s);
     if (!next) {
       result_.reason = "base: " + next.error().message;
@@ -240,9 +366,7 @@ bool Mission::Drive(const planning::Path& path) {
     }
     result_.odometry_distance_m += std::hypot(next->x_m - odo.x_m, next->y_m - odo.y_m);
     odo = *next;
-    TrajectorySample sample{probes_.now_s(), Propagate(T_world_base_, start, odo), std::nullopt};
-    if (probes_.true_pose) sample.T_world_base_true = probes_.true_pose();
-    result_.trajectory.push_back(sample);
+    RecordSample(odo);
     if (probes_.tilt_rad) {
       const double tilt = probes_.tilt_rad();
       result_.max_tilt_rad = std::max(result_.max_tilt_rad, tilt);
@@ -259,12 +383,6 @@ bool Mission::Drive(const planning::Path& path) {
       return false;
     }
   }
-  Result<sensors::Odometry> stopped = base_.Drive(0.0, 0.0, kStopTime_s);
-  if (!stopped) {
-    result_.reason = "base: " + stopped.error().message;
-    return false;
-  }
-  return true;
 }
 
 }  // namespace

@@ -30,7 +30,10 @@ struct MissionConfig {
   double stuck_timeout_s = 8.0;    ///< no progress while commanded for this long: stuck [s]
   double control_period_s = 0.1;   ///< path follower rate [s]
   /// Clearance kept beyond the robot's half width when planning, for tracking error [m].
-  double safety_margin_m = 0.1;
+  double safety_margin_m = 0.05;
+  /// The robot stops this far before the first unobserved cell of its plan, turns to face it and
+  /// scans: it never drives blind into ground its laser has not seen [m].
+  double unknown_margin_m = 0.5;
   PurePursuitConfig follower;
   planning::PlannerConfig planner;
   planning::Algorithm algorithm = planning::Algorithm::kAStar;
@@ -58,6 +61,9 @@ struct StopRecord {
   std::optional<Eigen::Isometry3d> T_world_base_true;                  ///< simulation only
   std::optional<planning::Path> plan;  ///< to the goal, world frame
   std::string plan_error;              ///< why there was no plan
+  double plan_known_m = 0;             ///< length of the plan over observed cells [m]
+  bool elevation_from_odometry = false;  ///< registration failed: the scan entered the elevation
+                                         ///< map at the odometry pose
   double distance_to_goal_m = 0;       ///< from the estimate [m]
 };
 

@@ -10,6 +10,8 @@ namespace pitchlab::apps {
 namespace {
 
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+constexpr double kMissionMinInlierRatio = 0.15;
+constexpr double kMissionUnknownPenalty = 5.0;
 
 void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettings& s) {
   if (!node) return;
@@ -19,7 +21,8 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
       {"goal_tolerance_m", &m.goal_tolerance_m}, {"drive_per_stop_m", &m.drive_per_stop_m},
       {"time_budget_s", &m.time_budget_s},       {"max_tilt_deg", &m.max_tilt_deg},
       {"stuck_timeout_s", &m.stuck_timeout_s},   {"control_period_s", &m.control_period_s},
-      {"cell_m", &s.cell_m},                     {"safety_margin_m", &m.safety_margin_m},                     {"lookahead_m", &m.follower.lookahead_m},
+      {"cell_m", &s.cell_m},                     {"safety_margin_m", &m.safety_margin_m},
+      {"unknown_margin_m", &m.unknown_margin_m},                     {"lookahead_m", &m.follower.lookahead_m},
       {"max_speed_mps", &m.follower.max_speed_mps},
       {"max_yaw_rate_rps", &m.follower.max_yaw_rate_rps}};
   for (const auto& kv : node) {
@@ -60,8 +63,12 @@ RunSettings ParseRunSettings(const std::string& yaml_text, const std::string& so
   MissionConfig& m = s.mission;
   // The mission explores: unknown cells are allowed at a price, not forbidden.
   m.planner.unknown = planning::UnknownPolicy::kPenalise;
+  m.planner.unknown_penalty = kMissionUnknownPenalty;  // prefer ground that has been seen
   m.planner.robot =
       planning::RobotLimits::Preset(model == sim::P3Model::kP3AT ? "p3at" : "p3dx");
+  // Scan-to-map after a 4 m drive sees much new ground: accept a smaller overlapping share
+  // than the pairwise default unless the config says otherwise.
+  m.registration.registration.min_inlier_ratio = kMissionMinInlierRatio;
   YAML::Node root;
   try {
     root = yaml_text.empty() ? YAML::Node() : YAML::Load(yaml_text);
@@ -72,13 +79,17 @@ RunSettings ParseRunSettings(const std::string& yaml_text, const std::string& so
     ReadRunSection(root["run"], source, s);
     if (root["planner"]) {
       const planning::UnknownPolicy policy = m.planner.unknown;
+      const double penalty = m.planner.unknown_penalty;
       const planning::RobotLimits robot = m.planner.robot;
       m.planner = planning::ParsePlannerConfig(YAML::Dump(root["planner"]), source + ": planner");
       // Keys the section leaves out keep the run's defaults, not the planner tool's.
       if (!root["planner"]["unknown"]) m.planner.unknown = policy;
+      if (!root["planner"]["unknown_penalty"]) m.planner.unknown_penalty = penalty;
       if (!root["planner"]["robot"]) m.planner.robot = robot;
     }
+    const bool has_ratio = root["registration"] && root["registration"]["min_inlier_ratio"];
     m.registration.registration = mapping::ParseRegistrationConfig(yaml_text, source);
+    if (!has_ratio) m.registration.registration.min_inlier_ratio = kMissionMinInlierRatio;
   }
   m.follower.Validate();
   return s;
@@ -99,6 +110,7 @@ std::string RunSettingsToYaml(const RunSettings& s) {
      << "  control_period_s: " << m.control_period_s << "\n"
      << "  cell_m: " << s.cell_m << "\n"
      << "  safety_margin_m: " << m.safety_margin_m << "\n"
+     << "  unknown_margin_m: " << m.unknown_margin_m << "\n"
      << "  algorithm: " << planning::ToString(m.algorithm) << "\n"
      << "  lookahead_m: " << m.follower.lookahead_m << "\n"
      << "  max_speed_mps: " << m.follower.max_speed_mps << "\n"

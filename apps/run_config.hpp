@@ -11,7 +11,7 @@ namespace pitchlab::apps {
 
 struct RunSettings {
   MissionConfig mission;  ///< goal, map_area and mount are filled in by the caller
-  double cell_m = 0.2;    ///< elevation map and planning grid [m]
+  double cell_m = 0.1;    ///< elevation map and planning grid [m]
 };
 
 /// Reads `run`, `planner` and `registration` from `yaml_text` (empty: defaults) for a robot of

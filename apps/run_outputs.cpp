@@ -119,6 +119,7 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
   nlohmann::json j = {{"stop", stop.index},
                       {"stamp_s", stop.stamp_s},
                       {"merged", stop.merge.merged},
+                      {"elevation_from_odometry", stop.elevation_from_odometry},
                       {"success", reg.success},
                       {"reason", reg.reason},
                       {"path", mapping::ToString(reg.path)},

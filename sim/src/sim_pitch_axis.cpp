@@ -19,7 +19,9 @@ Result<double> SimPitchAxis::MoveTo(double pitch_rad, std::chrono::milliseconds 
   const double from = sim_.pitch_setpoint_rad();
   const double move_s = model_.MoveTime(from, target);
   const double speed_rps = model_.config().max_speed_dps * M_PI / 180.0;
-  const double half_count = M_PI / model_.config().encoder_counts_per_rev;
+  // Settled: within a quarter servo step and still. The encoder, not the setpoint, goes into
+  // Eq. 1, so a small steady-state error (gravity on a tilted robot) costs nothing.
+  const double tolerance = 0.25 * model_.config().step_deg * M_PI / 180.0;
   const double t0 = sim_.time_s(), timeout_s = timeout.count() / 1000.0;
   while (true) {
     // The servo's setpoint slews at its rated speed; MuJoCo's actuator follows.
@@ -30,7 +32,7 @@ Result<double> SimPitchAxis::MoveTo(double pitch_rad, std::chrono::milliseconds 
     // equal target in floating point.
     sim_.SetPitchSetpoint(slewing ? from + std::copysign(travelled, target - from) : target,
                           slewing ? std::copysign(speed_rps, target - from) : 0.0);
-    const bool there = std::abs(sim_.pitch_rad() - target) < half_count &&
+    const bool there = std::abs(sim_.pitch_rad() - target) < tolerance &&
                        std::abs(sim_.pitch_rate_rps()) < kStillRate_rps;
     if (elapsed >= move_s && there && sim_.pitch_setpoint_rad() == target) break;
     if (elapsed > timeout_s) {

@@ -75,10 +75,10 @@ void AddSteepFeatures(const TerrainConfig& c, SplitMix64& rng, HeightGrid& grid)
                   [=](double d) { return std::max(0.0, ridge_height_m - d * tan_slope); });
 }
 
-// Blends the surface to the origin's height within the pad (full) and a 3 m rim (smoothstep).
+// Blends the surface to the origin's height within the pad (full) and an 8 m rim (smoothstep).
 void FlattenStartPad(const TerrainConfig& c, HeightGrid& grid) {
   const double pad_height = grid.HeightBilinear(0.0, 0.0);
-  const double rim_m = 3.0;
+  const double rim_m = 8.0;  // wide enough that the blend is no steeper than the hills
   for (int iy = 0; iy < grid.ny; ++iy) {
     for (int ix = 0; ix < grid.nx; ++ix) {
       const double r = std::hypot(grid.x0_m + ix * grid.cell_m, grid.y0_m + iy * grid.cell_m);
@@ -121,6 +121,8 @@ std::filesystem::path GenerateTerrainWorld(const TerrainConfig& config,
   metadata.bounds = Bounds2d{grid.x0_m + margin_m, grid.y0_m + margin_m, grid.XMax_m() - margin_m,
                              grid.YMax_m() - margin_m};
   metadata.default_start = StartPose{0.0, 0.0, 0.0};
+  // The default run: 35 m north-west, past the butte and over rougher ground.
+  metadata.default_goal = GoalPoint{-25.0, 25.0};
   std::filesystem::create_directories(out_dir);
   const std::filesystem::path xml = out_dir / "terrain.xml";
   WriteHeightfieldWorld(grid, metadata,

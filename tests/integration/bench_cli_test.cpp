@@ -1,0 +1,208 @@
+// `pitchlab bench` end to end in the small yard world: shards cover a sweep exactly once and
+// merge to the unsharded summary, a failing run is recorded while the others finish, a killed or
+// re-run sweep resumes, and bad input fails before any run starts.
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace pitchlab {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const fs::path kYard = fs::path(PITCHLAB_SOURCE_DIR) / "tests/data/worlds/yard.xml";
+
+std::string Slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+std::vector<json> Records(const fs::path& bench_dir) {
+  std::vector<json> records;
+  std::istringstream in(Slurp(bench_dir / "runs.jsonl"));
+  for (std::string line; std::getline(in, line);) records.push_back(json::parse(line));
+  return records;
+}
+
+std::multiset<std::string> RunIds(const std::vector<json>& records) {
+  std::multiset<std::string> ids;
+  for (const json& r : records) {
+    ids.insert(r["world"].get<std::string>() + "-s" + std::to_string(r["seed"].get<int>()));
+  }
+  return ids;
+}
+
+struct CliResult {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+class BenchCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = fs::temp_directory_path() / ("pitchlab_bench_cli_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
+
+  static CliResult Exec(const std::string& args) {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const int status = std::system(
+        (std::string(PITCHLAB_CLI) + " bench " + args + " >" + out.string() + " 2>" + err.string())
+            .c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(out), Slurp(err)};
+  }
+  static fs::path dir_;
+};
+fs::path BenchCli::dir_;
+
+// The counts of a summary row, without the timings that differ from sweep to sweep.
+json Counts(const json& row) {
+  return {{"world", row["world"]},
+          {"runs", row["runs"]},
+          {"successes", row["successes"]},
+          {"failures", row["failures"]},
+          {"failure_reasons", row["failure_reasons"]}};
+}
+
+TEST_F(BenchCli, ShardsCoverEveryRunOnceAndMergeToTheUnshardedSummary) {
+  const std::string sweep = "--worlds " + kYard.string() + " --seeds 1..3 --jobs 2 --json";
+  const CliResult whole = Exec(sweep + " --out " + (dir_ / "whole").string());
+  ASSERT_EQ(whole.exit_code, 0) << whole.err;
+  const json summary = json::parse(whole.out);
+  EXPECT_EQ(summary, json::parse(Slurp(dir_ / "whole/summary.json")));
+  EXPECT_EQ(summary["total"]["runs"], 3);
+  EXPECT_EQ(summary["total"]["successes"], 3) << Slurp(dir_ / "whole/runs.jsonl");
+  EXPECT_NE(whole.err.find("run 3 of 3: yard seed"), std::string::npos) << whole.err;
+
+  const std::vector<json> all = Records(dir_ / "whole");
+  ASSERT_EQ(all.size(), 3u);
+  for (const json& r : all) {
+    EXPECT_EQ(r["exit_code"], 0);
+    EXPECT_EQ(r["reason"], "goal reached");
+    EXPECT_GT(r["sim_time_s"].get<double>(), 0.0);
+    EXPECT_GT(r["distance_m"].get<double>(), 11.0);
+    EXPECT_TRUE(r["final_pose_error_m"].is_number());
+    EXPECT_TRUE(r["max_registration_error_m"].is_number());
+    EXPECT_TRUE(r["cost_ratio"].is_number());
+    EXPECT_TRUE(fs::exists(dir_ / "whole" / r["run_dir"].get<std::string>() / "metrics.json"));
+  }
+
+  for (const char* shard : {"1/2", "2/2"}) {
+    const std::string out = (dir_ / ("shard" + std::string(1, shard[0]))).string();
+    const CliResult r = Exec(sweep + " --shard " + shard + " --out " + out);
+    ASSERT_EQ(r.exit_code, 0) << shard << ": " << r.err;
+  }
+  const std::vector<json> one = Records(dir_ / "shard1"), two = Records(dir_ / "shard2");
+  EXPECT_EQ(one.size(), 2u);  // runs 0 and 2 of the list
+  EXPECT_EQ(two.size(), 1u);  // run 1
+  std::vector<json> both = one;
+  both.insert(both.end(), two.begin(), two.end());
+  EXPECT_EQ(RunIds(both), RunIds(all));  // every run exactly once
+
+  const CliResult merged =
+      Exec("--summarize --json " + (dir_ / "shard1").string() + " " + (dir_ / "shard2").string());
+  ASSERT_EQ(merged.exit_code, 0) << merged.err;
+  const json m = json::parse(merged.out);
+  ASSERT_EQ(m["worlds"].size(), summary["worlds"].size());
+  EXPECT_EQ(Counts(m["worlds"][0]), Counts(summary["worlds"][0]));
+  EXPECT_EQ(Counts(m["total"]), Counts(summary["total"]));
+
+  // A re-run of a finished shard skips what runs.jsonl already records.
+  const CliResult again = Exec(sweep + " --shard 1/2 --out " + (dir_ / "shard1").string());
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(Records(dir_ / "shard1").size(), 2u);
+  EXPECT_NE(again.err.find("2 already recorded"), std::string::npos) << again.err;
+}
+
+TEST_F(BenchCli, FailingRunsAreRecordedWithTheirReasonAndTheOthersFinish) {
+  // A copy of the yard without a default goal: `pitchlab run` refuses it, exit 2, no folder.
+  std::string no_goal = Slurp(kYard);
+  const auto line = no_goal.find("<numeric name=\"pitchlab:default_goal\"");
+  ASSERT_NE(line, std::string::npos);
+  no_goal.erase(line, no_goal.find('\n', line) - line);
+  std::ofstream(dir_ / "nogoal.xml") << no_goal;
+
+  const CliResult r = Exec("--quiet --worlds " + (dir_ / "nogoal.xml").string() + "," +
+                           kYard.string() + " --seeds 4 --out " + (dir_ / "mixed").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::map<std::string, json> by_world;
+  for (const json& rec : Records(dir_ / "mixed")) by_world[rec["world"]] = rec;
+  ASSERT_EQ(by_world.size(), 2u);
+  EXPECT_FALSE(by_world["nogoal"]["success"].get<bool>());
+  EXPECT_EQ(by_world["nogoal"]["exit_code"], 2);
+  EXPECT_NE(by_world["nogoal"]["reason"].get<std::string>().find("no default goal"),
+            std::string::npos)
+      << by_world["nogoal"];
+  EXPECT_TRUE(by_world["yard"]["success"].get<bool>()) << by_world["yard"];
+
+  // A mission that fails inside the run: its folder and metrics exist, the reason is the run's.
+  std::ofstream(dir_ / "budget.yaml") << "run: {time_budget_s: 1}\n";
+  const CliResult budget =
+      Exec("--quiet --worlds " + kYard.string() + " --seeds 1 --config " +
+           (dir_ / "budget.yaml").string() + " --out " + (dir_ / "budget").string());
+  ASSERT_EQ(budget.exit_code, 0) << budget.err;
+  const json spent = Records(dir_ / "budget").at(0);
+  EXPECT_FALSE(spent["success"].get<bool>());
+  EXPECT_EQ(spent["exit_code"], 1);
+  EXPECT_NE(spent["reason"].get<std::string>().find("time budget"), std::string::npos) << spent;
+  EXPECT_TRUE(fs::exists(dir_ / "budget/runs/yard-s1/metrics.json"));
+
+  // A run over its wall-time limit is killed; no half-written folder is left behind.
+  const CliResult slow =
+      Exec("--quiet --worlds " + kYard.string() + " --seeds 1,2 --jobs 2 --timeout-s 0.2 --out " +
+           (dir_ / "slow").string());
+  ASSERT_EQ(slow.exit_code, 0) << slow.err;
+  for (const json& rec : Records(dir_ / "slow")) {
+    EXPECT_FALSE(rec["success"].get<bool>());
+    EXPECT_NE(rec["reason"].get<std::string>().find("timeout"), std::string::npos) << rec;
+  }
+  EXPECT_TRUE(fs::is_empty(dir_ / "slow/runs"));
+}
+
+struct BadBench {
+  std::string args, message;
+};
+
+TEST_F(BenchCli, BadInputGivesAClearErrorBeforeAnyRunStarts) {
+  std::ofstream(dir_ / "bad.yaml") << "run: {drive_per_stop_m: -1}\n";
+  const std::string yard = " --worlds " + kYard.string();
+  const BadBench cases[] = {
+      {yard + " --seeds 1..2 --shard 3/2", "need 1 <= K <= N"},
+      {yard + " --seeds 1..2 --shard 0/2", "need 1 <= K <= N"},
+      {yard + " --seeds 1..2 --shard 2", "not K/N"},
+      {yard + " --seeds 5..1", "is empty"},
+      {yard + " --seeds 1,x", "not a whole number"},
+      {yard + " --seeds 1,1", "twice"},
+      {" --worlds " + kYard.string() + ",atlantis --seeds 1", "unknown world 'atlantis'"},
+      {yard + " --seeds 1 --jobs 0", "--jobs"},
+      {yard + " --seeds 1 --config " + (dir_ / "bad.yaml").string(), "drive_per_stop_m"},
+  };
+  for (const BadBench& c : cases) {
+    const CliResult r = Exec(c.args + " --out " + (dir_ / "never").string());
+    EXPECT_EQ(r.exit_code, 2) << c.args;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << " said: " << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "never")) << c.args;
+  }
+  const CliResult missing = Exec("--summarize " + (dir_ / "nowhere").string());
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("no runs.jsonl"), std::string::npos) << missing.err;
+}
+
+}  // namespace
+}  // namespace pitchlab
