@@ -18,6 +18,8 @@ int RunPlan(int argc, char** argv);
 int RunRun(int argc, char** argv);
 /// `pitchlab hw`: emulate devices on ptys driven by the simulator; read an LMS200.
 int RunHw(int argc, char** argv);
+/// `pitchlab bench`: a sweep of runs (worlds x seeds), each isolated, sharded, summarized.
+int RunBench(int argc, char** argv);
 /// `pitchlab worlds`: the built-in worlds and their metadata.
 int RunWorlds(int argc, char** argv);
 

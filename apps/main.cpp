@@ -19,6 +19,7 @@ struct Command {
 
 constexpr Command kCommands[] = {
     {"run", pitchlab::apps::RunRun, "closed-loop stop-scan-go mission, scored, with a report"},
+    {"bench", pitchlab::apps::RunBench, "sweep of runs over worlds x seeds: isolated, sharded, summarized"},
     {"scan", pitchlab::apps::RunScan, "one full 3D scan of a world, written as PCD"},
     {"register", pitchlab::apps::RunRegister, "align two scans (Algorithm 1), result as JSON"},
     {"merge", pitchlab::apps::RunMerge, "merge a scan sequence into one map cloud + trajectory"},
