@@ -13,7 +13,7 @@ namespace {
 // Top-level sections any pitchlab module reads; anything else is a typo worth an error.
 const std::set<std::string> kSections = {"seed",     "robot",      "odometry",     "lms200",
                                          "pitch_unit", "scan",     "mount",        "registration",
-                                         "elevation", "planner",   "run"};
+                                         "elevation", "planner",   "run",          "backend",   "hw"};
 
 std::string ReadFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

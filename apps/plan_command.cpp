@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_args.hpp"
+#include "run_folder.hpp"
 #include "commands.hpp"
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/planning/path_io.hpp"
@@ -20,35 +21,6 @@ namespace pitchlab::apps {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
-
-// The output folder is filled as a hidden sibling (".NAME.partial") and its files are moved in
-// only once all are written: a failure part way leaves no half-written folder behind.
-class StagedFolder {
- public:
-  explicit StagedFolder(const std::filesystem::path& out) : out_(out.lexically_normal()) {
-    if (!out_.has_filename()) out_ = out_.parent_path();
-    stage_ = out_.parent_path() / ("." + out_.filename().string() + ".partial");
-    std::filesystem::remove_all(stage_);
-    std::filesystem::create_directories(stage_);
-  }
-  StagedFolder(const StagedFolder&) = delete;
-  StagedFolder& operator=(const StagedFolder&) = delete;
-  ~StagedFolder() {
-    std::error_code ignored;
-    std::filesystem::remove_all(stage_, ignored);
-  }
-  /// Where to write a file of the folder now.
-  std::filesystem::path operator/(const std::string& name) const { return stage_ / name; }
-  /// Moves every file into the output folder (created; files of the same name replaced).
-  void Commit() const {
-    std::filesystem::create_directories(out_);
-    for (const auto& e : std::filesystem::directory_iterator(stage_))
-      std::filesystem::rename(e.path(), out_ / e.path().filename());
-  }
-
- private:
-  std::filesystem::path out_, stage_;
-};
 
 CliArgs PlanArgs() {
   CliArgs args(

@@ -13,6 +13,7 @@
 #include "app_config.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
+#include "hw_backend.hpp"
 #include "mission.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/elevation_truth.hpp"
@@ -45,6 +46,8 @@ CliArgs RunArgs() {
       .Option("seed", "N", "seed of every random source, overrides the config's seed")
       .Option("config", "FILE.yaml", "configuration (see README)")
       .Option("out", "DIR", "run folder to create (default: runs/<world>-s<seed>-<time>)")
+      .Option("backend", "sim|hw", "sim (default) or hw: the real devices of the config's `hw` "
+              "section (`run --backend hw --help`), overrides the config's backend")
       .Flag("json", "print metrics.json on stdout at the end")
       .Flag("quiet", "no progress on stderr");
   return args;
@@ -70,6 +73,8 @@ worlds::WorldMetadata LoadMetadata(const std::filesystem::path& world) {
 }  // namespace
 
 int RunRun(int argc, char** argv) {
+  // backend: hw (config or --backend): the same mission over the hardware drivers.
+  if (SelectedBackend(argc, argv) == Backend::kHw) return RunHwMission(argc, argv);
   const auto wall_start = std::chrono::steady_clock::now();
   CliArgs args = RunArgs();
   if (!args.Parse(argc, argv)) return 0;

@@ -47,6 +47,23 @@ void RunFolder::Commit() {
   committed_ = true;
 }
 
+StagedFolder::StagedFolder(const fs::path& out) : out_(out.lexically_normal()) {
+  if (!out_.has_filename()) out_ = out_.parent_path();
+  stage_ = out_.parent_path() / ("." + out_.filename().string() + ".partial");
+  fs::remove_all(stage_);
+  fs::create_directories(stage_);
+}
+
+StagedFolder::~StagedFolder() {
+  std::error_code ignored;
+  fs::remove_all(stage_, ignored);
+}
+
+void StagedFolder::Commit() const {
+  fs::create_directories(out_);
+  for (const auto& e : fs::directory_iterator(stage_)) fs::rename(e.path(), out_ / e.path().filename());
+}
+
 void WriteTextFile(const fs::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);
   out << text;

@@ -28,6 +28,25 @@ class RunFolder {
   bool committed_ = false;
 };
 
+/// The output folder of a tool that may write into an existing folder (map, plan): files are
+/// written into a hidden sibling (".NAME.partial") and moved in only when all are written, so a
+/// failure part way leaves neither a half-written folder nor half of a file set.
+class StagedFolder {
+ public:
+  explicit StagedFolder(const std::filesystem::path& out);  ///< throws std::filesystem_error
+  ~StagedFolder();  ///< removes the staging folder
+  StagedFolder(const StagedFolder&) = delete;
+  StagedFolder& operator=(const StagedFolder&) = delete;
+
+  /// Where to write the file `name` now.
+  std::filesystem::path operator/(const std::string& name) const { return stage_ / name; }
+  /// Moves every file into the output folder (created; files of the same name replaced).
+  void Commit() const;
+
+ private:
+  std::filesystem::path out_, stage_;
+};
+
 /// Writes `text` to `path` (the folder exists); throws std::runtime_error naming the path.
 void WriteTextFile(const std::filesystem::path& path, const std::string& text);
 /// Reads a whole file; throws std::runtime_error naming the path.
