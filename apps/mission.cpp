@@ -82,7 +82,7 @@ class Mission {
   bool Follow(const std::vector<Eigen::Vector2d>& prefix);
   bool TurnTo(double yaw_rad);
   bool Rebase();  // the map frame = base_link where the robot is now (before the first scan)
-  void RecordSample(const sensors::Odometry& odo);
+  bool RecordSample(const sensors::Odometry& odo);  // false: tipping over (reason set)
   Eigen::Isometry3d Estimate(const sensors::Odometry& odo) const {
     return Propagate(T_world_base_, odo_ref_, odo);
   }
@@ -337,14 +337,20 @@ bool Mission::TurnTo(double yaw_rad) {
       result_.reason = "base: " + next.error().message;
       return false;
     }
-    RecordSample(*next);
+    if (!RecordSample(*next)) return false;
   }
 }
 
-void Mission::RecordSample(const sensors::Odometry& odo) {
+bool Mission::RecordSample(const sensors::Odometry& odo) {
   TrajectorySample sample{probes_.now_s(), Estimate(odo), std::nullopt};
   if (probes_.true_pose) sample.T_world_base_true = probes_.true_pose();
   result_.trajectory.push_back(sample);
+  if (!probes_.tilt_rad) return true;
+  const double tilt = probes_.tilt_rad();
+  result_.max_tilt_rad = std::max(result_.max_tilt_rad, tilt);
+  if (tilt <= config_.max_tilt_deg * kPi / 180) return true;
+  result_.reason = "tipping over: tilt " + std::to_string(tilt * 180 / kPi) + " deg";
+  return false;
 }
 
 bool Mission::Follow(const std::vector<Eigen::Vector2d>& prefix) {
@@ -366,15 +372,7 @@ bool Mission::Follow(const std::vector<Eigen::Vector2d>& prefix) {
     }
     result_.odometry_distance_m += std::hypot(next->x_m - odo.x_m, next->y_m - odo.y_m);
     odo = *next;
-    RecordSample(odo);
-    if (probes_.tilt_rad) {
-      const double tilt = probes_.tilt_rad();
-      result_.max_tilt_rad = std::max(result_.max_tilt_rad, tilt);
-      if (tilt > config_.max_tilt_deg * kPi / 180) {
-        result_.reason = "tipping over: tilt " + std::to_string(tilt * 180 / kPi) + " deg";
-        return false;
-      }
-    }
+    if (!RecordSample(odo)) return false;
     if ((Eigen::Vector2d(odo.x_m, odo.y_m) - progress_xy).norm() > kMinProgress_m) {
       progress_xy = Eigen::Vector2d(odo.x_m, odo.y_m);
       progress_s = probes_.now_s();

