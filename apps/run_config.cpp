@@ -80,12 +80,13 @@ RunSettings ParseRunSettings(const std::string& yaml_text, const std::string& so
     if (root["planner"]) {
       const planning::UnknownPolicy policy = m.planner.unknown;
       const double penalty = m.planner.unknown_penalty;
-      const planning::RobotLimits robot = m.planner.robot;
-      m.planner = planning::ParsePlannerConfig(YAML::Dump(root["planner"]), source + ": planner");
-      // Keys the section leaves out keep the run's defaults, not the planner tool's.
-      if (!root["planner"]["unknown"]) m.planner.unknown = policy;
-      if (!root["planner"]["unknown_penalty"]) m.planner.unknown_penalty = penalty;
-      if (!root["planner"]["robot"]) m.planner.robot = robot;
+      // Keys the section leaves out keep the run's defaults, not the planner tool's: the robot's
+      // preset first (its limits may then be overridden one by one), the unknown-cell policy.
+      YAML::Node section = YAML::Clone(root["planner"]);
+      if (!section["robot"]) section["robot"] = m.planner.robot.name;
+      m.planner = planning::ParsePlannerConfig(YAML::Dump(section), source + ": planner");
+      if (!section["unknown"]) m.planner.unknown = policy;
+      if (!section["unknown_penalty"]) m.planner.unknown_penalty = penalty;
     }
     const bool has_ratio = root["registration"] && root["registration"]["min_inlier_ratio"];
     m.registration.registration = mapping::ParseRegistrationConfig(yaml_text, source);

@@ -1,0 +1,54 @@
+#include "run_config.hpp"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+namespace pitchlab::apps {
+namespace {
+
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+TEST(RunSettings, DefaultsExploreWithTheRobotsPreset) {
+  const RunSettings s = ParseRunSettings("", "test", sim::P3Model::kP3DX);
+  EXPECT_EQ(s.mission.planner.robot.name, "p3dx");
+  EXPECT_EQ(s.mission.planner.unknown, planning::UnknownPolicy::kPenalise);
+  EXPECT_GT(s.mission.planner.unknown_penalty, 1.0);
+}
+
+TEST(RunSettings, APlannerLimitOverridesOnlyThatLimitOfThePreset) {
+  const RunSettings s =
+      ParseRunSettings("planner: {max_inclination_deg: 17}\n", "test", sim::P3Model::kP3AT);
+  EXPECT_EQ(s.mission.planner.robot.name, "p3at");
+  EXPECT_NEAR(s.mission.planner.robot.max_inclination_rad, 17 * kDeg, 1e-9);
+  EXPECT_NEAR(s.mission.planner.robot.step_max_m, planning::RobotLimits::P3AT().step_max_m, 1e-12);
+  EXPECT_EQ(s.mission.planner.unknown, planning::UnknownPolicy::kPenalise);
+}
+
+TEST(RunSettings, RunKeysAreReadAndBadOnesNamed) {
+  const RunSettings s =
+      ParseRunSettings("run: {drive_per_stop_m: 2.5, cell_m: 0.2, algorithm: dijkstra}\n", "f.yaml",
+                       sim::P3Model::kP3AT);
+  EXPECT_EQ(s.mission.drive_per_stop_m, 2.5);
+  EXPECT_EQ(s.cell_m, 0.2);
+  EXPECT_EQ(s.mission.algorithm, planning::Algorithm::kDijkstra);
+  try {
+    ParseRunSettings("run: {drive_per_stop: 2}\n", "f.yaml", sim::P3Model::kP3AT);
+    FAIL() << "an unknown key was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("f.yaml: run.drive_per_stop"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(ParseRunSettings("run: {cell_m: 5}\n", "f.yaml", sim::P3Model::kP3AT),
+               std::invalid_argument);
+}
+
+TEST(RunSettings, WrittenYamlReadsBackTheSame) {
+  const RunSettings s = ParseRunSettings(
+      "run: {goal_tolerance_m: 0.3}\nplanner: {weights: {roughness: 5}}\n", "t",
+      sim::P3Model::kP3AT);
+  const RunSettings back = ParseRunSettings(RunSettingsToYaml(s), "back", sim::P3Model::kP3AT);
+  EXPECT_EQ(RunSettingsToYaml(back), RunSettingsToYaml(s));
+}
+
+}  // namespace
+}  // namespace pitchlab::apps
