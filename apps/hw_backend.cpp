@@ -114,7 +114,8 @@ std::string DefaultOut(std::uint64_t seed) {
 worlds::WorldMetadata LoadMetadata(const std::filesystem::path& world) {
   char error[1000] = "";
   mjModel* model = mj_loadXML(world.string().c_str(), nullptr, error, sizeof(error));
-  if (model == nullptr) throw std::runtime_error("cannot load world '" + world.string() + "': " + error);
+  if (model == nullptr)
+    throw std::runtime_error("cannot load world '" + world.string() + "': " + error);
   const worlds::WorldMetadata meta = worlds::ReadWorldMetadata(model);
   mj_deleteModel(model);
   return meta;
@@ -159,7 +160,8 @@ Frame MissionFrame(const CliArgs& args, const Eigen::Vector3d& start, double cel
     f.map_area = mapping::GridGeometry::Covering(Eigen::Vector2d(b.x_min_m, b.y_min_m),
                                                  Eigen::Vector2d(b.x_max_m, b.y_max_m), cell_m,
                                                  kMapMargin_m);
-    if (meta.default_goal) default_goal = Eigen::Vector2d(meta.default_goal->x_m, meta.default_goal->y_m);
+    if (meta.default_goal)
+      default_goal = Eigen::Vector2d(meta.default_goal->x_m, meta.default_goal->y_m);
     if (meta.geodetic_origin) {
       f.origin = mapping::GeodeticOrigin{meta.geodetic_origin->latitude_deg,
                                          meta.geodetic_origin->longitude_deg,
@@ -179,8 +181,8 @@ Frame MissionFrame(const CliArgs& args, const Eigen::Vector3d& start, double cel
     throw CliError("a hardware run needs --goal x,y (or a --world with a default goal)");
   }
   const mapping::GridGeometry& a = f.map_area;
-  for (const auto& [name, p] : {std::pair{"start", Eigen::Vector2d(start.head<2>())},
-                                std::pair{"goal", f.goal}}) {
+  for (const auto& [name, p] :
+       {std::pair{"start", Eigen::Vector2d(start.head<2>())}, std::pair{"goal", f.goal}}) {
     if (p.x() < a.x_min_m || p.x() > a.x_max_m() || p.y() < a.y_min_m || p.y() > a.y_max_m()) {
       throw std::runtime_error(std::string(name) + " (" + std::to_string(p.x()) + ", " +
                                std::to_string(p.y()) + ") is off the map: it spans x " +
@@ -312,27 +314,6 @@ std::string HwRigConfigToYaml(const hw::HwRigConfig& c) {
   return os.str();
 }
 
-std::pair<std::optional<double>, std::string> TakeMapSize(const std::string& yaml_text,
-                                                          const std::string& source) {
-  YAML::Node root = LoadYaml(yaml_text, source);
-  if (!root.IsMap() || !root["run"] || !root["run"].IsMap() || !root["run"]["map_size_m"]) {
-    return {std::nullopt, yaml_text};
-  }
-  double size_m = 0;
-  try {
-    size_m = root["run"]["map_size_m"].as<double>();
-  } catch (const YAML::Exception&) {
-    throw std::invalid_argument(source + ": run.map_size_m must be a number [m]");
-  }
-  if (!(size_m >= 2.0 && size_m <= 2000.0)) {
-    throw std::invalid_argument(source + ": run.map_size_m = " + std::to_string(size_m) +
-                                " is outside 2 .. 2000 m");
-  }
-  root["run"].remove("map_size_m");
-  if (root["run"].size() == 0) root.remove("run");
-  return {size_m, YAML::Dump(root)};
-}
-
 HwBackend StartHwBackend(const hw::HwRigConfig& config) {
   // One steady clock for line stamps, odometry and the mission (DESIGN.md: one stamp clock).
   const auto t0 = std::chrono::steady_clock::now();
@@ -354,31 +335,32 @@ int RunHwMission(int argc, char** argv) {
   if (!args.Parse(argc, argv)) return 0;
   const bool quiet = args.Flagged("quiet");
 
-  AppConfig config = LoadAppConfig(args.Has("config") ? std::optional(args.Get("config"))
-                                                      : std::nullopt);
+  AppConfig config =
+      LoadAppConfig(args.Has("config") ? std::optional(args.Get("config")) : std::nullopt);
   if (args.Has("seed")) {
     const std::vector<double> seed = args.GetNumbers("seed", 1);
-    if (seed[0] < 0 || seed[0] != std::floor(seed[0])) throw CliError("--seed must be an integer >= 0");
+    if (seed[0] < 0 || seed[0] != std::floor(seed[0]))
+      throw CliError("--seed must be an integer >= 0");
     config.seed = static_cast<std::uint64_t>(seed[0]);
   }
   if (args.Has("robot")) config.rig.robot.model = ParseRobotModel(args.Get("robot"));
   const std::string config_text =
       args.Has("config") ? ReadBinaryFile(args.Get("config")) : std::string();
-  const auto [map_size_m, run_text] = TakeMapSize(config_text, config.source);
-  RunSettings settings = ParseRunSettings(run_text, config.source, config.rig.robot.model);
+  RunSettings settings = ParseRunSettings(config_text, config.source, config.rig.robot.model);
   const hw::HwRigConfig hw_config = ParseHwRigConfig(config_text, config.source, config.sensors);
 
   const std::vector<double> s = args.GetNumbers("start", 3);
   const Eigen::Vector3d start(s[0], s[1], s[2] * kDegToRad);
-  const Frame frame = MissionFrame(args, start, settings.cell_m, map_size_m);
+  const Frame frame = MissionFrame(args, start, settings.cell_m, settings.map_size_m);
   MissionConfig& mission = settings.mission;
   mission.goal_m = frame.goal;
   mission.mount = config.rig.robot.mount;
   mission.map_area = frame.map_area;
 
   RunFolder folder(args.Has("out") ? args.Get("out") : DefaultOut(config.seed));
-  if (!quiet) std::fprintf(stderr, "run: opening %s, %s, %s\n", hw_config.lms200.device.c_str(),
-                           hw_config.pitch_unit.device.c_str(), hw_config.base->device.c_str());
+  if (!quiet)
+    std::fprintf(stderr, "run: opening %s, %s, %s\n", hw_config.lms200.device.c_str(),
+                 hw_config.pitch_unit.device.c_str(), hw_config.base->device.c_str());
   HwBackend backend = StartHwBackend(hw_config);
   Eigen::Isometry3d T_world_start = Eigen::Isometry3d::Identity();  // base_link on the ground
   T_world_start.translation() << start.x(), start.y(), 0.0;
@@ -405,11 +387,8 @@ int RunHwMission(int argc, char** argv) {
   context.start = start;
   context.goal = frame.goal;
   context.geodetic_origin = frame.origin;
-  std::string run_yaml = RunSettingsToYaml(settings);
-  if (map_size_m) {
-    run_yaml.replace(0, 5, "run:\n  map_size_m: " + std::to_string(*map_size_m) + "\n");
-  }
-  context.config_yaml = AppConfigToYaml(config) + run_yaml + HwRigConfigToYaml(hw_config);
+  context.config_yaml =
+      AppConfigToYaml(config) + RunSettingsToYaml(settings) + HwRigConfigToYaml(hw_config);
   context.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   WriteFinalOutputs(folder, context, result, std::nullopt, nullptr, std::nullopt);

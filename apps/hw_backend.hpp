@@ -8,8 +8,8 @@
 //   hw:
 //     lms200: {device: /dev/ttyUSB0, baud: 500000}   # + reply_timeout_ms, retries, reconnects,
 //                                                    #   continuous
-//     pitch_unit: {device: /dev/ttyUSB1, baud: 38400}  # + reply_timeout_ms, retries, poll_period_ms
-//     base: {device: /dev/ttyS0, baud: 9600}         # + max_v_mps, max_omega_rps,
+//     pitch_unit: {device: /dev/ttyUSB1, baud: 38400}  # + reply_timeout_ms, retries,
+//     poll_period_ms base: {device: /dev/ttyS0, baud: 9600}         # + max_v_mps, max_omega_rps,
 //                                                    #   sip_timeout_ms, sync_attempts
 //   run: {map_size_m: 60}   # the map: a square this wide around the start (without --world)
 
@@ -41,11 +41,6 @@ hw::HwRigConfig ParseHwRigConfig(const std::string& yaml_text, const std::string
 
 /// `backend: hw` and the `hw` section as YAML, readable back by ParseHwRigConfig.
 std::string HwRigConfigToYaml(const hw::HwRigConfig& config);
-
-/// `run.map_size_m` [m] (nullopt: absent) and `yaml_text` without that key, for the parts that
-/// do not know it. Throws std::invalid_argument naming `source` on a bad value or bad YAML.
-std::pair<std::optional<double>, std::string> TakeMapSize(const std::string& yaml_text,
-                                                          const std::string& source);
 
 /// The devices of a hardware run and what the mission reads besides them.
 struct HwBackend {

@@ -28,7 +28,12 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
   for (const auto& kv : node) {
     const std::string key = kv.first.as<std::string>();
     try {
-      if (key == "max_stops") {
+      if (key == "map_size_m") {
+        s.map_size_m = kv.second.as<double>();
+        if (!(*s.map_size_m >= 2.0 && *s.map_size_m <= 2000.0)) {
+          throw std::invalid_argument("= " + std::to_string(*s.map_size_m) + " is outside 2 .. 2000 m");
+        }
+      } else if (key == "max_stops") {
         m.max_stops = kv.second.as<int>();
       } else if (key == "algorithm") {
         m.algorithm = planning::ParseAlgorithm(kv.second.as<std::string>());
@@ -110,6 +115,7 @@ std::string RunSettingsToYaml(const RunSettings& s) {
      << "  stuck_timeout_s: " << m.stuck_timeout_s << "\n"
      << "  control_period_s: " << m.control_period_s << "\n"
      << "  cell_m: " << s.cell_m << "\n"
+     << (s.map_size_m ? "  map_size_m: " + std::to_string(*s.map_size_m) + "\n" : std::string())
      << "  safety_margin_m: " << m.safety_margin_m << "\n"
      << "  unknown_margin_m: " << m.unknown_margin_m << "\n"
      << "  algorithm: " << planning::ToString(m.algorithm) << "\n"
