@@ -9,10 +9,10 @@ namespace pitchlab::apps {
 CliArgs::CliArgs(std::string command, std::string summary)
     : command_(std::move(command)), summary_(std::move(summary)) {}
 
-CliArgs& CliArgs::Option(const std::string& name, const std::string& placeholder,
+CliArgs& CliArgs::Option(const std::string& name, const std::string& metavar,
                          const std::string& help, std::optional<std::string> default_value) {
   order_.push_back(name);
-  specs_[name] = Spec{placeholder, help, std::move(default_value), false};
+  specs_[name] = Spec{metavar, help, std::move(default_value), false};
   return *this;
 }
 
@@ -57,7 +57,7 @@ bool CliArgs::Parse(int argc, char** argv) {
       }
       if (!inline_value) {
         if (i + 1 >= argc) throw CliError("--" + name + " needs a value (" +
-                                          it->second.placeholder + ")");
+                                          it->second.metavar + ")");
         value = argv[++i];
       }
       values_[name] = value;
@@ -87,7 +87,7 @@ std::string CliArgs::Usage() const {
   for (const std::string& name : order_) {
     const Spec& s = specs_.at(name);
     os << "  --" << name;
-    if (!s.is_flag) os << " " << s.placeholder;
+    if (!s.is_flag) os << " " << s.metavar;
     os << "\n      " << s.help;
     if (s.default_value) os << " (default: " << *s.default_value << ")";
     os << "\n";
@@ -130,7 +130,7 @@ std::vector<double> CliArgs::GetNumbers(const std::string& name, std::size_t cou
   }
   if (numbers.size() != count) {
     throw CliError("--" + name + " '" + text + "' needs " + std::to_string(count) +
-                   " comma-separated numbers (" + specs_.at(name).placeholder + ")");
+                   " comma-separated numbers (" + specs_.at(name).metavar + ")");
   }
   return numbers;
 }

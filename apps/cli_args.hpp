@@ -20,8 +20,8 @@ class CliArgs {
  public:
   CliArgs(std::string command, std::string summary);
 
-  /// An option taking a value; `placeholder` is shown in --help (e.g. "x,y,yaw").
-  CliArgs& Option(const std::string& name, const std::string& placeholder, const std::string& help,
+  /// An option taking a value; `metavar` is shown in --help (e.g. "x,y,yaw").
+  CliArgs& Option(const std::string& name, const std::string& metavar, const std::string& help,
                   std::optional<std::string> default_value = std::nullopt);
   /// A boolean switch.
   CliArgs& Flag(const std::string& name, const std::string& help);
@@ -42,7 +42,7 @@ class CliArgs {
 
  private:
   struct Spec {
-    std::string placeholder, help;
+    std::string metavar, help;
     std::optional<std::string> default_value;
     bool is_flag = false;
   };
