@@ -20,7 +20,12 @@ inline sensors::Scan3D SimulatedScan(const std::string& world, double x_m, doubl
                                      double yaw_deg, std::uint64_t seed = 1) {
   std::ostringstream name;
   name << world << "_" << x_m << "_" << y_m << "_" << yaw_deg << "_s" << seed << ".pcd";
-  const std::filesystem::path dir = PITCHLAB_MAPPING_SCAN_CACHE;
+  // Keyed by this test binary's build time: it relinks whenever the simulator or a world
+  // library changes, so a cached scan never outlives the code that made it.
+  const auto built = std::filesystem::last_write_time("/proc/self/exe").time_since_epoch().count();
+  const std::filesystem::path dir =
+      std::filesystem::path(PITCHLAB_MAPPING_SCAN_CACHE) / std::to_string(built);
+  std::filesystem::create_directories(dir);
   const std::filesystem::path path = dir / name.str();
   if (std::filesystem::exists(path)) {
     Result<sensors::Scan3D> cached = sensors::ReadScanPcd(path.string());
