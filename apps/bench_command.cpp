@@ -467,19 +467,19 @@ json RecoveredRecord(const SweepSettings& s, const BenchRun& run) {
   return r;
 }
 
-/// Runs `todo` with at most `jobs` at once, appending each record to the log as it ends.
-void RunSweep(const SweepSettings& s, const std::vector<BenchRun>& todo, RecordLog& log,
+/// Runs `pending` with at most `jobs` at once, appending each record to the log as it ends.
+void RunSweep(const SweepSettings& s, const std::vector<BenchRun>& pending, RecordLog& log,
               bool quiet) {
   std::vector<Running> running;
   std::size_t next = 0, done = 0;
   const auto finish = [&](const json& record) {
     log.Append(record);
     ++done;
-    if (!quiet) PrintProgress(record, done, todo.size());
+    if (!quiet) PrintProgress(record, done, pending.size());
   };
-  while (next < todo.size() || !running.empty()) {
-    while (next < todo.size() && static_cast<int>(running.size()) < s.jobs) {
-      const BenchRun& run = todo[next++];
+  while (next < pending.size() || !running.empty()) {
+    while (next < pending.size() && static_cast<int>(running.size()) < s.jobs) {
+      const BenchRun& run = pending[next++];
       RemoveStaging(s.out, run);
       if (fs::exists(RunDir(s.out, run))) {
         finish(RecoveredRecord(s, run));
@@ -487,7 +487,7 @@ void RunSweep(const SweepSettings& s, const std::vector<BenchRun>& todo, RecordL
       }
       if (!quiet) {
         std::fprintf(stderr, "bench: start %s seed %llu (%zu of %zu)\n", run.world.label.c_str(),
-                     static_cast<unsigned long long>(run.seed), next, todo.size());
+                     static_cast<unsigned long long>(run.seed), next, pending.size());
       }
       running.push_back({run, StartRun(s, run), Clock::now(), false});
     }
@@ -658,20 +658,20 @@ int Sweep(const CliArgs& args) {
   const fs::path jsonl = s.out / "runs.jsonl";
   std::set<std::string> recorded;
   for (const json& r : ReadRecords(jsonl)) recorded.insert(RecordKey(r));
-  std::vector<BenchRun> todo;
+  std::vector<BenchRun> pending;
   for (const BenchRun& run : shard) {
-    if (!recorded.count(run.Id())) todo.push_back(run);
+    if (!recorded.count(run.Id())) pending.push_back(run);
   }
   if (!quiet) {
     std::fprintf(stderr,
                  "bench: shard %s: %zu of %zu runs, %zu already recorded in %s, %zu to run, %d at "
                  "a time\n",
                  s.shard.Text().c_str(), shard.size(), worlds.size() * seeds.size(),
-                 shard.size() - todo.size(), jsonl.string().c_str(), todo.size(), s.jobs);
+                 shard.size() - pending.size(), jsonl.string().c_str(), pending.size(), s.jobs);
   }
   {
     RecordLog log(jsonl);
-    RunSweep(s, todo, log, quiet);
+    RunSweep(s, pending, log, quiet);
   }
   // The summary covers every run recorded in the folder (all shards that share it).
   const json summary = Summarize(ReadRecords(jsonl), {jsonl.string()});

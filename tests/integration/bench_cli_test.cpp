@@ -16,20 +16,17 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_support.hpp"
+
 namespace pitchlab {
 namespace {
 
 namespace fs = std::filesystem;
+using cli_test::CliResult;
+using cli_test::Slurp;
 using nlohmann::json;
 
 const fs::path kYard = fs::path(PITCHLAB_SOURCE_DIR) / "tests/data/worlds/yard.xml";
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
 
 std::vector<json> Records(const fs::path& bench_dir) {
   std::vector<json> records;
@@ -46,11 +43,6 @@ std::multiset<std::string> RunIds(const std::vector<json>& records) {
   return ids;
 }
 
-struct CliResult {
-  int exit_code = -1;
-  std::string out, err;
-};
-
 class BenchCli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -61,11 +53,7 @@ class BenchCli : public ::testing::Test {
   static void TearDownTestSuite() { fs::remove_all(dir_); }
 
   static CliResult Exec(const std::string& args) {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const int status = std::system(
-        (std::string(PITCHLAB_CLI) + " bench " + args + " >" + out.string() + " 2>" + err.string())
-            .c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(out), Slurp(err)};
+    return cli_test::RunPitchlab("bench " + args, dir_);
   }
   static fs::path dir_;
 };

@@ -22,10 +22,14 @@
 
 #include "pitchlab/mapping/elevation_io.hpp"
 
+#include "cli_support.hpp"
+
 namespace pitchlab {
 namespace {
 
 namespace fs = std::filesystem;
+using cli_test::CliResult;
+using cli_test::Slurp;
 
 const fs::path kYard = fs::path(PITCHLAB_SOURCE_DIR) / "tests/data/worlds/yard.xml";
 // Both runs: a reduced scan (50 lines over 50 deg at 1 deg: a 38400-baud line still takes
@@ -37,18 +41,6 @@ constexpr char kSharedConfig[] =
     "lms200: {resolution_deg: 1}\n";
 constexpr char kMission[] = " --goal=-3,0 --quiet";
 constexpr int kEmulatorStartTimeout_ms = 30000;
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
-
-struct CliResult {
-  int exit_code = -1;
-  std::string out, err;
-};
 
 // `pitchlab hw emulate` as a child process; its device paths parsed from the JSON it prints.
 class Emulators {
@@ -115,11 +107,7 @@ class HwRunCli : public ::testing::Test {
     if (!HasFailure()) fs::remove_all(dir_);
   }
   CliResult Exec(const std::string& args) const {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const int status = std::system(
-        (std::string(PITCHLAB_CLI) + " " + args + " >" + out.string() + " 2>" + err.string())
-            .c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(out), Slurp(err)};
+    return cli_test::RunPitchlab(args, dir_);
   }
   fs::path Write(const std::string& name, const std::string& text) const {
     std::ofstream(dir_ / name) << text;

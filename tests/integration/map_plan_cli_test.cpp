@@ -14,22 +14,14 @@
 
 #include "pitchlab/mapping/elevation_io.hpp"
 
+#include "cli_support.hpp"
+
 namespace pitchlab {
 namespace {
 
 namespace fs = std::filesystem;
-
-struct CliRun {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
+using cli_test::CliResult;
+using cli_test::Slurp;
 
 // One office scan and its map, made once for the suite (a scan takes seconds).
 class MapPlanCli : public ::testing::Test {
@@ -38,7 +30,7 @@ class MapPlanCli : public ::testing::Test {
     dir_ = fs::temp_directory_path() / "pitchlab_cli_map_plan";
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    const CliRun scan =
+    const CliResult scan =
         Run("scan --world office --json --quiet --out " + (dir_ / "office.pcd").string());
     ASSERT_EQ(scan.exit_code, 0) << scan.err;
     const auto pose = nlohmann::json::parse(scan.out)["pose"];
@@ -49,16 +41,8 @@ class MapPlanCli : public ::testing::Test {
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }
 
-  static CliRun Run(const std::string& args) {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string command = std::string(PITCHLAB_CLI) + " " + args + " >" + out.string() +
-                                " 2>" + err.string();
-    const int status = std::system(command.c_str());
-    CliRun run;
-    run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    run.out = Slurp(out);
-    run.err = Slurp(err);
-    return run;
+  static CliResult Run(const std::string& args) {
+    return cli_test::RunPitchlab(args, dir_);
   }
   static std::string Point(double x, double y) {
     return std::to_string(x) + "," + std::to_string(y);
@@ -66,7 +50,7 @@ class MapPlanCli : public ::testing::Test {
 
   static inline fs::path dir_;
   static inline double start_x_ = 0, start_y_ = 0;
-  static inline CliRun map_run_;
+  static inline CliResult map_run_;
 };
 
 TEST_F(MapPlanCli, ScanMapPlanWritesFilesThatParse) {
@@ -86,7 +70,7 @@ TEST_F(MapPlanCli, ScanMapPlanWritesFilesThatParse) {
   // 1.5 m ahead of the robot (facing +x at the office's start). The laser does not see the
   // floor right around the robot, so unknown cells are penalised, not forbidden.
   const fs::path plan_dir = dir_ / "plan";
-  const CliRun plan = Run("plan " + (dir_ / "map" / "map.plem").string() + " --start " +
+  const CliResult plan = Run("plan " + (dir_ / "map" / "map.plem").string() + " --start " +
                           Point(start_x_, start_y_) + " --goal " +
                           Point(start_x_ + 1.5, start_y_) +
                           " --unknown penalise --json --out " + plan_dir.string());
@@ -134,7 +118,7 @@ TEST_F(MapPlanCli, BadInputGivesAClearErrorANonZeroExitAndNoFolder) {
   };
   for (const auto& c : cases) {
     const fs::path out = dir_ / "bad_plan";
-    const CliRun run = Run("plan " + c.args + " --out " + out.string());
+    const CliResult run = Run("plan " + c.args + " --out " + out.string());
     EXPECT_NE(run.exit_code, 0) << c.args;
     EXPECT_NE(run.err.find(c.message), std::string::npos) << c.args << "\n" << run.err;
     EXPECT_FALSE(fs::exists(out)) << c.args;

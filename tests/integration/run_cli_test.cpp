@@ -14,24 +14,16 @@
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/sensors/scan_pcd.hpp"
 
+#include "cli_support.hpp"
+
 namespace pitchlab {
 namespace {
 
 namespace fs = std::filesystem;
+using cli_test::CliResult;
+using cli_test::Slurp;
 
 const fs::path kYard = fs::path(PITCHLAB_SOURCE_DIR) / "tests/data/worlds/yard.xml";
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
-
-struct CliResult {
-  int exit_code = -1;
-  std::string out, err;
-};
 
 class RunCli : public ::testing::Test {
  protected:
@@ -43,11 +35,7 @@ class RunCli : public ::testing::Test {
   static void TearDownTestSuite() { fs::remove_all(dir_); }
 
   static CliResult Exec(const std::string& args) {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const int status = std::system((std::string(PITCHLAB_CLI) + " " + args + " >" +
-                                    out.string() + " 2>" + err.string())
-                                       .c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(out), Slurp(err)};
+    return cli_test::RunPitchlab(args, dir_);
   }
   // Folders in the scratch folder other than the successful run's: a failed run leaves none,
   // not even its hidden staging folder.

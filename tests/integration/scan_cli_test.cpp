@@ -13,22 +13,14 @@
 
 #include "pitchlab/sensors/scan_pcd.hpp"
 
+#include "cli_support.hpp"
+
 namespace pitchlab {
 namespace {
 
 namespace fs = std::filesystem;
-
-struct CliRun {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
+using cli_test::CliResult;
+using cli_test::Slurp;
 
 class ScanCli : public ::testing::Test {
  protected:
@@ -42,23 +34,15 @@ class ScanCli : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  CliRun Run(const std::string& args) const {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string command = std::string(PITCHLAB_CLI) + " " + args + " >" + out.string() +
-                                " 2>" + err.string();
-    const int status = std::system(command.c_str());
-    CliRun run;
-    run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    run.out = Slurp(out);
-    run.err = Slurp(err);
-    return run;
+  CliResult Run(const std::string& args) const {
+    return cli_test::RunPitchlab(args, dir_);
   }
   fs::path dir_;
 };
 
 TEST_F(ScanCli, WritesAFullSeedScanAndAJsonSummaryWithTheTruePose) {
   const fs::path pcd = dir_ / "office.pcd";
-  const CliRun run = Run("scan --world office --json --quiet --out " + pcd.string());
+  const CliResult run = Run("scan --world office --json --quiet --out " + pcd.string());
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const nlohmann::json summary = nlohmann::json::parse(run.out);
   EXPECT_EQ(summary["lines"], 200);
@@ -92,7 +76,7 @@ TEST_F(ScanCli, SameSeedGivesTheSameBytesAndAnotherSeedDoesNot) {
     const fs::path config = dir_ / ("seed" + std::to_string(seed) + ".yaml");
     std::ofstream(config) << "seed: " << seed << "\nscan: {lines: 40}\n";
     const fs::path pcd = dir_ / ("run" + std::to_string(runs++) + ".pcd");
-    const CliRun run = Run("scan --world cluttered --quiet --config " + config.string() +
+    const CliResult run = Run("scan --world cluttered --quiet --config " + config.string() +
                            " --out " + pcd.string());
     EXPECT_EQ(run.exit_code, 0) << run.err;
     return Slurp(pcd);
@@ -128,7 +112,7 @@ TEST_F(ScanCli, BadInputGivesAClearErrorANonZeroExitAndNoFile) {
   };
   for (const BadInput& c : cases) {
     const fs::path pcd = dir_ / "never.pcd";
-    const CliRun run = Run("scan --quiet " + c.args + " --out " + pcd.string());
+    const CliResult run = Run("scan --quiet " + c.args + " --out " + pcd.string());
     EXPECT_NE(run.exit_code, 0) << c.args;
     EXPECT_NE(run.err.find(c.message), std::string::npos) << c.args << " said: " << run.err;
     EXPECT_FALSE(fs::exists(pcd)) << c.args;
@@ -136,7 +120,7 @@ TEST_F(ScanCli, BadInputGivesAClearErrorANonZeroExitAndNoFile) {
 }
 
 TEST_F(ScanCli, HelpListsTheOptionsAndExitsZero) {
-  const CliRun run = Run("scan --help");
+  const CliResult run = Run("scan --help");
   EXPECT_EQ(run.exit_code, 0);
   for (const char* option : {"--world", "--pose", "--config", "--out", "--json"}) {
     EXPECT_NE(run.out.find(option), std::string::npos) << option;
