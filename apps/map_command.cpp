@@ -176,13 +176,7 @@ int RunMap(int argc, char** argv) {
   }
   summary["wall_time_s"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  {
-    const std::string file = (folder / "map.json").string();
-    std::FILE* f = std::fopen(file.c_str(), "w");
-    if (!f) throw std::runtime_error(file + ": cannot write");
-    std::fputs((summary.dump(2) + "\n").c_str(), f);
-    std::fclose(f);
-  }
+  WriteTextFile(folder / "map.json", summary.dump(2) + "\n");
   folder.Commit();
   if (args.Flagged("json")) {
     std::cout << summary.dump(2) << "\n";

@@ -125,13 +125,7 @@ int RunPlan(int argc, char** argv) {
   mapping::RgbImage image = mapping::RenderElevationImage(layers);
   planning::DrawPath(*result, map->geometry(), image);
   check(mapping::WritePng(image, (folder / "path.png").string()));
-  {
-    const std::string file = (folder / "plan.json").string();
-    std::FILE* f = std::fopen(file.c_str(), "w");
-    if (!f) throw std::runtime_error(file + ": cannot write");
-    std::fputs((summary.dump(2) + "\n").c_str(), f);
-    std::fclose(f);
-  }
+  WriteTextFile(folder / "plan.json", summary.dump(2) + "\n");
   folder.Commit();
   if (args.Flagged("json")) {
     std::cout << summary.dump(2) << "\n";

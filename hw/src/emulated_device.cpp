@@ -12,28 +12,13 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "baud_code.hpp"
+
 namespace pitchlab::hw {
 namespace {
 
 constexpr int kIdlePeriodMs = 5;
 constexpr std::size_t kPacingChunkBytes = 16;
-
-speed_t SpeedCode(int baud) {
-  switch (baud) {
-    case 9600:
-      return B9600;
-    case 19200:
-      return B19200;
-    case 38400:
-      return B38400;
-    case 115200:
-      return B115200;
-    case 500000:
-      return B500000;
-    default:
-      return B0;
-  }
-}
 
 }  // namespace
 

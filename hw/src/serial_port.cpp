@@ -9,25 +9,10 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "baud_code.hpp"
+
 namespace pitchlab::hw {
 namespace {
-
-speed_t SpeedCode(int baud) {
-  switch (baud) {
-    case 9600:
-      return B9600;
-    case 19200:
-      return B19200;
-    case 38400:
-      return B38400;
-    case 115200:
-      return B115200;
-    case 500000:
-      return B500000;
-    default:
-      return B0;
-  }
-}
 
 std::string SystemError(const std::string& what, const std::string& device) {
   return what + " " + device + ": " + std::strerror(errno);
