@@ -9,6 +9,8 @@
 #include <sstream>
 #include <string>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -27,7 +29,8 @@ using cli_test::Slurp;
 class MapPlanCli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = fs::temp_directory_path() / "pitchlab_cli_map_plan";
+    // Per process: CTest runs each test of the suite in its own process, in parallel.
+    dir_ = fs::temp_directory_path() / ("pitchlab_cli_map_plan_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     const CliResult scan =
