@@ -18,6 +18,7 @@
 
 #include "app_config.hpp"
 #include "cli_args.hpp"
+#include "pitchlab/hw/stop_request.hpp"
 #include "pitchlab/worlds/world_catalog.hpp"
 #include "pitchlab/worlds/world_metadata.hpp"
 #include "run_config.hpp"
@@ -358,10 +359,28 @@ int RunHwMission(int argc, char** argv) {
   mission.map_area = frame.map_area;
 
   RunFolder folder(args.Has("out") ? args.Get("out") : DefaultOut(config.seed));
+  // Ctrl-C / SIGTERM from here on: the drivers see the flag within one read timeout, the mission
+  // ends, the drivers' destructors stop the base (zero speed, motors off) and the LMS200 output,
+  // and the staging folder is removed uncommitted: no half-written run folder.
+  hw::InstallStopSignalHandlers();
+  const auto interrupted = [&](const std::string& during) {
+    std::fprintf(stderr,
+                 "run (hw): %s %s: base stopped and motors disabled, LMS200 output stopped; "
+                 "no run folder written (%s)\n",
+                 hw::StopReason().c_str(), during.c_str(), folder.final_path().string().c_str());
+    return hw::StopExitCode();
+  };
   if (!quiet)
     std::fprintf(stderr, "run: opening %s, %s, %s\n", hw_config.lms200.device.c_str(),
                  hw_config.pitch_unit.device.c_str(), hw_config.base->device.c_str());
-  HwBackend backend = StartHwBackend(hw_config);
+  HwBackend backend;
+  try {
+    backend = StartHwBackend(hw_config);
+  } catch (const std::runtime_error&) {
+    if (hw::StopRequested()) return interrupted("while opening the devices");
+    throw;
+  }
+  backend.probes.interrupted = hw::StopRequested;
   Eigen::Isometry3d T_world_start = Eigen::Isometry3d::Identity();  // base_link on the ground
   T_world_start.translation() << start.x(), start.y(), 0.0;
   T_world_start.rotate(Eigen::AngleAxisd(start.z(), Eigen::Vector3d::UnitZ()));
@@ -378,6 +397,10 @@ int RunHwMission(int argc, char** argv) {
   };
   const MissionResult result = RunMission(*backend.rig, *backend.rig->base(), T_world_start,
                                           mission, backend.probes, observer);
+  if (hw::StopRequested()) {
+    backend.rig.reset();  // the destructors put the devices in a safe state now
+    return interrupted("after " + std::to_string(result.stops.size()) + " stops");
+  }
 
   RunContext context;
   context.world = frame.world;
@@ -392,6 +415,8 @@ int RunHwMission(int argc, char** argv) {
   context.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   WriteFinalOutputs(folder, context, result, std::nullopt, nullptr, std::nullopt);
+  backend.rig.reset();
+  if (hw::StopRequested()) return interrupted("while writing the run folder");
   folder.Commit();
 
   const nlohmann::json metrics = RunMetrics(context, result, std::nullopt);

@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <csignal>
+#include <cstdio>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -19,6 +20,7 @@
 #include "pitchlab/hw/lms200_emulator.hpp"
 #include "pitchlab/hw/p2os_emulator.hpp"
 #include "pitchlab/hw/pitch_unit_emulator.hpp"
+#include "pitchlab/hw/stop_request.hpp"
 #include "pitchlab/sim/sim_rig.hpp"
 #include "pitchlab/worlds/world_catalog.hpp"
 #include "world_paths.hpp"
@@ -200,8 +202,26 @@ int RunLms200(int argc, char** argv) {
   if (units != "cm" && units != "mm") throw CliError("--units '" + units + "' is not cm or mm");
   config.lms.range_mode =
       units == "mm" ? sensors::Lms200RangeMode::kMm : sensors::Lms200RangeMode::kCm;
-  hw::Lms200Driver driver(config);
-  Result<sensors::LaserLine> line = driver.NextLine(std::chrono::milliseconds(3000));
+  // Ctrl-C: the driver returns within one read timeout and its destructor stops a streaming
+  // device; then a clear message and 128 + signal.
+  hw::InstallStopSignalHandlers();
+  const auto interrupted = [&] {
+    std::fprintf(stderr, "hw lms200: %s; %s left in on-request mode\n", hw::StopReason().c_str(),
+                 config.device.c_str());
+    return hw::StopExitCode();
+  };
+  std::unique_ptr<hw::Lms200Driver> driver;
+  try {
+    driver = std::make_unique<hw::Lms200Driver>(config);
+  } catch (const std::runtime_error&) {
+    if (hw::StopRequested()) return interrupted();
+    throw;
+  }
+  Result<sensors::LaserLine> line = driver->NextLine(std::chrono::milliseconds(3000));
+  if (!line && hw::StopRequested()) {
+    driver.reset();
+    return interrupted();
+  }
   if (!line) throw std::runtime_error(line.error().message);
   nlohmann::json ranges = nlohmann::json::array(), status = nlohmann::json::array();
   std::size_t valid = 0;
@@ -211,9 +231,9 @@ int RunLms200(int argc, char** argv) {
     ranges.push_back(ok ? nlohmann::json(line->ranges_m[i]) : nlohmann::json(nullptr));
     status.push_back(StatusName(line->status[i]));
   }
-  const hw::Lms200DriverStats& stats = driver.stats();
+  const hw::Lms200DriverStats& stats = driver->stats();
   nlohmann::json out = {{"device", config.device},
-                        {"type", driver.type()},
+                        {"type", driver->type()},
                         {"baud", config.lms.baud},
                         {"units", units},
                         {"stamp_s", line->stamp_s},
@@ -232,7 +252,7 @@ int RunLms200(int argc, char** argv) {
   if (args.Flagged("json")) {
     std::cout << out.dump(2) << "\n";
   } else {
-    std::cout << config.device << " (" << driver.type() << "): " << line->ranges_m.size()
+    std::cout << config.device << " (" << driver->type() << "): " << line->ranges_m.size()
               << " readings, " << valid << " valid\n";
   }
   return 0;

@@ -127,6 +127,10 @@ MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
 }
 
 bool Mission::OverBudget() {
+  if (probes_.interrupted && probes_.interrupted()) {
+    result_.reason = "interrupted";
+    return true;
+  }
   if (probes_.now_s() - result_.start_s <= config_.time_budget_s) return false;
   result_.reason = "time budget of " + std::to_string(config_.time_budget_s) + " s spent";
   return true;

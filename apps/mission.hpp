@@ -48,6 +48,8 @@ struct MissionProbes {
   std::function<double()> tilt_rad;  ///< attitude sensor: angle of base_link's z from vertical
   /// Ground truth (simulation only): scoring, never steering.
   std::function<Eigen::Isometry3d()> true_pose;
+  /// True once the run should stop now (Ctrl-C on hardware); polled wherever the budget is.
+  std::function<bool()> interrupted;
 };
 
 /// One stop of the mission, as it happened.

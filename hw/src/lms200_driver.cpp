@@ -6,6 +6,8 @@
 #include <thread>
 #include <vector>
 
+#include "pitchlab/hw/stop_request.hpp"
+
 namespace pitchlab::hw {
 namespace {
 
@@ -77,6 +79,7 @@ Result<Telegram> Lms200Driver::WaitFor(std::uint8_t reply_command, bool need_ack
   bool acked = !need_ack;
   std::uint8_t buffer[1024];
   for (;;) {
+    if (StopRequested()) return Fail(Error::Code::kFailed, StopReason());
     while (auto event = reader_.Next()) {
       using Kind = lms200::ReaderEvent::Kind;
       if (event->kind == Kind::kAck) acked = true;
@@ -113,7 +116,7 @@ Result<Telegram> Lms200Driver::Transact(const Telegram& request, milliseconds ti
     Result<Telegram> reply =
         WaitFor(std::uint8_t(request.command | lms200::kReplyBit), true, Clock::now() + timeout);
     if (reply) return reply;
-    if (reply.error().code == Error::Code::kDevice) return reply;
+    if (reply.error().code == Error::Code::kDevice || StopRequested()) return reply;
     last = reply.error();
   }
   return Fail(last.code, "request " + Hex(request.command) + " failed after " +
@@ -132,7 +135,7 @@ Result<int> Lms200Driver::ProbeBaud() {
     Result<Telegram> reply = Transact(lms200::SwitchModeRequest(lms200::kModeOnRequest),
                                       milliseconds(config_.reply_timeout_ms), 2);
     if (reply) return baud;
-    if (reply.error().code == Error::Code::kDevice)
+    if (reply.error().code == Error::Code::kDevice || StopRequested())
       return Fail(reply.error().code, reply.error().message);
   }
   return Fail(Error::Code::kTimeout, "no answer at 9600, 19200, 38400 or 500000 baud");
@@ -220,7 +223,7 @@ Result<void> Lms200Driver::Initialize() {
 
 Result<void> Lms200Driver::Reconnect() {
   Error last{Error::Code::kDevice, "no reconnect attempted"};
-  for (int i = 0; i < config_.reconnects; ++i) {
+  for (int i = 0; i < config_.reconnects && !StopRequested(); ++i) {
     std::this_thread::sleep_for(kReconnectPause);
     if (Result<void> opened = port_->Reopen(); !opened) {
       last = opened.error();
@@ -274,6 +277,8 @@ Result<sensors::LaserLine> Lms200Driver::NextLine(milliseconds timeout) {
   Error last{Error::Code::kTimeout, "nothing received"};
   bool reconnected = false;
   for (int attempt = 0; Remaining(deadline).count() > 0; ++attempt) {
+    // Ctrl-C: no retry, no reconnect; the caller unwinds and the destructor quiets the device.
+    if (StopRequested()) return tl::make_unexpected(StopError("LMS200 on " + config_.device));
     if (attempt > 0) ++stats_.retries;
     Result<Telegram> reply;
     double stamp_s = 0.0;

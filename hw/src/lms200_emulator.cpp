@@ -1,5 +1,6 @@
 #include "pitchlab/hw/lms200_emulator.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -16,7 +17,9 @@ double NowS() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-std::string PowerOnText(const std::string& type) { return type + ";V02.10 "; }
+constexpr char kVersion[] = "V02.10 ";  // 7 characters, as the status block holds them
+
+std::string PowerOnText(const std::string& type) { return type + ";" + kVersion; }
 
 }  // namespace
 
@@ -124,14 +127,15 @@ void Lms200Emulator::Handle(const Telegram& request) {
       Reply(lms200::kRequestType,
             std::vector<std::uint8_t>(config_.type.begin(), config_.type.end()));
       return;
-    case lms200::kRequestStatus: {
+    case lms200::kRequestStatus:
       Send({lms200::kAck});
-      const std::string version = "V02.10 ";
-      std::vector<std::uint8_t> data(version.begin(), version.end());
-      data.push_back(streaming_ ? lms200::kModeContinuous : lms200::kModeOnRequest);
-      Reply(lms200::kRequestStatus, data);
+      Reply(lms200::kRequestStatus, StatusBlock());
       return;
-    }
+    case lms200::kRequestErrors:
+      // No errors: only the status byte. sicktoolbox probes the baud rate with this request.
+      Send({lms200::kAck});
+      Reply(lms200::kRequestErrors, {});
+      return;
     case lms200::kSwitchVariant: {
       if (d.size() != 4) break;
       Send({lms200::kAck});
@@ -158,20 +162,22 @@ void Lms200Emulator::Handle(const Telegram& request) {
       Reply(lms200::kRequestConfig, config_block_);
       return;
     case lms200::kConfigure: {
-      if (d.size() <= lms200::kConfigUnitsIndex || d[lms200::kConfigUnitsIndex] > 1) break;
+      // A block of another length is not an LMS200 configuration: not acknowledged.
+      if (d.size() != lms200::kConfigBlockBytes) break;
       Send({lms200::kAck});
-      if (!setup_mode_) {
-        Reply(lms200::kConfigure, {0x00});  // not in installation mode: rejected
-        return;
-      }
-      config_block_ = d;
-      {
+      // Refused (0x00, block echoed) outside installation mode, and for what this emulator
+      // cannot produce: units other than cm / mm, measuring modes beyond the 8 m / 80 m ones
+      // (their values carry reflectivity in bits the decoders read as range).
+      const bool possible =
+          d[lms200::kConfigUnitsIndex] <= 1 && d[lms200::kConfigMeasuringModeIndex] <= 2;
+      std::vector<std::uint8_t> data = {std::uint8_t(setup_mode_ && possible ? 0x01 : 0x00)};
+      if (setup_mode_ && possible) {
+        config_block_ = d;
         std::lock_guard<std::mutex> lock(mutex_);
         current_.range_mode = d[lms200::kConfigUnitsIndex] == 1 ? sensors::Lms200RangeMode::kMm
                                                                 : sensors::Lms200RangeMode::kCm;
       }
-      std::vector<std::uint8_t> data = {0x01};
-      data.insert(data.end(), d.begin(), d.end());
+      data.insert(data.end(), config_block_.begin(), config_block_.end());
       Reply(lms200::kConfigure, data);
       return;
     }
@@ -184,6 +190,28 @@ void Lms200Emulator::Handle(const Telegram& request) {
       break;
   }
   Send({lms200::kNak});  // unknown command or malformed data
+}
+
+std::vector<std::uint8_t> Lms200Emulator::StatusBlock() const {
+  // The fields the clients read (docs/hardware_interop.md); the pollution, calibration and
+  // signal values an LMS also reports are left at zero.
+  std::vector<std::uint8_t> b(lms200::kStatusBlockBytes, 0);
+  const std::string version = kVersion;
+  std::copy(version.begin(), version.end(), b.begin() + lms200::kStatusVersionIndex);
+  b[lms200::kStatusOperatingModeIndex] =
+      setup_mode_ ? lms200::kModeSetup
+                  : (streaming_ ? lms200::kModeContinuous : lms200::kModeOnRequest);
+  b[lms200::kStatusDeviceStatusIndex] = 0;
+  b[lms200::kStatusMeasuringModeIndex] = config_block_[lms200::kConfigMeasuringModeIndex];
+  const sensors::Lms200Config now = current();
+  const int fov = int(std::lround(now.fov_deg));
+  const int res = int(std::lround(now.resolution_deg * 100.0));
+  b[lms200::kStatusScanAngleIndex] = std::uint8_t(fov & 0xFF);
+  b[lms200::kStatusScanAngleIndex + 1] = std::uint8_t(fov >> 8);
+  b[lms200::kStatusResolutionIndex] = std::uint8_t(res & 0xFF);
+  b[lms200::kStatusResolutionIndex + 1] = std::uint8_t(res >> 8);
+  b[lms200::kStatusUnitsIndex] = now.range_mode == sensors::Lms200RangeMode::kMm ? 1 : 0;
+  return b;
 }
 
 sensors::LaserLine Lms200Emulator::FlatWall(const sensors::Lms200Config& config) const {

@@ -117,6 +117,7 @@ Telegram SetupModeRequest() {
 Telegram SingleScanRequest() { return {kHostAddress, kRequestValues, {0x01}}; }
 Telegram TypeRequest() { return {kHostAddress, kRequestType, {}}; }
 Telegram StatusRequest() { return {kHostAddress, kRequestStatus, {}}; }
+Telegram ErrorsRequest() { return {kHostAddress, kRequestErrors, {}}; }
 
 Telegram VariantRequest(int fov_deg, int resolution_cdeg) {
   Telegram t{kHostAddress, kSwitchVariant, {}};

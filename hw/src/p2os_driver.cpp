@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "pitchlab/hw/stop_request.hpp"
+
 namespace pitchlab::hw {
 namespace {
 
@@ -49,9 +51,12 @@ P2osDriver::P2osDriver(const P2osDriverConfig& config, ClockFn clock)
 }
 
 P2osDriver::~P2osDriver() {
+  // Leave the robot safe whatever ended the session (Ctrl-C included): zero speed, motors off,
+  // connection closed.
   if (!port_ || !port_->is_open()) return;
   (void)Send(p2os::CommandPacket(p2os::kVel, 0));
   (void)Send(p2os::CommandPacket(p2os::kRVel, 0));
+  (void)Send(p2os::CommandPacket(p2os::kEnable, 0));
   (void)Send(p2os::CommandPacket(p2os::kClose));
 }
 
@@ -65,6 +70,7 @@ Result<std::vector<std::uint8_t>> P2osDriver::WaitPacket(std::uint8_t first_byte
   const auto deadline = Clock::now() + timeout;
   std::uint8_t buffer[256];
   for (;;) {
+    if (StopRequested()) return Fail(Error::Code::kFailed, StopReason());
     while (auto payload = reader_.Next()) {
       if (!payload->empty() && (*payload)[0] == first_byte) return *payload;
     }
@@ -79,6 +85,7 @@ Result<std::vector<std::uint8_t>> P2osDriver::WaitPacket(std::uint8_t first_byte
 Result<void> P2osDriver::Handshake() {
   std::string failed = "SYNC0";
   for (int attempt = 0; attempt < config_.sync_attempts; ++attempt) {
+    if (StopRequested()) return Fail(Error::Code::kFailed, StopReason());
     // A robot left connected by a crashed client: CLOSE puts it back to waiting for SYNC0.
     if (attempt > 0) (void)Send(p2os::CommandPacket(p2os::kClose));
     port_->DiscardInput();
@@ -135,6 +142,7 @@ Result<bool> P2osDriver::Pump(Clock::time_point deadline, bool stop_at_first_sip
   bool got_sip = false;
   auto last_sip_time = Clock::now();
   for (;;) {
+    if (StopRequested()) return tl::make_unexpected(StopError("P3 base on " + config_.device));
     while (auto payload = reader_.Next()) {
       if (Result<p2os::Sip> sip = p2os::DecodeSip(*payload); sip) {
         Integrate(*sip);

@@ -102,6 +102,17 @@ void P2osEmulator::Handle(const std::vector<std::uint8_t>& p) {
     case p2os::kRVel:
       if (argument && enabled_) Command(v_mps_, *argument * kPi / 180.0);
       break;
+    case p2os::kVel2:
+      // Two signed bytes in the argument word; a client packing them into a short may send a
+      // "negative" word (ARGNINT), so the word is taken modulo 2^16.
+      if (argument && enabled_) {
+        const std::uint16_t word = std::uint16_t(*argument);
+        const double left = std::int8_t(word >> 8) * p2os::kVel2UnitMmps / 1000.0;
+        const double right = std::int8_t(word & 0xFF) * p2os::kVel2UnitMmps / 1000.0;
+        Command(0.5 * (left + right), (right - left) / config_.track_m);
+      }
+      break;
+    case p2os::kStop:
     case p2os::kEStop:
       Command(0.0, 0.0);
       break;

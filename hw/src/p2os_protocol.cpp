@@ -82,7 +82,7 @@ std::vector<std::uint8_t> EncodeSip(const Sip& sip) {
   p.push_back(0);                                // COMPASS
   p.push_back(0);                                // no sonar readings
   p.insert(p.end(), {0, 0, 0, 0, 0});            // GRIP_STATE, ANPORT, ANALOG, DIGIN, DIGOUT
-  PutLe(p, std::uint16_t(sip.battery_dv * 10));  // BATTERYX10
+  PutLe(p, sip.battery_dv);                      // BATTERYX10: volts x 10, 16 bit
   p.push_back(0);                                // CHARGESTATE
   PutLe(p, std::uint16_t(sip.rotvel_ddps));
   PutLe(p, 0);  // FAULTFLAGS

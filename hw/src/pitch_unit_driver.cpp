@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "pitchlab/hw/stop_request.hpp"
+
 namespace pitchlab::hw {
 namespace {
 
@@ -60,6 +62,7 @@ Result<pitch::Frame> PitchUnitDriver::Request(const pitch::Frame& request) {
   Error last{Error::Code::kTimeout, "no reply"};
   std::uint8_t buffer[256];
   for (int attempt = 0; attempt < config_.retries; ++attempt) {
+    if (StopRequested()) return tl::make_unexpected(StopError("pitch unit on " + config_.device));
     if (attempt > 0) ++retries_;
     port_->DiscardInput();
     reader_.Clear();
@@ -68,6 +71,9 @@ Result<pitch::Frame> PitchUnitDriver::Request(const pitch::Frame& request) {
     }
     const auto deadline = Clock::now() + milliseconds(config_.reply_timeout_ms);
     for (;;) {
+      if (StopRequested()) {
+        return tl::make_unexpected(StopError("pitch unit on " + config_.device));
+      }
       if (auto frame = reader_.Next()) {
         if (frame->command == (request.command | pitch::kReplyBit)) return *frame;
         if (frame->command == pitch::kErrorReply) {

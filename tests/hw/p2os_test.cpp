@@ -1,7 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
+#include <thread>
+#include <utility>
 
 #include "pitchlab/hw/p2os_driver.hpp"
 #include "pitchlab/hw/p2os_emulator.hpp"
@@ -75,7 +78,7 @@ class P2osDriverTest : public ::testing::Test {
 
 TEST_F(P2osDriverTest, HandshakeOpensAndEnablesTheMotors) {
   P2osDriver driver(Config());
-  EXPECT_EQ(driver.robot(), "pitchlab Pioneer p3at");
+  EXPECT_EQ(driver.robot(), "pitchlab Pioneer p3at-sh");
   EXPECT_TRUE(emulator_.connected());
   EXPECT_TRUE(emulator_.motors_enabled());
 }
@@ -125,6 +128,70 @@ TEST_F(P2osDriverTest, UnpluggedRobotIsADeviceError) {
   Result<sensors::Odometry> odom = driver.Drive(0.1, 0.0, 0.5);
   ASSERT_FALSE(odom);
   EXPECT_EQ(odom.error().code, Error::Code::kDevice);
+}
+
+// Each fault on the robot's SIPs: odometry stays right (a mangled SIP is never integrated).
+class P2osFaultTest : public P2osDriverTest,
+                      public ::testing::WithParamInterface<FaultPlan::Kind> {};
+
+TEST_P(P2osFaultTest, OdometryStaysRightThroughTheFault) {
+  P2osDriver driver(Config());
+  FaultPlan plan;
+  plan.kind = GetParam();
+  plan.probability = 0.3;
+  plan.delay_ms = 150;  // well inside sip_timeout_ms
+  plan.seed = 5;
+  emulator_.SetFaults(plan);
+  Result<sensors::Odometry> odom = driver.Drive(0.3, 0.0, 1.0);
+  ASSERT_TRUE(odom) << odom.error().message;
+  EXPECT_NEAR(odom->x_m, 0.3, 0.1);
+  EXPECT_NEAR(odom->y_m, 0.0, 0.01);
+  EXPECT_NEAR(odom->v_mps, 0.3, 0.01);
+  EXPECT_GT(emulator_.stats().faults, 0u);
+  if (GetParam() != FaultPlan::Kind::kDelay) EXPECT_GT(driver.checksum_errors(), 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Faults, P2osFaultTest,
+                         ::testing::Values(FaultPlan::Kind::kDrop, FaultPlan::Kind::kDuplicate,
+                                           FaultPlan::Kind::kDelay),
+                         [](const auto& info) {
+                           switch (info.param) {
+                             case FaultPlan::Kind::kDrop:
+                               return std::string("drop");
+                             case FaultPlan::Kind::kDuplicate:
+                               return std::string("duplicate");
+                             default:
+                               return std::string("delay");
+                           }
+                         });
+
+TEST_F(P2osDriverTest, UnplugWhileDrivingIsADeviceErrorNamingTheDevice) {
+  P2osDriver driver(Config());
+  std::thread unplug([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // SIPs are flowing by now
+    emulator_.Unplug();
+  });
+  Result<sensors::Odometry> odom = driver.Drive(0.2, 0.0, 3.0);
+  unplug.join();
+  ASSERT_FALSE(odom);
+  EXPECT_EQ(odom.error().code, Error::Code::kDevice);
+  EXPECT_NE(odom.error().message.find(emulator_.path()), std::string::npos) << odom.error().message;
+}
+
+TEST_F(P2osDriverTest, ClosingTheDriverStopsTheRobotAndDisablesTheMotors) {
+  {
+    P2osDriver driver(Config());
+    ASSERT_TRUE(driver.Drive(0.3, 0.2, 0.3));
+    ASSERT_TRUE(emulator_.motors_enabled());
+    ASSERT_GT(emulator_.command().first, 0.0);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+  while (emulator_.connected() && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  EXPECT_FALSE(emulator_.connected());
+  EXPECT_FALSE(emulator_.motors_enabled());
+  EXPECT_EQ(emulator_.command(), std::make_pair(0.0, 0.0));
 }
 
 TEST(P2osDriverStartup, NoRobotThrowsNamingTheDeviceAndStep) {

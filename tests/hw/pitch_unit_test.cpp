@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "pitchlab/hw/pitch_unit_driver.hpp"
 #include "pitchlab/hw/pitch_unit_emulator.hpp"
@@ -111,6 +112,21 @@ TEST_F(PitchUnitDriverTest, UnpluggedBoardIsADeviceError) {
   Result<double> reached = driver.MoveTo(5.0 * kDeg, milliseconds(1000));
   ASSERT_FALSE(reached);
   EXPECT_EQ(reached.error().code, Error::Code::kDevice);
+}
+
+TEST_F(PitchUnitDriverTest, UnplugMidMoveIsADeviceErrorNamingTheDevice) {
+  PitchUnitDriver driver(Config());
+  std::thread unplug([&] {
+    // 0 -> -60 deg at 90 deg/s takes about 0.67 s: the board goes while the servo slews.
+    std::this_thread::sleep_for(milliseconds(150));
+    emulator_.Unplug();
+  });
+  Result<double> reached = driver.MoveTo(-60.0 * kDeg, milliseconds(5000));
+  unplug.join();
+  ASSERT_FALSE(reached);
+  EXPECT_EQ(reached.error().code, Error::Code::kDevice);
+  EXPECT_NE(reached.error().message.find(emulator_.path()), std::string::npos)
+      << reached.error().message;
 }
 
 TEST_F(PitchUnitDriverTest, StepSizeMismatchThrowsNamingTheField) {

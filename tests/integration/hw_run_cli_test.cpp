@@ -15,11 +15,17 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 #include <nlohmann/json.hpp>
 
+#include "pitchlab/hw/lms200_emulator.hpp"
+#include "pitchlab/hw/p2os_emulator.hpp"
+#include "pitchlab/hw/pitch_unit_emulator.hpp"
 #include "pitchlab/mapping/elevation_io.hpp"
 
 #include "cli_support.hpp"
@@ -95,6 +101,70 @@ class Emulators {
   int stdout_ = -1;
   nlohmann::json paths_;
 };
+
+// `pitchlab <args>` in the background (stderr to `err`), for a test that signals it.
+class Background {
+ public:
+  Background(const std::vector<std::string>& args, const fs::path& err) {
+    std::vector<char*> argv = {const_cast<char*>(PITCHLAB_CLI)};
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    const std::string err_path = err.string();
+    pid_ = ::fork();  // after it only async-signal-safe calls: argv is built above
+    if (pid_ == 0) {
+      const int fd = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      const int null = ::open("/dev/null", O_WRONLY);
+      ::dup2(fd, STDERR_FILENO);
+      ::dup2(null, STDOUT_FILENO);
+      ::execv(PITCHLAB_CLI, argv.data());
+      ::_exit(127);
+    }
+  }
+  ~Background() {
+    if (pid_ > 0 && !exited_) {
+      ::kill(pid_, SIGKILL);
+      ::waitpid(pid_, nullptr, 0);
+    }
+  }
+  // Waits until `pred` holds; false if the process ended first or 60 s passed.
+  template <typename Pred>
+  bool Until(Pred pred) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (!pred()) {
+      int status = 0;
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+        exited_ = true;
+        return false;
+      }
+      if (std::chrono::steady_clock::now() > deadline) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return true;
+  }
+  // Sends `signal` and returns the exit code (-1 when killed by a signal).
+  int Signal(int signal) {
+    ::kill(pid_, signal);
+    int status = 0;
+    ::waitpid(pid_, &status, 0);
+    exited_ = true;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+ private:
+  pid_t pid_ = -1;
+  bool exited_ = false;
+};
+
+// Within a second (the emulated P3's watchdog takes 2 s, so a stop seen sooner was sent).
+template <typename Pred>
+bool Soon(Pred pred) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+  while (!pred()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return true;
+}
 
 class HwRunCli : public ::testing::Test {
  protected:
@@ -231,6 +301,55 @@ TEST_F(HwRunCli, AHardwareRunWithoutDevicesSaysWhichSettingIsMissing) {
   EXPECT_EQ(absent.exit_code, 1);
   EXPECT_NE(absent.err.find("/nonexistent/tty"), std::string::npos) << absent.err;
   EXPECT_FALSE(fs::exists(dir_ / "gone"));
+}
+
+// Ctrl-C in a hardware run: the base is stopped with its motors disabled, the LMS200 stops
+// streaming, no run folder (nor its hidden staging folder) is left, and the exit code is 130
+// with a message saying so. The devices are emulated in this process, so their state is read
+// directly the moment the run has exited.
+TEST_F(HwRunCli, CtrlCWhileTheBaseTurnsStopsItAndLeavesNoRunFolder) {
+  hw::Lms200Emulator lms{hw::Lms200EmulatorConfig{}};
+  hw::PitchUnitEmulator pitch{sensors::PitchUnitConfig{}};
+  hw::P2osEmulator base{hw::P2osEmulatorConfig{38400}};
+  const fs::path config =
+      Write("ctrl_c.yaml",
+            std::string(kSharedConfig) + "backend: hw\nhw:\n" + "  lms200: {device: " + lms.path() +
+                ", baud: 38400, continuous: true}\n" + "  pitch_unit: {device: " + pitch.path() +
+                ", baud: 38400}\n" + "  base: {device: " + base.path() + ", baud: 38400}\n");
+  const fs::path out = dir_ / "interrupted", err = dir_ / "interrupted.err";
+  // The goal is behind the robot: the mission begins by turning in place to face it.
+  Background run(
+      {"run", "--config", config.string(), "--goal=-6,0", "--out", out.string(), "--quiet"}, err);
+  ASSERT_TRUE(run.Until([&] { return base.command().second != 0.0; })) << Slurp(err);
+  ASSERT_TRUE(base.motors_enabled());
+  ASSERT_TRUE(lms.streaming());
+  EXPECT_EQ(run.Signal(SIGINT), 130) << Slurp(err);
+  const std::string message = Slurp(err);
+  EXPECT_NE(message.find("interrupted by SIGINT"), std::string::npos) << message;
+  EXPECT_NE(message.find("no run folder written"), std::string::npos) << message;
+  EXPECT_TRUE(Soon([&] { return !base.motors_enabled(); })) << "motors left enabled";
+  EXPECT_EQ(base.command(), std::make_pair(0.0, 0.0));
+  EXPECT_TRUE(Soon([&] { return !lms.streaming(); })) << "LMS200 left streaming";
+  EXPECT_FALSE(fs::exists(out));
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    EXPECT_EQ(entry.path().filename().string().rfind(".interrupted", 0), std::string::npos)
+        << "staging folder left: " << entry.path();
+  }
+}
+
+TEST_F(HwRunCli, SigtermWhileHwLms200WaitsForASilentDeviceEndsWithTheSignalsCode) {
+  hw::Lms200Emulator lms{hw::Lms200EmulatorConfig{}};
+  hw::FaultPlan silent;
+  silent.kind = hw::FaultPlan::Kind::kSilent;
+  lms.SetFaults(silent);  // the driver keeps probing baud rates: a long wait to interrupt
+  const fs::path err = dir_ / "lms200.err";
+  Background scan({"hw", "lms200", "--device", lms.path(), "--baud", "38400", "--once", "--json"},
+                  err);
+  ASSERT_TRUE(scan.Until([&] { return lms.stats().requests > 0; })) << Slurp(err);
+  EXPECT_EQ(scan.Signal(SIGTERM), 128 + SIGTERM) << Slurp(err);
+  const std::string message = Slurp(err);
+  EXPECT_NE(message.find("hw lms200: interrupted by SIGTERM"), std::string::npos) << message;
+  EXPECT_FALSE(lms.streaming());
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // telegram; baud switch acknowledged at the old rate; variant, range mode, single scans and
 // continuous output. Ranges come from a callback (the simulator, or a built-in flat wall).
 
+#include <atomic>
 #include <functional>
 #include <mutex>
 #include <string>
@@ -37,6 +38,8 @@ class Lms200Emulator final : public EmulatedDevice {
   sensors::Lms200Config current() const;
   /// Measured-value telegrams sent so far.
   std::size_t scans_sent() const;
+  /// True while the device streams measured values (mode 0x24).
+  bool streaming() const { return streaming_; }
 
  private:
   void OnBytes(const std::uint8_t* bytes, std::size_t size) override;
@@ -45,6 +48,7 @@ class Lms200Emulator final : public EmulatedDevice {
   void Handle(const lms200::Telegram& request);
   void Reply(std::uint8_t command, std::vector<std::uint8_t> data);
   void SendScan();
+  std::vector<std::uint8_t> StatusBlock() const;
   sensors::LaserLine FlatWall(const sensors::Lms200Config& config) const;
 
   Lms200EmulatorConfig config_;
@@ -55,7 +59,7 @@ class Lms200Emulator final : public EmulatedDevice {
   sensors::Lms200Config current_;
   std::size_t scans_sent_ = 0;
   bool setup_mode_ = false;
-  bool streaming_ = false;
+  std::atomic<bool> streaming_{false};
   double next_stream_s_ = 0.0;
   std::vector<std::uint8_t> config_block_;
 };

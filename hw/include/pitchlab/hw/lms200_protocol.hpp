@@ -32,7 +32,8 @@ enum Command : std::uint8_t {
   kReset = 0x10,          ///< re-initialise; reply 0x91, then the power-on telegram
   kSwitchMode = 0x20,     ///< operating mode / baud rate; reply 0xA0
   kRequestValues = 0x30,  ///< measured values (0x01 = one full scan); reply 0xB0
-  kRequestStatus = 0x31,  ///< status; reply 0xB1
+  kRequestStatus = 0x31,  ///< status; reply 0xB1 (kStatusBlockBytes + status byte)
+  kRequestErrors = 0x32,  ///< error list (type, number pairs); reply 0xB2
   kRequestType = 0x3A,    ///< type string ("LMS200;30106"); reply 0xBA
   kSwitchVariant = 0x3B,  ///< field of view + resolution; reply 0xBB
   kRequestConfig = 0x74,  ///< configuration block; reply 0xF4
@@ -51,10 +52,23 @@ enum Mode : std::uint8_t {
   kModeBaud500k = 0x48,
 };
 
-/// Index of the measuring-units byte in the configuration block (0 = cm, 1 = mm).
-constexpr std::size_t kConfigUnitsIndex = 6;
-/// Length of the configuration block of an LMS200 (kRequestConfig reply without status).
-constexpr std::size_t kConfigBlockBytes = 32;
+/// The configuration block (kRequestConfig reply data without its status byte; kConfigure
+/// request data): blocks A..A4, 34 bytes. Offsets of the bytes the clients touch (layout as
+/// docs/hardware_interop.md records it from independent LMS2xx drivers).
+constexpr std::size_t kConfigBlockBytes = 34;
+constexpr std::size_t kConfigAvailabilityIndex = 4;   ///< block C
+constexpr std::size_t kConfigMeasuringModeIndex = 5;  ///< block D: 0..2 = 8 m / 80 m modes
+constexpr std::size_t kConfigUnitsIndex = 6;          ///< block E: 0 = cm, 1 = mm
+/// The status block (kRequestStatus reply data without its status byte), 152 bytes, and the
+/// offsets in it of the fields clients read (data index: the telegram's byte after CMD is 0).
+constexpr std::size_t kStatusBlockBytes = 152;
+constexpr std::size_t kStatusVersionIndex = 0;          ///< 7 characters, e.g. "V02.10 "
+constexpr std::size_t kStatusOperatingModeIndex = 7;    ///< kModeSetup / 0x24 / 0x25
+constexpr std::size_t kStatusDeviceStatusIndex = 8;     ///< 0 = no error
+constexpr std::size_t kStatusMeasuringModeIndex = 101;  ///< as the configuration's block D
+constexpr std::size_t kStatusScanAngleIndex = 106;      ///< field of view [deg], LE 16 bit
+constexpr std::size_t kStatusResolutionIndex = 108;     ///< [0.01 deg], LE 16 bit
+constexpr std::size_t kStatusUnitsIndex = 121;          ///< 0 = cm, 1 = mm
 /// Special measured-value codes (13-bit).
 constexpr std::uint16_t kCodeNoReturn = 8191;  ///< invalid / no measurement
 constexpr std::uint16_t kCodeDazzled = 8190;
@@ -91,6 +105,7 @@ Telegram SetupModeRequest();  ///< kSwitchMode 0x00 with the password "SICK_LMS"
 Telegram SingleScanRequest();
 Telegram TypeRequest();
 Telegram StatusRequest();
+Telegram ErrorsRequest();
 Telegram VariantRequest(int fov_deg, int resolution_cdeg);  ///< e.g. (180, 50)
 Telegram ConfigRequest();
 Telegram ConfigureRequest(const std::vector<std::uint8_t>& block);

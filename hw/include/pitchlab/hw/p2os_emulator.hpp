@@ -1,7 +1,8 @@
 #pragma once
 // An emulated Pioneer P3 microcontroller (P2OS/ARCOS) on a pseudo-terminal: SYNC0/1/2 handshake,
 // OPEN, ENABLE, VEL/RVEL, SETO, CLOSE, E_STOP, a 2 s watchdog, standard SIPs every 100 ms.
-// Motion comes from callbacks (the simulated base) or a built-in unicycle.
+// STOP, VEL2, SONAR and CONFIG are accepted (CONFIG is not answered). Motion comes from callbacks
+// (the simulated base) or a built-in unicycle.
 
 #include <functional>
 #include <mutex>
@@ -32,7 +33,9 @@ struct P2osEmulatorConfig {
   double sip_period_s = 0.1;  ///< standard SIP rate [s]
   double watchdog_s = 2.0;    ///< motors stop after this long without a packet [s]
   double track_m = 0.33;      ///< built-in model's wheel track [m]
-  std::string name = "pitchlab", type = "Pioneer", subtype = "p3at";
+  /// SYNC2 strings. "p3at-sh" (an ARCOS P3-AT) is the subclass whose client tables take the
+  /// SIP's positions and speeds as mm and mm/s, as sent here (docs/hardware_interop.md).
+  std::string name = "pitchlab", type = "Pioneer", subtype = "p3at-sh";
 };
 
 class P2osEmulator final : public EmulatedDevice {
@@ -45,6 +48,8 @@ class P2osEmulator final : public EmulatedDevice {
   bool connected() const { return connected_; }
   /// True while motors are enabled.
   bool motors_enabled() const { return enabled_; }
+  /// The wheel setpoint in force: forward [m/s], yaw rate [rad/s].
+  std::pair<double, double> command() const { return {v_mps_, omega_rps_}; }
 
  private:
   void OnBytes(const std::uint8_t* bytes, std::size_t size) override;
@@ -59,7 +64,7 @@ class P2osEmulator final : public EmulatedDevice {
   p2os::PacketReader reader_;
   int sync_stage_ = 0;  // next SYNC expected; 3 = synced
   std::atomic<bool> connected_{false}, enabled_{false};
-  double v_mps_ = 0.0, omega_rps_ = 0.0;
+  std::atomic<double> v_mps_{0.0}, omega_rps_{0.0};
   double last_packet_s_ = 0.0, next_sip_s_ = 0.0, last_step_s_ = 0.0;
   BaseState own_;     // built-in model state
   BaseState origin_;  // SETO: odometry reported relative to this

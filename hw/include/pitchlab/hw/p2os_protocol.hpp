@@ -28,10 +28,14 @@ enum Command : std::uint8_t {
   kPulse = 0,  ///< keep-alive (same number as SYNC0 once connected)
   kOpen = 1,
   kClose = 2,
-  kSetO = 7,    ///< reset odometry to the origin
-  kEnable = 4,  ///< motors on (arg 1) / off (arg 0)
-  kVel = 11,    ///< forward speed [mm/s]
-  kRVel = 21,   ///< rotational speed [deg/s]
+  kSetO = 7,     ///< reset odometry to the origin
+  kEnable = 4,   ///< motors on (arg 1) / off (arg 0)
+  kVel = 11,     ///< forward speed [mm/s]
+  kConfig = 18,  ///< request a CONFIG packet (not emulated: clients fall back to their tables)
+  kRVel = 21,    ///< rotational speed [deg/s]
+  kSonar = 28,   ///< sonars on (arg 1) / off (arg 0)
+  kStop = 29,    ///< stop moving, motors stay enabled
+  kVel2 = 32,    ///< wheel speeds: argument bits 8-15 left, 0-7 right, signed, kVel2Unit each
   kEStop = 55,
 };
 /// Argument type bytes.
@@ -40,6 +44,9 @@ constexpr std::uint8_t kArgNegInt = 0x1B;
 /// SIP types: standard SIPs are 0x32 (motors stopped) and 0x33 (moving).
 constexpr std::uint8_t kSipStopped = 0x32;
 constexpr std::uint8_t kSipMoving = 0x33;
+
+/// Wheel-speed unit of VEL2 [mm/s] (the P3's Vel2Divisor in the client tables).
+constexpr int kVel2UnitMmps = 20;
 
 /// Angle unit of THPOS: 4096 per revolution [rad].
 constexpr double kAngleUnitRad = 0.001533981;
