@@ -7,6 +7,7 @@
 
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/point_cloud.hpp"
+#include "slope_guard.hpp"
 
 namespace pitchlab::apps {
 namespace {
@@ -19,6 +20,10 @@ constexpr double kEscapeRadius_m = 1.0;   // how far a start inside a hazard mar
 constexpr double kGoalApproach_m = 2.0;   // a blocked goal farther than this: approach it
 constexpr double kHeadingTolerance_rad = 3.0 * kPi / 180;  // turning in place ends within this
 constexpr double kTurnGain_per_s = 2.0;   // yaw rate per radian of heading error
+constexpr double kBackOff_m = 0.6;         // reverse this far from a tilt beyond caution
+constexpr double kBackOffSpeed_mps = 0.2;
+constexpr double kFeltAhead_m = 0.2;       // the tilting ground: under the front axle and on
+constexpr double kSlopeLookahead_m = 1.0;  // slow down this far before a slope (braking distance)
 
 double Yaw(const Eigen::Isometry3d& T) { return std::atan2(T.linear()(1, 0), T.linear()(0, 0)); }
 
@@ -79,7 +84,9 @@ class Mission {
   void UpdateElevation(const StopRecord& stop);
   void Plan(StopRecord& stop) const;
   bool Drive(const StopRecord& stop);
-  bool Follow(const std::vector<Eigen::Vector2d>& prefix);
+  bool Follow(const planning::Path& path, double length_m);
+  bool BackOff(const sensors::Odometry& odo, double tilt_rad);  // false: the mission ends
+  double Tilt() const { return probes_.tilt_rad ? probes_.tilt_rad() : 0.0; }
   bool TurnTo(double yaw_rad);
   bool Rebase();  // the map frame = base_link where the robot is now (before the first scan)
   bool RecordSample(const sensors::Odometry& odo);  // false: tipping over (reason set)
@@ -102,6 +109,8 @@ class Mission {
   Eigen::Isometry3d T_world_base_ = Eigen::Isometry3d::Identity();  // estimate at odo_ref_
   sensors::Odometry odo_ref_;
   bool last_stop_turned_only_ = false;  // the previous stop only turned to look ahead
+  bool backed_off_ = false;             // the last drive ended backing off from a tilt
+  std::vector<FeltHazard> felt_;
 };
 
 MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
@@ -241,7 +250,9 @@ std::optional<Eigen::Vector2d> EscapeCell(const planning::TraversabilityGrid& gr
 }
 
 void Mission::Plan(StopRecord& stop) const {
-  const mapping::ElevationLayers layers = mapping::ComputeLayers(result_.elevation);
+  mapping::ElevationLayers layers = mapping::ComputeLayers(result_.elevation);
+  for (const FeltHazard& f : felt_) MarkFelt(layers, f);
+  stop.felt_hazards = static_cast<int>(felt_.size());
   planning::PlannerConfig planner = config_.planner;
   planner.robot.width_m += 2.0 * config_.safety_margin_m;  // the follower cuts corners a little
   const planning::TraversabilityGrid grid = planning::BuildTraversability(layers, planner);
@@ -298,8 +309,10 @@ bool Mission::Drive(const StopRecord& stop) {
   const bool turn_only = length < config_.unknown_margin_m && !last_stop_turned_only_;
   if (!turn_only) length = std::max(length, std::min(config_.drive_per_stop_m, 1.0));
   last_stop_turned_only_ = turn_only;
-  if (!turn_only && !Follow(PathPrefix(path, length))) return false;
-  if (!TurnTo(PathHeading(path, turn_only ? 0.0 : length))) return false;
+  backed_off_ = false;
+  if (!turn_only && !Follow(path, length)) return false;
+  // After backing off, the next scan looks at the slope from where the robot stands.
+  if (!backed_off_ && !TurnTo(PathHeading(path, turn_only ? 0.0 : length))) return false;
   Result<sensors::Odometry> stopped = base_.Drive(0.0, 0.0, kStopTime_s);
   if (!stopped) {
     result_.reason = "base: " + stopped.error().message;
@@ -357,7 +370,11 @@ bool Mission::RecordSample(const sensors::Odometry& odo) {
   return false;
 }
 
-bool Mission::Follow(const std::vector<Eigen::Vector2d>& prefix) {
+bool Mission::Follow(const planning::Path& path, double length_m) {
+  const std::vector<Eigen::Vector2d> prefix = PathPrefix(path, length_m);
+  double prefix_m = 0;
+  for (std::size_t i = 1; i < prefix.size(); ++i) prefix_m += (prefix[i] - prefix[i - 1]).norm();
+  const double slope_grade = std::tan(config_.slope_tilt_deg * kPi / 180);
   PurePursuit follower(prefix, config_.follower);
   sensors::Odometry odo = odo_ref_;
   if (Result<sensors::Odometry> now = base_.ReadOdometry(); now) odo = *now;
@@ -366,9 +383,19 @@ bool Mission::Follow(const std::vector<Eigen::Vector2d>& prefix) {
   while (true) {
     if (OverBudget()) return false;
     const Eigen::Isometry3d T_est = Estimate(odo);
-    const DriveCommand cmd =
+    DriveCommand cmd =
         follower.Command(T_est.translation().x(), T_est.translation().y(), Yaw(T_est));
     if (cmd.done) return true;
+    const double tilt = Tilt();
+    if (tilt > config_.caution_tilt_deg * kPi / 180) return BackOff(odo, tilt);
+    const double arc = prefix_m - follower.remaining_m();
+    if (tilt > config_.slope_tilt_deg * kPi / 180 ||
+        MaxGrade(path, arc, arc + kSlopeLookahead_m) > slope_grade) {
+      // Slower on slopes, on the same arc: braking and turning pitch a top-heavy robot over.
+      const double scale = std::min(1.0, config_.slope_speed_mps / std::max(std::abs(cmd.v_mps), 1e-9));
+      cmd.v_mps *= scale;
+      cmd.omega_rps *= scale;
+    }
     Result<sensors::Odometry> next = base_.Drive(cmd.v_mps, cmd.omega_rps, config_.control_period_s);
     if (!next) {
       result_.reason = "base: " + next.error().message;
@@ -387,6 +414,37 @@ bool Mission::Follow(const std::vector<Eigen::Vector2d>& prefix) {
   }
 }
 
+// Reverses straight out of a tilt beyond caution and remembers the ground ahead as too steep.
+bool Mission::BackOff(const sensors::Odometry& odo, double tilt_rad) {
+  const Eigen::Isometry3d T = Estimate(odo);
+  const double heading = Yaw(T);
+  felt_.push_back({T.translation().head<2>() +
+                       kFeltAhead_m * Eigen::Vector2d(std::cos(heading), std::sin(heading)),
+                   heading, tilt_rad, T.translation().z()});
+  backed_off_ = true;
+  char line[160];
+  std::snprintf(line, sizeof(line),
+                "tilt %.1f deg at (%.2f, %.2f): backing off, the ground ahead is too steep",
+                tilt_rad * 180 / kPi, T.translation().x(), T.translation().y());
+  Progress(line);
+  const Eigen::Vector2d from(odo.x_m, odo.y_m);
+  const double start_s = probes_.now_s();
+  sensors::Odometry now = odo;
+  while ((Eigen::Vector2d(now.x_m, now.y_m) - from).norm() < kBackOff_m) {
+    if (OverBudget()) return false;
+    if (probes_.now_s() - start_s > config_.stuck_timeout_s) break;  // as far as it goes
+    Result<sensors::Odometry> next = base_.Drive(-kBackOffSpeed_mps, 0.0, config_.control_period_s);
+    if (!next) {
+      result_.reason = "base: " + next.error().message;
+      return false;
+    }
+    result_.odometry_distance_m += std::hypot(next->x_m - now.x_m, next->y_m - now.y_m);
+    now = *next;
+    if (!RecordSample(now)) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 MissionResult RunMission(sensors::ScanSource& source, sensors::MobileBase& base,
@@ -397,6 +455,13 @@ MissionResult RunMission(sensors::ScanSource& source, sensors::MobileBase& base,
   config.planner.Validate();
   config.registration.Validate();
   if (config.map_area.cell_count() == 0) throw std::invalid_argument("mission: empty map area");
+  if (!(config.caution_tilt_deg > 0 && config.caution_tilt_deg < config.max_tilt_deg) ||
+      !(config.slope_tilt_deg > 0 && config.slope_tilt_deg < config.caution_tilt_deg) ||
+      !(config.slope_speed_mps > 0)) {
+    throw std::invalid_argument(
+        "mission: need 0 < slope_tilt_deg < caution_tilt_deg < max_tilt_deg and "
+        "slope_speed_mps > 0");
+  }
   if (!(config.drive_per_stop_m > 0) || config.max_stops < 1 || !(config.goal_tolerance_m > 0)) {
     throw std::invalid_argument("mission: drive_per_stop_m, max_stops, goal_tolerance_m must be > 0");
   }

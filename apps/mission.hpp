@@ -27,6 +27,12 @@ struct MissionConfig {
   int max_stops = 40;              ///< scans at most [1]
   double time_budget_s = 1800.0;   ///< mission time at most (simulated or real) [s]
   double max_tilt_deg = 30.0;      ///< beyond this the robot is tipping over [deg]
+  /// Beyond this tilt the robot backs off and marks the ground ahead as too steep, then plans
+  /// again: a top-heavy P3 (the laser sits 0.45 m up) pitches over a rim before the map says so.
+  double caution_tilt_deg = 22.0;
+  /// Beyond this tilt the follower slows to slope_speed_mps (same curvature) [deg].
+  double slope_tilt_deg = 10.0;
+  double slope_speed_mps = 0.2;    ///< cruise speed on slopes [m/s]
   double stuck_timeout_s = 8.0;    ///< no progress while commanded for this long: stuck [s]
   double control_period_s = 0.1;   ///< path follower rate [s]
   /// Clearance kept beyond the robot's half width when planning, for tracking error [m].
@@ -45,7 +51,9 @@ struct MissionConfig {
 /// What the loop reads besides the seam interfaces. `now_s` is required; the others may be empty.
 struct MissionProbes {
   std::function<double()> now_s;  ///< the run's clock (simulated or steady) [s]
-  std::function<double()> tilt_rad;  ///< attitude sensor: angle of base_link's z from vertical
+  /// Attitude sensor: angle of base_link's z from vertical. Without it the robot neither slows
+  /// on slopes nor backs off from a tilt, and cannot tell it is tipping over.
+  std::function<double()> tilt_rad;
   /// Ground truth (simulation only): scoring, never steering.
   std::function<Eigen::Isometry3d()> true_pose;
   /// True once the run should stop now (Ctrl-C on hardware); polled wherever the budget is.
@@ -64,6 +72,7 @@ struct StopRecord {
   std::optional<planning::Path> plan;  ///< to the goal, world frame
   std::string plan_error;              ///< why there was no plan
   double plan_known_m = 0;             ///< length of the plan over observed cells [m]
+  int felt_hazards = 0;                ///< places marked too steep by the tilt so far
   bool elevation_from_odometry = false;  ///< registration failed: the scan entered the elevation
                                          ///< map at the odometry pose
   double distance_to_goal_m = 0;       ///< from the estimate [m]

@@ -20,6 +20,8 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
   const std::map<std::string, double*> numbers = {
       {"goal_tolerance_m", &m.goal_tolerance_m}, {"drive_per_stop_m", &m.drive_per_stop_m},
       {"time_budget_s", &m.time_budget_s},       {"max_tilt_deg", &m.max_tilt_deg},
+      {"caution_tilt_deg", &m.caution_tilt_deg}, {"slope_tilt_deg", &m.slope_tilt_deg},
+      {"slope_speed_mps", &m.slope_speed_mps},
       {"stuck_timeout_s", &m.stuck_timeout_s},   {"control_period_s", &m.control_period_s},
       {"cell_m", &s.cell_m},                     {"safety_margin_m", &m.safety_margin_m},
       {"unknown_margin_m", &m.unknown_margin_m},                     {"lookahead_m", &m.follower.lookahead_m},
@@ -97,6 +99,13 @@ RunSettings ParseRunSettings(const std::string& yaml_text, const std::string& so
     m.registration.registration = mapping::ParseRegistrationConfig(yaml_text, source);
     if (!has_ratio) m.registration.registration.min_inlier_ratio = kMissionMinInlierRatio;
   }
+  if (!(m.slope_tilt_deg > 0 && m.slope_tilt_deg < m.caution_tilt_deg &&
+        m.caution_tilt_deg < m.max_tilt_deg) ||
+      !(m.slope_speed_mps > 0)) {
+    throw std::invalid_argument(source +
+                                ": run: need 0 < slope_tilt_deg < caution_tilt_deg < "
+                                "max_tilt_deg and slope_speed_mps > 0");
+  }
   m.follower.Validate();
   return s;
 }
@@ -112,6 +121,9 @@ std::string RunSettingsToYaml(const RunSettings& s) {
      << "  max_stops: " << m.max_stops << "\n"
      << "  time_budget_s: " << m.time_budget_s << "\n"
      << "  max_tilt_deg: " << m.max_tilt_deg << "\n"
+     << "  caution_tilt_deg: " << m.caution_tilt_deg << "\n"
+     << "  slope_tilt_deg: " << m.slope_tilt_deg << "\n"
+     << "  slope_speed_mps: " << m.slope_speed_mps << "\n"
      << "  stuck_timeout_s: " << m.stuck_timeout_s << "\n"
      << "  control_period_s: " << m.control_period_s << "\n"
      << "  cell_m: " << s.cell_m << "\n"

@@ -1,0 +1,35 @@
+#pragma once
+// Driving on slopes with a top-heavy P3: the laser sits 0.45 m up, so the loaded P3-AT pitches
+// over forward at about 21 deg (its centre of mass is 0.25 m high and 0.1 m behind the front axle),
+// close to the 19.3 deg the planner allows. The mission slows where the planned path is steep and
+// backs off when its own tilt passes a caution limit; these helpers are the geometry of that.
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "pitchlab/mapping/elevation_layers.hpp"
+#include "pitchlab/planning/planner.hpp"
+
+namespace pitchlab::apps {
+
+/// The steepest grade |dz| / ds of the path between arc lengths from_m and to_m [m], measured over
+/// baselines of baseline_m along the path (single cells are too noisy to tell a slope) [1].
+double MaxGrade(const planning::Path& path, double from_m, double to_m, double baseline_m = 0.3);
+
+/// Ground the robot's own tilt showed to be too steep: an attitude sensor measures the slope over
+/// the whole footprint, which a sparse scan of a rim or a crack can miss.
+struct FeltHazard {
+  Eigen::Vector2d centre_m = Eigen::Vector2d::Zero();  ///< world frame [m]
+  double heading_rad = 0;  ///< the robot's heading when it tilted [rad]
+  double tilt_rad = 0;     ///< the tilt it felt [rad]
+  double z_m = 0;          ///< base_link height estimate there [m]
+  double radius_m = 0.35;  ///< about the robot's half length [m]
+};
+
+/// Gives every cell within f.radius_m of f.centre_m the felt slope (along the heading), so the
+/// planner's inclination limit forbids them; unobserved cells there become observed at f.z_m.
+/// Drop cells stay drops.
+void MarkFelt(mapping::ElevationLayers& layers, const FeltHazard& f);
+
+}  // namespace pitchlab::apps
