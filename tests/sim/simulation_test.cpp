@@ -221,7 +221,8 @@ TEST(ComposeWorldXml, MakesRelativeAssetPathsAbsoluteAndKeepsAbsoluteOnes) {
 namespace pitchlab::sim {
 namespace {
 
-// Every world the build generates loads with the robot, places at its default start and settles.
+// Every world the build generates loads with the robot, places at its default start and settles,
+// and is georeferenced (so run folders carry GeoJSON paths and trajectories).
 TEST(Worlds, EveryBuildWorldPlacesBothRobotsAtItsDefaultStart) {
   DIR* dir = opendir(PITCHLAB_WORLDS_DIR);
   if (dir == nullptr) GTEST_SKIP() << "no worlds folder " << PITCHLAB_WORLDS_DIR;
@@ -240,6 +241,9 @@ TEST(Worlds, EveryBuildWorldPlacesBothRobotsAtItsDefaultStart) {
       Result<Eigen::Isometry3d> pose = sim.PlaceRobot(start.x(), start.y(), start.z());
       EXPECT_TRUE(pose) << name << ": " << pose.error().message;
       EXPECT_TRUE(sim.TakeWarnings().empty()) << name;
+      ASSERT_TRUE(sim.world().geodetic_origin) << name;
+      EXPECT_LE(std::abs(sim.world().geodetic_origin->x()), 90.0) << name;
+      EXPECT_LE(std::abs(sim.world().geodetic_origin->y()), 180.0) << name;
     }
   }
 }

@@ -121,6 +121,9 @@ std::filesystem::path GenerateTerrainWorld(const TerrainConfig& config,
   metadata.bounds = Bounds2d{grid.x0_m + margin_m, grid.y0_m + margin_m, grid.XMax_m() - margin_m,
                              grid.YMax_m() - margin_m};
   metadata.default_start = StartPose{0.0, 0.0, 0.0};
+  // Illustrative placement in the hills south of Cluj-Napoca, where the paper's authors worked,
+  // so maps and paths open in GIS tools in a plausible place.
+  metadata.geodetic_origin = GeodeticPoint{46.72000, 23.60000, 700.0};
   // The default run: 35 m north-west, past the butte and over rougher ground.
   metadata.default_goal = GoalPoint{-25.0, 25.0};
   std::filesystem::create_directories(out_dir);
