@@ -253,9 +253,8 @@ void Mission::Plan(StopRecord& stop) const {
   mapping::ElevationLayers layers = mapping::ComputeLayers(result_.elevation);
   for (const FeltHazard& f : felt_) MarkFelt(layers, f);
   stop.felt_hazards = static_cast<int>(felt_.size());
-  planning::PlannerConfig planner = config_.planner;
-  planner.robot.width_m += 2.0 * config_.safety_margin_m;  // the follower cuts corners a little
-  const planning::TraversabilityGrid grid = planning::BuildTraversability(layers, planner);
+  const planning::TraversabilityGrid grid =
+      planning::BuildTraversability(layers, MissionPlanner(config_));
   const Eigen::Vector2d here = stop.T_world_base.translation().head<2>();
   auto path = planning::PlanPath(grid, here, config_.goal_m, config_.algorithm);
   if (!path && path.error().reason == planning::NoPath::Reason::kStartBlocked) {
@@ -446,6 +445,12 @@ bool Mission::BackOff(const sensors::Odometry& odo, double tilt_rad) {
 }
 
 }  // namespace
+
+planning::PlannerConfig MissionPlanner(const MissionConfig& config) {
+  planning::PlannerConfig planner = config.planner;
+  planner.robot.width_m += 2.0 * config.safety_margin_m;  // the follower cuts corners a little
+  return planner;
+}
 
 MissionResult RunMission(sensors::ScanSource& source, sensors::MobileBase& base,
                          const Eigen::Isometry3d& T_world_start, const MissionConfig& config,

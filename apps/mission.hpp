@@ -60,6 +60,9 @@ struct MissionProbes {
   std::function<bool()> interrupted;
 };
 
+/// The planner as the mission runs it: the robot's width grown by the safety margin each side.
+planning::PlannerConfig MissionPlanner(const MissionConfig& config);
+
 /// One stop of the mission, as it happened.
 struct StopRecord {
   int index = 0;

@@ -178,6 +178,7 @@ int RunRun(int argc, char** argv) {
   context.goal = goal;
   context.geodetic_origin = origin;
   context.config_yaml = AppConfigToYaml(config) + RunSettingsToYaml(settings);
+  context.planner = MissionPlanner(mission);
   context.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   WriteFinalOutputs(folder, context, result, score, &truth_layers, *optimum);

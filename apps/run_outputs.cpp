@@ -1,4 +1,5 @@
 #include "run_outputs.hpp"
+#include "traversability_image.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -249,7 +250,13 @@ void WriteFinalOutputs(RunFolder& folder, const RunContext& c, const MissionResu
   DrawPolyline(image, r.elevation.geometry(), EstimatedXy(r), 255, 140, 0);
   DrawPolyline(image, r.elevation.geometry(), TrueXy(r), 30, 80, 255);
   Check(mapping::WritePng(image, folder.File("elevation.png").string()));
+  Check(mapping::WritePng(
+      RenderTraversability(planning::BuildTraversability(layers, c.planner), options),
+      folder.File("traversability.png").string()));
   if (truth) {
+    Check(mapping::WritePng(
+        RenderTraversability(planning::BuildTraversability(*truth, c.planner), options),
+        folder.File("truth_traversability.png").string()));
     mapping::RgbImage truth_image = mapping::RenderElevationImage(*truth, options);
     if (truth_optimum) planning::DrawPath(*truth_optimum, truth->geometry, truth_image);
     DrawPolyline(truth_image, truth->geometry, TrueXy(r), 30, 80, 255);
@@ -272,7 +279,15 @@ void WriteFinalOutputs(RunFolder& folder, const RunContext& c, const MissionResu
     report.Png(ReadBinaryFile(folder.File("truth_elevation.png")),
                "true elevation map, true optimal path (red), true trajectory (blue)", 900);
   }
-  report.Plot({{"estimated", "#e08000", EstimatedXy(r), false}, {"true", "#1e50ff", TrueXy(r), true}},
+  report.Paragraph("Where the planner may go, on the estimated map at the end and on the true "
+                   "map. " + TraversabilityLegend());
+  report.Png(ReadBinaryFile(folder.File("traversability.png")), "traversability, estimated map",
+             900);
+  if (truth) {
+    report.Png(ReadBinaryFile(folder.File("truth_traversability.png")),
+               "traversability, true map", 900);
+  }
+    report.Plot({{"estimated", "#e08000", EstimatedXy(r), false}, {"true", "#1e50ff", TrueXy(r), true}},
               "trajectories (world frame, metres)");
   report.Heading("Stops");
   std::vector<std::vector<std::string>> table;

@@ -24,6 +24,8 @@ struct RunContext {
   Eigen::Vector2d goal{0, 0};      ///< [m]
   std::optional<mapping::GeodeticOrigin> geodetic_origin;
   std::string config_yaml;         ///< the configuration as used
+  /// The planner as the mission used it (robot width including the safety margin).
+  planning::PlannerConfig planner;
   double wall_time_s = 0;          ///< whole run including set-up [s]
 };
 

@@ -85,7 +85,8 @@ TEST_F(RunCli, AMissionAroundABlockReachesTheGoalAndWritesEveryOutput) {
   EXPECT_TRUE(mapping::LoadElevationMap((run / "elevation.plem").string()));
   EXPECT_NE(Slurp(run / "elevation.asc").find("ncols"), std::string::npos);
   EXPECT_NE(Slurp(run / "elevation.prj").find("PROJCS"), std::string::npos);
-  for (const char* png : {"elevation.png", "truth_elevation.png"}) {
+  for (const char* png : {"elevation.png", "truth_elevation.png", "traversability.png",
+                          "truth_traversability.png"}) {
     EXPECT_EQ(Slurp(run / png).substr(1, 3), "PNG") << png;
   }
   for (const char* csv : {"trajectory_estimated.csv", "trajectory_true.csv"}) {
