@@ -19,8 +19,9 @@ constexpr double kStopTime_s = 0.5;       // braking before a scan
 constexpr double kEscapeRadius_m = 1.0;   // how far a start inside a hazard margin looks out
 constexpr double kGoalApproach_m = 2.0;   // a blocked goal farther than this: approach it
 constexpr double kHeadingTolerance_rad = 3.0 * kPi / 180;  // turning in place ends within this
-constexpr double kTurnGain_per_s = 2.0;   // yaw rate per radian of heading error
-constexpr double kBackOff_m = 0.6;         // reverse this far from a tilt beyond caution
+constexpr double kTurnGain_per_s = 2.0;                    // yaw rate per radian of heading error
+constexpr double kMinDrive_m = 0.1;  // a drive shorter than this is no progress
+constexpr double kBackOff_m = 0.6;   // reverse this far from a tilt beyond caution
 constexpr double kBackOffSpeed_mps = 0.2;
 constexpr double kFeltAhead_m = 0.2;       // the tilting ground: under the front axle and on
 constexpr double kSlopeLookahead_m = 1.0;  // slow down this far before a slope (braking distance)
@@ -43,7 +44,8 @@ Eigen::Isometry3d Propagate(const Eigen::Isometry3d& T_world_base_at_ref,
   const Eigen::Vector2d step_world = Eigen::Rotation2Dd(yaw) * step_base;
   const double new_yaw = yaw + std::remainder(now.yaw_rad - ref.yaw_rad, 2.0 * kPi);
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.translation() = T_world_base_at_ref.translation() + Eigen::Vector3d(step_world.x(), step_world.y(), 0);
+  T.translation() =
+      T_world_base_at_ref.translation() + Eigen::Vector3d(step_world.x(), step_world.y(), 0);
   T.linear() = (Eigen::AngleAxisd(new_yaw, Eigen::Vector3d::UnitZ()) *
                 Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
                 Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
@@ -74,7 +76,11 @@ class Mission {
  public:
   Mission(sensors::ScanSource& source, sensors::MobileBase& base, const MissionConfig& config,
           const MissionProbes& probes, const MissionObserver& observer)
-      : source_(source), base_(base), config_(config), probes_(probes), observer_(observer),
+      : source_(source),
+        base_(base),
+        config_(config),
+        probes_(probes),
+        observer_(observer),
         builder_(config.registration) {}
 
   MissionResult Run(const Eigen::Isometry3d& T_world_start);
@@ -83,6 +89,8 @@ class Mission {
   bool Stop(int k);  // false: the mission ends (result_.reason says why)
   void UpdateElevation(const StopRecord& stop);
   void Plan(StopRecord& stop) const;
+  tl::expected<planning::Path, planning::NoPath> PlanOn(const planning::TraversabilityGrid& grid,
+                                                        const Eigen::Vector2d& here) const;
   bool Drive(const StopRecord& stop);
   bool Follow(const planning::Path& path, double length_m);
   bool BackOff(const sensors::Odometry& odo, double tilt_rad);  // false: the mission ends
@@ -172,8 +180,8 @@ bool Mission::Stop(int k) {
   if (!merge) stop.merge.registration.reason = merge.error().message;
   // A failed registration is never merged: the pose comes from odometry and the map keeps
   // what it had.
-  stop.T_world_base = stop.merge.merged ? T_world_map_ * stop.merge.T_map_base
-                                        : stop.T_world_base_odom;
+  stop.T_world_base =
+      stop.merge.merged ? T_world_map_ * stop.merge.T_map_base : stop.T_world_base_odom;
   T_world_base_ = stop.T_world_base;
   odo_ref_ = *odo;
   // A scan whose registration failed is never merged into the map cloud; the elevation map
@@ -191,7 +199,10 @@ bool Mission::Stop(int k) {
   std::snprintf(line, sizeof(line), "stop %d: %.1f m to goal, registration %s, %s", k,
                 s.distance_to_goal_m,
                 s.merge.merged ? mapping::ToString(s.merge.registration.path) : "FAILED",
-                arrived ? "goal reached" : s.plan ? "path planned" : "no path");
+                arrived           ? "goal reached"
+                : !s.plan         ? "no path"
+                : s.through_drops ? "path planned through inferred drops, to look closer"
+                                  : "path planned");
   Progress(line);
   if (arrived) {
     result_.success = true;
@@ -207,8 +218,8 @@ bool Mission::Stop(int k) {
 
 void Mission::UpdateElevation(const StopRecord& stop) {
   const Eigen::Isometry3f T = stop.T_world_base.cast<float>();
-  const Eigen::Vector3f laser = (stop.T_world_base * config_.mount.BaseToLaser(0.0)).translation()
-                                    .cast<float>();
+  const Eigen::Vector3f laser =
+      (stop.T_world_base * config_.mount.BaseToLaser(0.0)).translation().cast<float>();
   result_.elevation.Insert(stop.scan.points, T, laser);
   // The laser cannot see under the robot, but the robot stands on that ground.
   std::vector<Eigen::Vector3f> ground;
@@ -249,13 +260,11 @@ std::optional<Eigen::Vector2d> EscapeCell(const planning::TraversabilityGrid& gr
   return best;
 }
 
-void Mission::Plan(StopRecord& stop) const {
-  mapping::ElevationLayers layers = mapping::ComputeLayers(result_.elevation);
-  for (const FeltHazard& f : felt_) MarkFelt(layers, f);
-  stop.felt_hazards = static_cast<int>(felt_.size());
-  const planning::TraversabilityGrid grid =
-      planning::BuildTraversability(layers, MissionPlanner(config_));
-  const Eigen::Vector2d here = stop.T_world_base.translation().head<2>();
+// A path from `here` on `grid`: out of a hazard margin first if the robot stands in one, and to
+// the nearest free cell by a blocked goal (within kGoalApproach_m from afar, where the hazard may
+// be a sparse view; within the goal tolerance from close by, which counts as arriving).
+tl::expected<planning::Path, planning::NoPath> Mission::PlanOn(
+    const planning::TraversabilityGrid& grid, const Eigen::Vector2d& here) const {
   auto path = planning::PlanPath(grid, here, config_.goal_m, config_.algorithm);
   if (!path && path.error().reason == planning::NoPath::Reason::kStartBlocked) {
     if (const auto escape = EscapeCell(grid, here)) {
@@ -266,12 +275,55 @@ void Mission::Plan(StopRecord& stop) const {
       }
     }
   }
-  if (!path && path.error().reason == planning::NoPath::Reason::kGoalBlocked &&
-      (config_.goal_m - here).norm() > kGoalApproach_m) {
-    // From afar a blocked goal cell is often a hazard seen sparsely; head for the nearest free
-    // cell near it, and let closer scans settle what is there.
-    if (const auto near = EscapeCell(grid, config_.goal_m, kGoalApproach_m)) {
-      path = planning::PlanPath(grid, here, *near, config_.algorithm);
+  if (!path && path.error().reason == planning::NoPath::Reason::kGoalBlocked) {
+    const bool far = (config_.goal_m - here).norm() > kGoalApproach_m;
+    const double radius = far ? kGoalApproach_m : config_.goal_tolerance_m;
+    if (const auto near = EscapeCell(grid, config_.goal_m, radius)) {
+      auto to_near = planning::PlanPath(grid, here, *near, config_.algorithm);
+      if (to_near) path = std::move(to_near);
+    }
+  }
+  return path;
+}
+
+void Mission::Plan(StopRecord& stop) const {
+  mapping::ElevationLayers layers = mapping::ComputeLayers(result_.elevation);
+  for (const FeltHazard& f : felt_) MarkFelt(layers, f);
+  stop.felt_hazards = static_cast<int>(felt_.size());
+  const planning::PlannerConfig planner = MissionPlanner(config_);
+  planning::TraversabilityGrid grid = planning::BuildTraversability(layers, planner);
+  const Eigen::Vector2d here = stop.T_world_base.translation().head<2>();
+  auto path = PlanOn(grid, here);
+  if (!path) {
+    // Recovery: drops are inferred from rays passing low, and at range a small attitude error
+    // makes them where there are none. If they cut every way, plan through them as unknown: the
+    // robot drives only over what it has seen, stops short of them and looks from closer.
+    std::vector<bool> drop(layers.state.size(), false);
+    std::size_t drops = 0;
+    for (std::size_t k = 0; k < layers.state.size(); ++k) {
+      if (layers.state[k] != mapping::CellState::kDrop) continue;
+      layers.state[k] = mapping::CellState::kUnknown;
+      drop[k] = true;
+      ++drops;
+    }
+    if (drops > 0) {
+      planning::TraversabilityGrid relaxed = planning::BuildTraversability(layers, planner);
+      if (auto through = PlanOn(relaxed, here)) {
+        stop.plan_note =
+            "no path around the inferred drops: planning through them as unknown, "
+            "to look from closer (" +
+            path.error().message + ")";
+        stop.through_drops = true;
+        path = std::move(through);
+        grid = std::move(relaxed);
+        // How far the robot may go before the first of those cells.
+        stop.plan_to_drop_m = 0;
+        for (std::size_t i = 1; i < path->waypoints.size(); ++i) {
+          const planning::Waypoint &v = path->waypoints[i - 1], &w = path->waypoints[i];
+          if (drop[grid.geometry.Linear(grid.geometry.IndexOf(w.x_m, w.y_m))]) break;
+          stop.plan_to_drop_m += std::hypot(w.x_m - v.x_m, w.y_m - v.y_m);
+        }
+      }
     }
   }
   if (!path) {
@@ -306,7 +358,19 @@ bool Mission::Drive(const StopRecord& stop) {
   // close, only turn to face the path so the next scan sees it (once: then drive a little).
   double length = std::min(config_.drive_per_stop_m, stop.plan_known_m - config_.unknown_margin_m);
   const bool turn_only = length < config_.unknown_margin_m && !last_stop_turned_only_;
-  if (!turn_only) length = std::max(length, std::min(config_.drive_per_stop_m, 1.0));
+  // After a turn that showed nothing new, the unknown ground is in the laser's blind zone just
+  // ahead: drive a little onto it, but never up to a cell the map took for a drop.
+  if (!turn_only) {
+    length = std::max(length, std::min(config_.drive_per_stop_m, 1.0));
+    if (stop.through_drops)
+      length = std::min(length, stop.plan_to_drop_m - config_.unknown_margin_m);
+    if (length < kMinDrive_m) {
+      // Looked from as close as it may go: the drops stand, so there is no way on.
+      result_.reason = "no path at stop " + std::to_string(stop.index) +
+                       ": the drops that block the way stay drops seen from close by";
+      return false;
+    }
+  }
   last_stop_turned_only_ = turn_only;
   backed_off_ = false;
   if (!turn_only && !Follow(path, length)) return false;
@@ -391,11 +455,13 @@ bool Mission::Follow(const planning::Path& path, double length_m) {
     if (tilt > config_.slope_tilt_deg * kPi / 180 ||
         MaxGrade(path, arc, arc + kSlopeLookahead_m) > slope_grade) {
       // Slower on slopes, on the same arc: braking and turning pitch a top-heavy robot over.
-      const double scale = std::min(1.0, config_.slope_speed_mps / std::max(std::abs(cmd.v_mps), 1e-9));
+      const double scale =
+          std::min(1.0, config_.slope_speed_mps / std::max(std::abs(cmd.v_mps), 1e-9));
       cmd.v_mps *= scale;
       cmd.omega_rps *= scale;
     }
-    Result<sensors::Odometry> next = base_.Drive(cmd.v_mps, cmd.omega_rps, config_.control_period_s);
+    Result<sensors::Odometry> next =
+        base_.Drive(cmd.v_mps, cmd.omega_rps, config_.control_period_s);
     if (!next) {
       result_.reason = "base: " + next.error().message;
       return false;
@@ -468,7 +534,8 @@ MissionResult RunMission(sensors::ScanSource& source, sensors::MobileBase& base,
         "slope_speed_mps > 0");
   }
   if (!(config.drive_per_stop_m > 0) || config.max_stops < 1 || !(config.goal_tolerance_m > 0)) {
-    throw std::invalid_argument("mission: drive_per_stop_m, max_stops, goal_tolerance_m must be > 0");
+    throw std::invalid_argument(
+        "mission: drive_per_stop_m, max_stops, goal_tolerance_m must be > 0");
   }
   Mission mission(source, base, config, probes, observer);
   return mission.Run(T_world_start);

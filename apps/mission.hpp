@@ -22,19 +22,19 @@ namespace pitchlab::apps {
 
 struct MissionConfig {
   Eigen::Vector2d goal_m = Eigen::Vector2d::Zero();  ///< goal in the world frame [m]
-  double goal_tolerance_m = 0.5;   ///< success within this of the goal [m]
-  double drive_per_stop_m = 4.0;   ///< path length driven between two scans [m]
-  int max_stops = 40;              ///< scans at most [1]
-  double time_budget_s = 1800.0;   ///< mission time at most (simulated or real) [s]
-  double max_tilt_deg = 30.0;      ///< beyond this the robot is tipping over [deg]
+  double goal_tolerance_m = 0.5;                     ///< success within this of the goal [m]
+  double drive_per_stop_m = 4.0;                     ///< path length driven between two scans [m]
+  int max_stops = 40;                                ///< scans at most [1]
+  double time_budget_s = 1800.0;  ///< mission time at most (simulated or real) [s]
+  double max_tilt_deg = 30.0;     ///< beyond this the robot is tipping over [deg]
   /// Beyond this tilt the robot backs off and marks the ground ahead as too steep, then plans
   /// again: a top-heavy P3 (the laser sits 0.45 m up) pitches over a rim before the map says so.
   double caution_tilt_deg = 22.0;
   /// Beyond this tilt the follower slows to slope_speed_mps (same curvature) [deg].
   double slope_tilt_deg = 10.0;
-  double slope_speed_mps = 0.2;    ///< cruise speed on slopes [m/s]
-  double stuck_timeout_s = 8.0;    ///< no progress while commanded for this long: stuck [s]
-  double control_period_s = 0.1;   ///< path follower rate [s]
+  double slope_speed_mps = 0.2;   ///< cruise speed on slopes [m/s]
+  double stuck_timeout_s = 8.0;   ///< no progress while commanded for this long: stuck [s]
+  double control_period_s = 0.1;  ///< path follower rate [s]
   /// Clearance kept beyond the robot's half width when planning, for tracking error [m].
   double safety_margin_m = 0.08;
   /// The robot stops this far before the first unobserved cell of its plan, turns to face it and
@@ -66,19 +66,22 @@ planning::PlannerConfig MissionPlanner(const MissionConfig& config);
 /// One stop of the mission, as it happened.
 struct StopRecord {
   int index = 0;
-  double stamp_s = 0;                  ///< when the scan started [s]
-  sensors::Scan3D scan;                ///< points in base_link
-  mapping::MergeStep merge;            ///< registration against the map
+  double stamp_s = 0;        ///< when the scan started [s]
+  sensors::Scan3D scan;      ///< points in base_link
+  mapping::MergeStep merge;  ///< registration against the map
   Eigen::Isometry3d T_world_base_odom = Eigen::Isometry3d::Identity();  ///< odometry's pose
   Eigen::Isometry3d T_world_base = Eigen::Isometry3d::Identity();       ///< the estimate used
-  std::optional<Eigen::Isometry3d> T_world_base_true;                  ///< simulation only
-  std::optional<planning::Path> plan;  ///< to the goal, world frame
-  std::string plan_error;              ///< why there was no plan
-  double plan_known_m = 0;             ///< length of the plan over observed cells [m]
-  int felt_hazards = 0;                ///< places marked too steep by the tilt so far
+  std::optional<Eigen::Isometry3d> T_world_base_true;                   ///< simulation only
+  std::optional<planning::Path> plan;    ///< to the goal, world frame
+  std::string plan_error;                ///< why there was no plan
+  std::string plan_note;                 ///< how the plan was found, when not the plain way
+  bool through_drops = false;            ///< planned through inferred drops as unknown (recovery)
+  double plan_to_drop_m = 0;             ///< with through_drops: plan length before the first [m]
+  double plan_known_m = 0;               ///< length of the plan over observed cells [m]
+  int felt_hazards = 0;                  ///< places marked too steep by the tilt so far
   bool elevation_from_odometry = false;  ///< registration failed: the scan entered the elevation
                                          ///< map at the odometry pose
-  double distance_to_goal_m = 0;       ///< from the estimate [m]
+  double distance_to_goal_m = 0;         ///< from the estimate [m]
 };
 
 /// A pose of the robot while driving (sampled every control period).
@@ -90,14 +93,14 @@ struct TrajectorySample {
 
 struct MissionResult {
   bool success = false;
-  std::string reason;                    ///< "goal reached" or why it stopped
+  std::string reason;  ///< "goal reached" or why it stopped
   std::vector<StopRecord> stops;
   std::vector<TrajectorySample> trajectory;
-  mapping::ElevationMap elevation;       ///< estimated, world frame
-  mapping::PointCloud map_cloud_world;   ///< merged scans, world frame
-  double start_s = 0, end_s = 0;         ///< clock at start and end [s]
-  double odometry_distance_m = 0;        ///< driven, by odometry [m]
-  double max_tilt_rad = 0;               ///< largest tilt seen by the attitude probe [rad]
+  mapping::ElevationMap elevation;      ///< estimated, world frame
+  mapping::PointCloud map_cloud_world;  ///< merged scans, world frame
+  double start_s = 0, end_s = 0;        ///< clock at start and end [s]
+  double odometry_distance_m = 0;       ///< driven, by odometry [m]
+  double max_tilt_rad = 0;              ///< largest tilt seen by the attitude probe [rad]
 };
 
 /// Called after each stop is planned (for output as it happens) and with progress text.

@@ -142,6 +142,13 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
     j["error"] = {{"translation_m", d.translation().norm()},
                   {"rotation_deg", Eigen::AngleAxisd(d.linear()).angle() * kRadToDeg}};
   }
+  // The plan of this stop: how it was found, or why there was none.
+  j["plan"] = {{"found", stop.plan.has_value()},
+               {"known_m", stop.plan_known_m},
+               {"felt_hazards", stop.felt_hazards},
+               {"through_inferred_drops", stop.through_drops}};
+  if (!stop.plan_note.empty()) j["plan"]["note"] = stop.plan_note;
+  if (!stop.plan_error.empty()) j["plan"]["error"] = stop.plan_error;
   return j;
 }
 

@@ -21,10 +21,10 @@ double MaxGrade(const planning::Path& path, double from_m, double to_m, double b
 /// the whole footprint, which a sparse scan of a rim or a crack can miss.
 struct FeltHazard {
   Eigen::Vector2d centre_m = Eigen::Vector2d::Zero();  ///< world frame [m]
-  double heading_rad = 0;  ///< the robot's heading when it tilted [rad]
-  double tilt_rad = 0;     ///< the tilt it felt [rad]
-  double z_m = 0;          ///< base_link height estimate there [m]
-  double radius_m = 0.35;  ///< about the robot's half length [m]
+  double heading_rad = 0;                              ///< the robot's heading when it tilted [rad]
+  double tilt_rad = 0;                                 ///< the tilt it felt [rad]
+  double z_m = 0;                                      ///< base_link height estimate there [m]
+  double radius_m = 0.35;                              ///< about the robot's half length [m]
 };
 
 /// Gives every cell within f.radius_m of f.centre_m the felt slope (along the heading), so the

@@ -43,7 +43,7 @@ TEST(RenderTraversability, EachKindOfCellHasItsColourNorthUp) {
   EXPECT_EQ(Pixel(img, 8, 3), (std::array<int, 3>{220, 0, 220}));
   EXPECT_EQ(Pixel(img, 10, 3), (std::array<int, 3>{240, 175, 175}));
   const std::array<int, 3> unknown = Pixel(img, 0, 0);  // row 1, the top
-  EXPECT_EQ(unknown[0], unknown[1]);  // grey
+  EXPECT_EQ(unknown[0], unknown[1]);                    // grey
   EXPECT_EQ(unknown[1], unknown[2]);
 }
 
