@@ -29,27 +29,33 @@ constexpr double kSlopeLookahead_m = 1.0;  // slow down this far before a slope 
 double Yaw(const Eigen::Isometry3d& T) { return std::atan2(T.linear()(1, 0), T.linear()(0, 0)); }
 
 // Odometry increment since `ref` applied to the pose estimated at `ref`, in the horizontal plane:
-// x, y and yaw move by the odometry's planar motion; z, roll and pitch keep the estimate's (wheel
-// odometry says nothing about them, and composing a planar turn onto a tilted frame would leak
-// the tilt into the heading).
+// x, y and yaw move by the odometry's planar motion; z keeps the estimate's, and so do roll and
+// pitch unless an attitude sensor measured them (wheel odometry says nothing about them, and
+// composing a planar turn onto a tilted frame would leak the tilt into the heading).
 Eigen::Isometry3d Propagate(const Eigen::Isometry3d& T_world_base_at_ref,
-                            const sensors::Odometry& ref, const sensors::Odometry& now) {
+                            const sensors::Odometry& ref, const sensors::Odometry& now,
+                            const std::optional<Eigen::Vector2d>& roll_pitch_rad) {
   const Eigen::Matrix3d R = T_world_base_at_ref.linear();
   const double yaw = std::atan2(R(1, 0), R(0, 0));
-  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
-  const double roll = std::atan2(R(2, 1), R(2, 2));
+  const double pitch =
+      roll_pitch_rad ? roll_pitch_rad->y() : std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+  const double roll = roll_pitch_rad ? roll_pitch_rad->x() : std::atan2(R(2, 1), R(2, 2));
   const double c = std::cos(ref.yaw_rad), s = std::sin(ref.yaw_rad);
   const double dx = now.x_m - ref.x_m, dy = now.y_m - ref.y_m;
-  const Eigen::Vector2d step_base(c * dx + s * dy, -s * dx + c * dy);  // in ref's frame
-  const Eigen::Vector2d step_world = Eigen::Rotation2Dd(yaw) * step_base;
+  const Eigen::Vector3d step_base(c * dx + s * dy, -s * dx + c * dy, 0);  // in ref's frame
   const double new_yaw = yaw + std::remainder(now.yaw_rad - ref.yaw_rad, 2.0 * kPi);
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.translation() =
-      T_world_base_at_ref.translation() + Eigen::Vector3d(step_world.x(), step_world.y(), 0);
   T.linear() = (Eigen::AngleAxisd(new_yaw, Eigen::Vector3d::UnitZ()) *
                 Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
                 Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
                    .toRotationMatrix();
+  // The wheels roll along base_link's tilted x-y plane: a drive up a slope climbs. Rotated by the
+  // attitude between the two readings (the wheel odometry's frame is the ref's, turned by yaw).
+  const Eigen::Matrix3d R_mid = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                                 Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                                 Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+                                    .toRotationMatrix();
+  T.translation() = T_world_base_at_ref.translation() + R_mid * step_base;
   return T;
 }
 
@@ -94,12 +100,20 @@ class Mission {
   bool Drive(const StopRecord& stop);
   bool Follow(const planning::Path& path, double length_m);
   bool BackOff(const sensors::Odometry& odo, double tilt_rad);  // false: the mission ends
-  double Tilt() const { return probes_.tilt_rad ? probes_.tilt_rad() : 0.0; }
+  std::optional<Eigen::Vector2d> Attitude() const {
+    if (!probes_.roll_pitch_rad) return std::nullopt;
+    return probes_.roll_pitch_rad();
+  }
+  // Angle of base_link's z from vertical [rad]; 0 without an attitude sensor.
+  double Tilt() const {
+    const std::optional<Eigen::Vector2d> a = Attitude();
+    return a ? std::acos(std::clamp(std::cos(a->x()) * std::cos(a->y()), -1.0, 1.0)) : 0.0;
+  }
   bool TurnTo(double yaw_rad);
   bool Rebase();  // the map frame = base_link where the robot is now (before the first scan)
   bool RecordSample(const sensors::Odometry& odo);  // false: tipping over (reason set)
   Eigen::Isometry3d Estimate(const sensors::Odometry& odo) const {
-    return Propagate(T_world_base_, odo_ref_, odo);
+    return Propagate(T_world_base_, odo_ref_, odo, Attitude());
   }
   bool OverBudget();
   void Progress(const std::string& text) const {
@@ -170,7 +184,7 @@ bool Mission::Stop(int k) {
     result_.reason = "base: " + odo.error().message;
     return false;
   }
-  stop.T_world_base_odom = Propagate(T_world_base_, odo_ref_, *odo);
+  stop.T_world_base_odom = Propagate(T_world_base_, odo_ref_, *odo, Attitude());
   // Algorithm 1 against the map, odometry as the prior (none for the scan that starts the map).
   const std::optional<Eigen::Isometry3d> prior =
       k == 0 ? std::nullopt
@@ -221,7 +235,10 @@ void Mission::UpdateElevation(const StopRecord& stop) {
   const Eigen::Vector3f laser =
       (stop.T_world_base * config_.mount.BaseToLaser(0.0)).translation().cast<float>();
   result_.elevation.Insert(stop.scan.points, T, laser);
-  // The laser cannot see under the robot, but the robot stands on that ground.
+  // The laser cannot see under the robot, but the robot stands on that ground; only a registered
+  // pose knows its height well enough (odometry's z drifts, and a wrong one makes a step around
+  // the robot that traps it).
+  if (stop.elevation_from_odometry) return;
   std::vector<Eigen::Vector3f> ground;
   for (double x = -kFootprintHalf_m; x <= kFootprintHalf_m + 1e-9; x += 0.1) {
     for (double y = -kFootprintHalf_m; y <= kFootprintHalf_m + 1e-9; y += 0.1) {
@@ -425,8 +442,8 @@ bool Mission::RecordSample(const sensors::Odometry& odo) {
   TrajectorySample sample{probes_.now_s(), Estimate(odo), std::nullopt};
   if (probes_.true_pose) sample.T_world_base_true = probes_.true_pose();
   result_.trajectory.push_back(sample);
-  if (!probes_.tilt_rad) return true;
-  const double tilt = probes_.tilt_rad();
+  if (!probes_.roll_pitch_rad) return true;
+  const double tilt = Tilt();
   result_.max_tilt_rad = std::max(result_.max_tilt_rad, tilt);
   if (tilt <= config_.max_tilt_deg * kPi / 180) return true;
   result_.reason = "tipping over: tilt " + std::to_string(tilt * 180 / kPi) + " deg";

@@ -51,9 +51,11 @@ struct MissionConfig {
 /// What the loop reads besides the seam interfaces. `now_s` is required; the others may be empty.
 struct MissionProbes {
   std::function<double()> now_s;  ///< the run's clock (simulated or steady) [s]
-  /// Attitude sensor: angle of base_link's z from vertical. Without it the robot neither slows
-  /// on slopes nor backs off from a tilt, and cannot tell it is tipping over.
-  std::function<double()> tilt_rad;
+  /// Attitude sensor (an inclinometer, or an IMU's gravity vector): roll and pitch of base_link
+  /// (x, y of the ZYX Euler angles) [rad]. It sets the attitude of the odometry pose, which is the
+  /// registration prior and the pose a scan goes in at when registration fails; the robot slows on
+  /// slopes, backs off from a tilt and knows it is tipping over by it. May be empty.
+  std::function<Eigen::Vector2d()> roll_pitch_rad;
   /// Ground truth (simulation only): scoring, never steering.
   std::function<Eigen::Isometry3d()> true_pose;
   /// True once the run should stop now (Ctrl-C on hardware); polled wherever the budget is.

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <ctime>
 #include <iostream>
+#include <random>
 
 #include "app_config.hpp"
 #include "cli_args.hpp"
@@ -31,6 +32,8 @@ namespace {
 
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 constexpr double kMapMargin_m = 1.0;
+constexpr double kAttitudeSigma_rad = 0.2 * kDegToRad;  // a MEMS inclinometer, at rest
+constexpr std::uint64_t kAttitudeSeedSalt = 0x6174746974756465;  // "attitude": its own stream
 
 CliArgs RunArgs() {
   CliArgs args("run",
@@ -150,8 +153,14 @@ int RunRun(int argc, char** argv) {
   MissionProbes probes;
   probes.now_s = [&sim] { return sim.time_s(); };
   probes.true_pose = [&sim] { return sim.T_world_base(); };
-  probes.tilt_rad = [&sim] {
-    return std::acos(std::clamp(sim.T_world_base().linear()(2, 2), -1.0, 1.0));
+  // The attitude sensor: a MEMS inclinometer's roll and pitch, truth plus seeded white noise.
+  std::mt19937_64 attitude_rng(config.seed ^ kAttitudeSeedSalt);
+  std::normal_distribution<double> attitude_noise(0.0, kAttitudeSigma_rad);
+  probes.roll_pitch_rad = [&sim, &attitude_rng, &attitude_noise] {
+    const Eigen::Matrix3d R = sim.T_world_base().linear();
+    const double roll = std::atan2(R(2, 1), R(2, 2));
+    const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+    return Eigen::Vector2d(roll + attitude_noise(attitude_rng), pitch + attitude_noise(attitude_rng));
   };
   MissionObserver observer;
   observer.on_stop = [&](const StopRecord& stop, const MissionResult& so_far) {

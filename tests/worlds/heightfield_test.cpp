@@ -3,6 +3,7 @@
 #include <GeographicLib/UTMUPS.hpp>
 
 #include <cmath>
+#include <tuple>
 
 #include "pitchlab/worlds/dem_world.hpp"
 #include "pitchlab/worlds/heightfield_world.hpp"
@@ -74,7 +75,7 @@ TEST(Heightfield, TerrainWorldSurfaceIsTheGeneratorsHeightsUnderMjRay) {
   ExpectRaysMatchGrid(std::filesystem::path(PITCHLAB_WORLDS_DIR) / "terrain.xml", grid, 400);
 }
 
-TEST(Heightfield, TerrainHasSlopesBeyondAP3AndAFlatStartPad) {
+TEST(Heightfield, TerrainHasSlopesBeyondAP3AndFlatStartAndGoalPads) {
   const HeightGrid grid = GenerateTerrainHeights(TerrainConfig{});
   constexpr double kP3SlopeLimit_rad = 30.0 * kPi / 180.0;
   constexpr double kFlat_rad = 1.0 * kPi / 180.0;
@@ -91,6 +92,29 @@ TEST(Heightfield, TerrainHasSlopesBeyondAP3AndAFlatStartPad) {
       const int iy = static_cast<int>(std::lround((y - grid.y0_m) / grid.cell_m));
       EXPECT_LT(grid.Slope_rad(ix, iy), kFlat_rad) << "start pad at " << x << ", " << y;
     }
+  }
+  const TerrainConfig c;
+  for (double x = -1.0; x <= 1.0; x += 0.5) {
+    for (double y = -1.0; y <= 1.0; y += 0.5) {
+      const int ix = static_cast<int>(std::lround((c.goal_x_m + x - grid.x0_m) / grid.cell_m));
+      const int iy = static_cast<int>(std::lround((c.goal_y_m + y - grid.y0_m) / grid.cell_m));
+      EXPECT_LT(grid.Slope_rad(ix, iy), kFlat_rad) << "goal pad at " << x << ", " << y;
+    }
+  }
+  // The pads sit at the level of their surroundings, not on a mesa (the old start pad took the
+  // height of a hilltop and stood 3 m proud behind 30 deg rims): the pad's height is the mean of
+  // the ring where its rim ends, up to what rocks on that ring add.
+  constexpr double kLevel_m = 0.1;
+  for (const auto& [cx, cy, ring] : {std::tuple{0.0, 0.0, c.start_pad_radius_m + 8.0},
+                                     {c.goal_x_m, c.goal_y_m, c.goal_pad_radius_m + 3.0}}) {
+    double sum = 0;
+    constexpr int kSamples = 64;
+    for (int k = 0; k < kSamples; ++k) {
+      const double a = 2.0 * kPi * k / kSamples;
+      sum += grid.HeightBilinear(cx + ring * std::cos(a), cy + ring * std::sin(a));
+    }
+    EXPECT_NEAR(grid.HeightBilinear(cx, cy), sum / kSamples, kLevel_m)
+        << "pad at " << cx << ", " << cy;
   }
 }
 
@@ -137,6 +161,7 @@ TEST(Heightfield, GeneratedWorldsAreTheSameBytesFromTheSameSeed) {
   TerrainConfig small;
   small.size_m = 12.0;
   small.cell_m = 0.2;
+  small.goal_x_m = -4.0, small.goal_y_m = 4.0;
   TempDir a("seed_a"), b("seed_b"), c("seed_c");
   GenerateTerrainWorld(small, a.path());
   GenerateTerrainWorld(small, b.path());

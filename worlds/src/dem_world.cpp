@@ -59,7 +59,7 @@ DemWorld BuildDemWorld(const DemWorldConfig& config) {
   if (config.relief_seed) {
     ReliefConfig relief;
     relief.seed = *config.relief_seed;
-    relief.keep_clear = metadata.default_start;
+    relief.keep_clear = {metadata.default_start};
     AddFineRelief(relief, world.grid);
   }
   const std::string file = config.dem_path.filename().string();

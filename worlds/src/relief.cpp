@@ -19,8 +19,10 @@ void IndexRange(double lo, double hi, double origin, double cell, int n, int& i0
 }
 
 bool NearKeepClear(const ReliefConfig& config, double x, double y, double radius) {
-  return std::hypot(x - config.keep_clear.x_m, y - config.keep_clear.y_m) <
-         config.keep_clear_radius_m + radius;
+  for (const StartPose& p : config.keep_clear) {
+    if (std::hypot(x - p.x_m, y - p.y_m) < config.keep_clear_radius_m + radius) return true;
+  }
+  return false;
 }
 
 // A rock: a smooth cap h * (1 - (r/R)^2)^2 that rises out of the surface; max() keeps rocks from

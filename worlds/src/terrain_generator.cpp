@@ -14,14 +14,20 @@ namespace pitchlab::worlds {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+constexpr double kStartRim_m = 8.0;  // blends of the start and goal pads into the hills [m]
+constexpr double kGoalRim_m = 3.0;
 
 void Validate(const TerrainConfig& c) {
   if (!(c.size_m > 0) || !(c.cell_m > 0) || c.size_m / c.cell_m > 8192 || c.octaves < 1 ||
-      !(c.hill_wavelength_m > 0) || !(c.steep_slope_deg > 0 && c.steep_slope_deg < 89)) {
+      !(c.hill_wavelength_m > 0) || !(c.steep_slope_deg > 0 && c.steep_slope_deg < 89) ||
+      !(c.start_pad_radius_m > 0) || !(c.goal_pad_radius_m > 0) ||
+      !(std::max(std::abs(c.goal_x_m), std::abs(c.goal_y_m)) + c.goal_pad_radius_m <
+        0.5 * c.size_m)) {
     throw std::invalid_argument("TerrainConfig: size_m " + std::to_string(c.size_m) + ", cell_m " +
                                 std::to_string(c.cell_m) +
                                 " must be positive with size/cell <= 8192, octaves >= 1, "
-                                "steep_slope_deg in (0, 89)");
+                                "steep_slope_deg in (0, 89), positive pad radii and the goal's "
+                                "pad inside the terrain");
   }
 }
 
@@ -75,14 +81,24 @@ void AddSteepFeatures(const TerrainConfig& c, SplitMix64& rng, HeightGrid& grid)
                   [=](double d) { return std::max(0.0, ridge_height_m - d * tan_slope); });
 }
 
-// Blends the surface to the origin's height within the pad (full) and an 8 m rim (smoothstep).
-void FlattenStartPad(const TerrainConfig& c, HeightGrid& grid) {
-  const double pad_height = grid.HeightBilinear(0.0, 0.0);
-  const double rim_m = 8.0;  // wide enough that the blend is no steeper than the hills
+// Levels a pad of `pad_m` around (cx, cy) and blends it into the surface over a rim of `rim_m`
+// (smoothstep). The pad takes the mean height of the surface on the rim's outer circle, so it sits
+// at the level of its surroundings: a pad at the height of its centre made a mesa wherever the
+// centre was a hilltop, its rim as steep as 30 deg.
+void FlattenPad(HeightGrid& grid, double cx, double cy, double pad_m, double rim_m) {
+  constexpr int kRingSamples = 64;
+  double sum = 0.0;
+  for (int k = 0; k < kRingSamples; ++k) {
+    const double a = 2.0 * kPi * k / kRingSamples;
+    sum +=
+        grid.HeightBilinear(cx + (pad_m + rim_m) * std::cos(a), cy + (pad_m + rim_m) * std::sin(a));
+  }
+  const double pad_height = sum / kRingSamples;
   for (int iy = 0; iy < grid.ny; ++iy) {
     for (int ix = 0; ix < grid.nx; ++ix) {
-      const double r = std::hypot(grid.x0_m + ix * grid.cell_m, grid.y0_m + iy * grid.cell_m);
-      const double t = std::clamp((r - c.start_pad_radius_m) / rim_m, 0.0, 1.0);
+      const double r =
+          std::hypot(grid.x0_m + ix * grid.cell_m - cx, grid.y0_m + iy * grid.cell_m - cy);
+      const double t = std::clamp((r - pad_m) / rim_m, 0.0, 1.0);
       const double keep = t * t * (3.0 - 2.0 * t);
       grid.At(ix, iy) = pad_height + keep * (grid.At(ix, iy) - pad_height);
     }
@@ -99,12 +115,13 @@ HeightGrid GenerateTerrainHeights(const TerrainConfig& config) {
   SplitMix64 rng(config.seed);
   AddHills(config, grid);
   AddSteepFeatures(config, rng, grid);
-  FlattenStartPad(config, grid);
+  FlattenPad(grid, 0.0, 0.0, config.start_pad_radius_m, kStartRim_m);
+  FlattenPad(grid, config.goal_x_m, config.goal_y_m, config.goal_pad_radius_m, kGoalRim_m);
   ReliefConfig relief;
   relief.seed = rng.Next();
   relief.rocks_per_100m2 = 1.5;
   relief.cracks_per_1000m2 = 2.0;
-  relief.keep_clear = StartPose{0.0, 0.0, 0.0};
+  relief.keep_clear = {StartPose{0.0, 0.0, 0.0}, StartPose{config.goal_x_m, config.goal_y_m, 0.0}};
   relief.keep_clear_radius_m = config.start_pad_radius_m;
   AddFineRelief(relief, grid);
   return grid;
@@ -125,7 +142,7 @@ std::filesystem::path GenerateTerrainWorld(const TerrainConfig& config,
   // so maps and paths open in GIS tools in a plausible place.
   metadata.geodetic_origin = GeodeticPoint{46.72000, 23.60000, 700.0};
   // The default run: 35 m north-west, past the butte and over rougher ground.
-  metadata.default_goal = GoalPoint{-25.0, 25.0};
+  metadata.default_goal = GoalPoint{config.goal_x_m, config.goal_y_m};
   std::filesystem::create_directories(out_dir);
   const std::filesystem::path xml = out_dir / "terrain.xml";
   WriteHeightfieldWorld(grid, metadata,

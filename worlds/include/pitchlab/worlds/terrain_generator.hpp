@@ -8,7 +8,7 @@
 namespace pitchlab::worlds {
 
 /// The procedural outdoor `terrain` world: fractal hills, a steep butte and a ridge beyond a P3's
-/// slope limit, rocks and cracks, a flat pad at the start.
+/// slope limit, rocks and cracks, level pads at the default start and goal.
 struct TerrainConfig {
   std::uint64_t seed = 20120917;    ///< the default world's seed
   double size_m = 64.0;             ///< side of the square terrain [m]
@@ -17,7 +17,10 @@ struct TerrainConfig {
   double hill_wavelength_m = 22.0;  ///< wavelength of the lowest noise octave [m]
   int octaves = 6;                  ///< fractal noise octaves (each half the amplitude)
   double steep_slope_deg = 38.0;    ///< flank slope of the butte and the ridge [deg]
-  double start_pad_radius_m = 3.0;  ///< flat pad around the default start [m]
+  double start_pad_radius_m = 3.0;  ///< flat pad around the default start (the origin) [m]
+  double goal_x_m = -25.0;          ///< the default goal: 35 m north-west, past the butte [m]
+  double goal_y_m = 25.0;           ///< [m]
+  double goal_pad_radius_m = 1.5;   ///< flat pad around the default goal [m]
 };
 
 /// The terrain heights [m] for `config`, centred on the origin; the same config gives the same
