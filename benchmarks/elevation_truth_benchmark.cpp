@@ -1,10 +1,12 @@
 // Ground-truth evaluation of elevation maps and planning (issue 4), printed as JSON lines:
 // - map quality on `terrain` and `urban` from simulated scans at true poses: RMSE, bias, max and
 //   p95 error and coverage against the true surface (rays cast straight down, looking through
-//   overhangs with the robot's headroom: mapping/elevation_truth.hpp) per cell size, and the
-//   RMSE against the first surface from above (the former truth) beside it;
-// - planning on the estimated map vs the true map: the estimated map's path costed on the true
-//   map, its ratio to the true optimum, and the truly forbidden cells it crosses.
+//   overhangs with the robot's headroom: mapping/elevation_truth.hpp) per cell size, over the
+//   surface cells, with the cells at vertical faces (wall cells: see CompareConfig) apart and
+//   all together, and the RMSE against the first surface from above (the former truth) beside it;
+// - planning on the estimated map vs the true map, with unknown cells forbidden and penalised:
+//   the estimated map's path costed on the true map, its ratio to the true optimum, and the truly
+//   forbidden cells it crosses, split by whether the estimate had observed them.
 //
 //   benchmarks/elevation_truth_benchmark [--worlds terrain,urban] [--cells 0.05,0.1,0.2,0.4]
 
@@ -62,10 +64,17 @@ WorldScans Scan(sim::SimRig& rig) {
   return w;
 }
 
+// The estimated map's path from start to start + offset costed on the true map, under one
+// unknown-cell policy. Truly forbidden cells it crosses are split by what the estimate knew of
+// them: a crossing through a cell the estimate observed is a map error; one through a cell it
+// had not seen (only possible when unknown cells are penalised) is the price of exploring, which
+// the closed loop pays by scanning again before it drives there.
 void PlanningVsTruth(const std::string& world, const mapping::ElevationLayers& est,
-                     const mapping::ElevationLayers& truth, const Eigen::Vector2d& start) {
+                     const mapping::ElevationLayers& truth, const Eigen::Vector2d& start,
+                     planning::UnknownPolicy policy) {
   planning::PlannerConfig cfg;
-  cfg.unknown = planning::UnknownPolicy::kPenalise;  // the estimate has shadows
+  cfg.unknown = policy;
+  const char* policy_name = policy == planning::UnknownPolicy::kForbid ? "forbid" : "penalise";
   const planning::TraversabilityGrid E = planning::BuildTraversability(est, cfg);
   const planning::TraversabilityGrid T = planning::BuildTraversability(truth, cfg);
   for (const Eigen::Vector2d offset :
@@ -74,26 +83,31 @@ void PlanningVsTruth(const std::string& world, const mapping::ElevationLayers& e
     const auto pe = planning::PlanPath(E, start, goal, planning::Algorithm::kAStar);
     const auto pt = planning::PlanPath(T, start, goal, planning::Algorithm::kAStar);
     std::printf(
-        "{\"world\": \"%s\", \"planning\": true, \"start\": [%.2f, %.2f], \"goal\": [%.2f, %.2f]",
-        world.c_str(), start.x(), start.y(), goal.x(), goal.y());
-    if (!pe || !pt) {
-      std::printf(", \"estimated\": \"%s\", \"true\": \"%s\"",
-                  pe ? "found" : planning::ToString(pe.error().reason),
-                  pt ? "found" : planning::ToString(pt.error().reason));
-      if (pe) {
-        const planning::PathOnMap on_truth = planning::EvaluatePath(T, *pe);
-        std::printf(", \"truly_forbidden_cells_crossed\": %zu, \"truly_unknown_cells\": %zu",
-                    on_truth.forbidden_cells, on_truth.unknown_cells);
+        "{\"world\": \"%s\", \"planning\": true, \"unknown\": \"%s\", \"start\": [%.2f, %.2f], "
+        "\"goal\": [%.2f, %.2f], \"estimated\": \"%s\", \"true\": \"%s\"",
+        world.c_str(), policy_name, start.x(), start.y(), goal.x(), goal.y(),
+        pe ? "found" : planning::ToString(pe.error().reason),
+        pt ? "found" : planning::ToString(pt.error().reason));
+    if (pe) {
+      const planning::PathOnMap on_truth = planning::EvaluatePath(T, *pe);
+      std::size_t where_known = 0, where_unseen = 0;
+      for (std::size_t n = 1; n < pe->cells.size(); ++n) {
+        const std::size_t k = T.geometry.Linear(pe->cells[n]);
+        if (T.Free(k)) continue;
+        (est.state[k] == mapping::CellState::kObserved ? where_known : where_unseen) += 1;
       }
-      std::printf("}\n");
-      continue;
+      std::printf(
+          ", \"estimated_cost\": %.4f, \"estimated_cost_on_truth\": %.4f, "
+          "\"truly_forbidden_cells_crossed\": %zu, \"of_which_observed_in_estimate\": %zu, "
+          "\"of_which_unseen_in_estimate\": %zu, \"truly_unknown_cells\": %zu",
+          pe->cost, on_truth.cost, on_truth.forbidden_cells, where_known, where_unseen,
+          on_truth.unknown_cells);
+      if (pt) {
+        std::printf(", \"true_optimum\": %.4f, \"ratio\": %.4f", pt->cost,
+                    on_truth.cost / pt->cost);
+      }
     }
-    const planning::PathOnMap on_truth = planning::EvaluatePath(T, *pe);
-    std::printf(
-        ", \"estimated_cost\": %.4f, \"estimated_cost_on_truth\": %.4f, \"true_optimum\": %.4f, "
-        "\"ratio\": %.4f, \"truly_forbidden_cells_crossed\": %zu, \"truly_unknown_cells\": %zu}\n",
-        pe->cost, on_truth.cost, pt->cost, on_truth.cost / pt->cost, on_truth.forbidden_cells,
-        on_truth.unknown_cells);
+    std::printf("}\n");
   }
 }
 
@@ -134,15 +148,21 @@ int main(int argc, char** argv) {
           mapping::ComputeLayers(mapping::ComputeTrueElevationMap(rig.caster(), g, first_hit)));
       std::printf(
           "{\"world\": \"%s\", \"scans\": %zu, \"points\": %zu, \"cell_m\": %.3f, "
-          "\"cells\": %zu, \"rmse_m\": %.4f, \"mean_error_m\": %.4f, \"max_abs_error_m\": %.4f, "
-          "\"p95_abs_error_m\": %.4f, \"coverage\": %.4f, \"drop_cells\": %zu, "
-          "\"first_hit_truth\": {\"rmse_m\": %.4f, \"max_abs_error_m\": %.4f, "
-          "\"coverage\": %.4f}}\n",
-          world.c_str(), scans.clouds.size(), points, cell, g.cell_count(), r.rmse_m,
-          r.mean_error_m, r.max_abs_error_m, r.p95_abs_error_m, r.coverage, r.drop_cells,
-          r0.rmse_m, r0.max_abs_error_m, r0.coverage);
+          "\"cells\": %zu, \"coverage\": %.4f, \"surface_cells\": %zu, \"rmse_m\": %.4f, "
+          "\"mean_error_m\": %.4f, \"max_abs_error_m\": %.4f, \"p95_abs_error_m\": %.4f, "
+          "\"wall_cells\": %zu, \"wall_rmse_m\": %.4f, \"all_rmse_m\": %.4f, "
+          "\"all_max_abs_error_m\": %.4f, \"drop_cells\": %zu, "
+          "\"first_hit_truth\": {\"rmse_m\": %.4f, \"all_rmse_m\": %.4f, \"coverage\": %.4f}}\n",
+          world.c_str(), scans.clouds.size(), points, cell, g.cell_count(), r.coverage,
+          r.surface_cells, r.rmse_m, r.mean_error_m, r.max_abs_error_m, r.p95_abs_error_m,
+          r.wall_cells, r.wall_rmse_m, r.all_rmse_m, r.all_max_abs_error_m, r.drop_cells, r0.rmse_m,
+          r0.all_rmse_m, r0.coverage);
       std::fflush(stdout);
-      if (std::abs(cell - 0.2) < 1e-9) PlanningVsTruth(world, est, truth, scans.start);
+      if (std::abs(cell - 0.2) < 1e-9) {
+        for (const auto policy :
+             {planning::UnknownPolicy::kForbid, planning::UnknownPolicy::kPenalise})
+          PlanningVsTruth(world, est, truth, scans.start, policy);
+      }
     }
   }
   return 0;

@@ -44,6 +44,17 @@ struct Moments {
   }
 };
 
+// RMS residual of the cell's points about their own least-squares plane (see the header).
+float PlaneResidual(const CellStats& c, double min_spread) {
+  if (c.count < 4) return kNaN;
+  Moments m;
+  m.Add(c.count, c.mean_x, c.mean_y, c.mean_z, c.c_xx, c.c_xy, c.c_xz, c.c_yy, c.c_yz);
+  double b = 0, cy = 0;
+  if (!m.Slopes(min_spread, &b, &cy)) return kNaN;
+  const double ssr = c.c_zz - b * c.c_xz - cy * c.c_yz;  // c_zz minus what the plane explains
+  return static_cast<float>(std::sqrt(std::max(0.0, ssr / c.count)));
+}
+
 // Inclination of cell (ci, cj) from its 3 x 3 region (see the header for the method).
 void Inclination(const ElevationMap& map, int ci, int cj, const LayerConfig& config, float* phi_x,
                  float* phi_y) {
@@ -72,9 +83,9 @@ void Inclination(const ElevationMap& map, int ci, int cj, const LayerConfig& con
   }
 }
 
-// Unknown cells whose clearance is below the lowest point of every observed neighbour (or below a
-// drop neighbour's reference)
-// by more than drop_depth become drops; grown breadth-first so a whole ditch is marked.
+// Unknown cells whose clearance is below the lowest point of every observed neighbour by more than
+// drop_depth become drops (seeds); grown breadth-first from them, below the same reference, up to
+// drop_flood_m, so a ditch is marked across and a sunken court along its rim.
 float LowestObservedNeighbour(const ElevationLayers& L, const CellIndex& c) {
   const GridGeometry& g = L.geometry;
   float ref = std::numeric_limits<float>::infinity();
@@ -91,6 +102,11 @@ float LowestObservedNeighbour(const ElevationLayers& L, const CellIndex& c) {
 void MarkDrops(ElevationLayers& L, const LayerConfig& config) {
   const GridGeometry& g = L.geometry;
   std::vector<float> reference(g.cell_count(), std::numeric_limits<float>::infinity());
+  // Flood steps from the nearest seed: a flood that went on without end carried a reference set
+  // by something tall (a fence top, a car's side: seen only above a ray) across whole shadowed
+  // streets on `urban`; a drop's hazard is its rim, which the first metre covers.
+  std::vector<int> hops(g.cell_count(), 0);
+  const int max_hops = static_cast<int>(std::floor(config.drop_flood_m / g.cell_m + 1e-9));
   std::deque<std::size_t> queue;
   const auto unknown_with_ray = [&](std::size_t k) {
     return L.state[k] == CellState::kUnknown && std::isfinite(L.clearance_z[k]);
@@ -107,6 +123,7 @@ void MarkDrops(ElevationLayers& L, const LayerConfig& config) {
   while (!queue.empty()) {
     const std::size_t k = queue.front();
     queue.pop_front();
+    if (hops[k] >= max_hops) continue;
     const CellIndex c = g.FromLinear(k);
     for (int dj = -1; dj <= 1; ++dj)
       for (int di = -1; di <= 1; ++di) {
@@ -120,6 +137,7 @@ void MarkDrops(ElevationLayers& L, const LayerConfig& config) {
         if (!(L.clearance_z[kn] < ref - config.drop_depth_m)) continue;
         L.state[kn] = CellState::kDrop;
         reference[kn] = ref;
+        hops[kn] = hops[k] + 1;
         queue.push_back(kn);
       }
   }
@@ -151,6 +169,7 @@ ElevationLayers ComputeLayers(const ElevationMap& map, const LayerConfig& config
   L.phi_x.assign(n, kNaN);
   L.phi_y.assign(n, kNaN);
   L.clearance_z.assign(n, std::numeric_limits<float>::infinity());
+  L.plane_residual.assign(n, kNaN);
   for (int j = 0; j < g.size_y; ++j) {
     for (int i = 0; i < g.size_x; ++i) {
       const std::size_t k = g.Linear({i, j});
@@ -163,6 +182,7 @@ ElevationLayers ComputeLayers(const ElevationMap& map, const LayerConfig& config
       L.min_z[k] = c.min_z;
       L.max_z[k] = c.max_z;
       L.roughness[k] = Roughness(c);  // Eq. 3
+      L.plane_residual[k] = PlaneResidual(c, config.min_spread_m);
       Inclination(map, i, j, config, &L.phi_x[k], &L.phi_y[k]);
     }
   }

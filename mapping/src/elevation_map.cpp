@@ -108,13 +108,22 @@ std::size_t TraceClearance(const FastGrid& g, std::vector<CellStats>& cells,
   return updated;
 }
 
-template <bool kWithRays>
-InsertStats InsertImpl(const GridGeometry& geometry, std::vector<CellStats>& cells,
-                       const Eigen::Vector3f* points, std::size_t count,
-                       const Eigen::Vector3f& origin, const InsertConfig& config) {
+// The grid cell of a finite point inside the grid and the z limits, or false.
+inline bool CellOf(const FastGrid& g, const Eigen::Vector3f& p, float z_lo, float z_hi, int* i,
+                   int* j) {
+  const float fx = (p.x() - g.x0) * g.inv_cell, fy = (p.y() - g.y0) * g.inv_cell;
+  if (!(fx >= 0.0f && fy >= 0.0f && fx < g.sx && fy < g.sy && p.z() >= z_lo && p.z() <= z_hi))
+    return false;
+  *i = static_cast<int>(fx);
+  *j = static_cast<int>(fy);
+  return true;
+}
+
+InsertStats InsertPointsImpl(const GridGeometry& geometry, std::vector<CellStats>& cells,
+                             const Eigen::Vector3f* points, std::size_t count,
+                             const InsertConfig& config) {
   const FastGrid g(geometry);
   const float z_lo = static_cast<float>(config.min_z_m), z_hi = static_cast<float>(config.max_z_m);
-  const float ray_len = static_cast<float>(config.clearance_length_m);
   InsertStats stats;
   for (std::size_t k = 0; k < count; ++k) {
     const Eigen::Vector3f& p = points[k];
@@ -122,18 +131,35 @@ InsertStats InsertImpl(const GridGeometry& geometry, std::vector<CellStats>& cel
       ++stats.non_finite;
       continue;
     }
-    const float fx = (p.x() - g.x0) * g.inv_cell, fy = (p.y() - g.y0) * g.inv_cell;
-    if (!(fx >= 0.0f && fy >= 0.0f && fx < g.sx && fy < g.sy && p.z() >= z_lo && p.z() <= z_hi)) {
+    int i, j;
+    if (!CellOf(g, p, z_lo, z_hi, &i, &j)) {
       ++stats.outside;
       continue;
     }
-    const int i = static_cast<int>(fx), j = static_cast<int>(fy);
     const float lx = p.x() - (g.x0 + i * g.cell + g.half_cell);
     const float ly = p.y() - (g.y0 + j * g.cell + g.half_cell);
     AddToCell(cells[static_cast<std::size_t>(j) * g.sx + i], lx, ly, p.z());
     ++stats.inserted;
-    if constexpr (kWithRays) {
-      if (ray_len <= 0.0f) continue;
+  }
+  return stats;
+}
+
+// Traces every ray of the scan, then adds the points that do not float over a lower ray.
+InsertStats InsertScanImpl(const GridGeometry& geometry, std::vector<CellStats>& cells,
+                           const Eigen::Vector3f* points, std::size_t count,
+                           const Eigen::Vector3f& origin, const InsertConfig& config) {
+  const FastGrid g(geometry);
+  const float z_lo = static_cast<float>(config.min_z_m), z_hi = static_cast<float>(config.max_z_m);
+  const float ray_len = static_cast<float>(config.clearance_length_m);
+  const float headroom = config.overhang_headroom_m > 0
+                             ? static_cast<float>(config.overhang_headroom_m)
+                             : std::numeric_limits<float>::infinity();
+  InsertStats stats;
+  if (ray_len > 0.0f) {
+    for (std::size_t k = 0; k < count; ++k) {
+      const Eigen::Vector3f& p = points[k];
+      int i, j;
+      if (!p.allFinite() || !CellOf(g, p, z_lo, z_hi, &i, &j)) continue;
       const Eigen::Vector3f d = p - origin;
       const float horizontal = std::hypot(d.x(), d.y());
       if (horizontal < 1e-6f) continue;
@@ -141,6 +167,26 @@ InsertStats InsertImpl(const GridGeometry& geometry, std::vector<CellStats>& cel
           horizontal > ray_len ? Eigen::Vector3f(p - d * (ray_len / horizontal)) : origin;
       stats.clearance_cells += TraceClearance(g, cells, from, p);
     }
+  }
+  for (std::size_t k = 0; k < count; ++k) {
+    const Eigen::Vector3f& p = points[k];
+    if (!p.allFinite()) {
+      ++stats.non_finite;
+      continue;
+    }
+    int i, j;
+    if (!CellOf(g, p, z_lo, z_hi, &i, &j)) {
+      ++stats.outside;
+      continue;
+    }
+    CellStats& c = cells[static_cast<std::size_t>(j) * g.sx + i];
+    if (p.z() > c.clearance_z + headroom) {
+      ++stats.overhang;
+      continue;
+    }
+    AddToCell(c, p.x() - (g.x0 + i * g.cell + g.half_cell),
+              p.y() - (g.y0 + j * g.cell + g.half_cell), p.z());
+    ++stats.inserted;
   }
   return stats;
 }
@@ -197,13 +243,13 @@ ElevationMap::ElevationMap(const GridGeometry& geometry,
 
 InsertStats ElevationMap::InsertPoints(const Eigen::Vector3f* points_m, std::size_t count,
                                        const InsertConfig& config) {
-  return InsertImpl<false>(geometry_, cells_, points_m, count, Eigen::Vector3f::Zero(), config);
+  return InsertPointsImpl(geometry_, cells_, points_m, count, config);
 }
 
 InsertStats ElevationMap::InsertScan(const Eigen::Vector3f* points_m, std::size_t count,
                                      const Eigen::Vector3f& sensor_origin_m,
                                      const InsertConfig& config) {
-  return InsertImpl<true>(geometry_, cells_, points_m, count, sensor_origin_m, config);
+  return InsertScanImpl(geometry_, cells_, points_m, count, sensor_origin_m, config);
 }
 
 Result<std::size_t> ElevationMap::Merge(const ElevationMap& other) {

@@ -73,7 +73,9 @@ void LookThroughOverhangs(VerticalCaster& cast, const std::vector<float>& x,
   for (int layer = 0; layer < config.max_overhangs && !live.empty(); ++layer) {
     // (1) The underside: the same geom next.
     step([&](std::size_t r) { return surface_z[r] - kStepM; }, -1.0f, depth,
-         [&](std::size_t r, float z, int g) { return under_z[r] = z, std::isfinite(z) && g == surface_geom[r]; });
+         [&](std::size_t r, float z, int g) {
+           return under_z[r] = z, std::isfinite(z) && g == surface_geom[r];
+         });
     // (2) Nothing else touches the underside, probed from just inside and just below.
     step([&](std::size_t r) { return under_z[r] + kStepM; }, -1.0f, 2 * kStepM,
          [&](std::size_t r, float, int g) { return g == surface_geom[r]; });
@@ -106,7 +108,8 @@ ElevationMap ComputeTrueElevationMap(const sensors::RayCaster& caster, const Gri
   const int k = std::max(1, config.samples_per_side);
   const std::size_t row_rays = static_cast<std::size_t>(geometry.size_x) * k;
   VerticalCaster cast(caster);
-  std::vector<float> x(row_rays), y(row_rays), top(row_rays, static_cast<float>(config.ray_top_z_m));
+  std::vector<float> x(row_rays), y(row_rays),
+      top(row_rays, static_cast<float>(config.ray_top_z_m));
   std::vector<float> surface_z;
   std::vector<int> surface_geom;
   std::vector<Eigen::Vector3f> hits;
@@ -130,32 +133,78 @@ ElevationMap ComputeTrueElevationMap(const sensors::RayCaster& caster, const Gri
   return truth;
 }
 
-MapErrorReport CompareToTruth(const ElevationLayers& estimate, const ElevationLayers& truth) {
+std::vector<bool> WallCells(const ElevationLayers& truth, const CompareConfig& config) {
+  const GridGeometry& g = truth.geometry;
+  std::vector<bool> wall(g.cell_count(), false);
+  if (!(config.wall_slope > 0)) return wall;
+  const float span_max = static_cast<float>(config.wall_slope * 3.0 * g.cell_m);
+  for (int j = 0; j < g.size_y; ++j)
+    for (int i = 0; i < g.size_x; ++i) {
+      float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+      for (int dj = -1; dj <= 1; ++dj)
+        for (int di = -1; di <= 1; ++di) {
+          const CellIndex nb{i + di, j + dj};
+          if (!g.Contains(nb)) continue;
+          const std::size_t kn = g.Linear(nb);
+          if (truth.state[kn] != CellState::kObserved) continue;
+          lo = std::min(lo, truth.min_z[kn]);
+          hi = std::max(hi, truth.max_z[kn]);
+        }
+      wall[g.Linear({i, j})] = hi - lo > span_max;
+    }
+  return wall;
+}
+
+namespace {
+
+// RMSE, bias, max and p95 of a set of signed errors (destroys their order).
+struct ErrorStats {
+  std::vector<double> abs_err;
+  double sum = 0, sum2 = 0;
+  void Add(double e) {
+    sum += e;
+    sum2 += e * e;
+    abs_err.push_back(std::abs(e));
+  }
+  double Rmse() const { return abs_err.empty() ? 0.0 : std::sqrt(sum2 / abs_err.size()); }
+  double Max() const {
+    return abs_err.empty() ? 0.0 : *std::max_element(abs_err.begin(), abs_err.end());
+  }
+};
+
+}  // namespace
+
+MapErrorReport CompareToTruth(const ElevationLayers& estimate, const ElevationLayers& truth,
+                              const CompareConfig& config) {
   if (!estimate.geometry.SameAs(truth.geometry)) {
     throw std::invalid_argument("compare to truth: the estimate and the truth grids differ");
   }
+  const std::vector<bool> wall = WallCells(truth, config);
   MapErrorReport rep;
-  std::vector<double> abs_err;
-  double sum = 0, sum2 = 0;
+  ErrorStats surface, walls, all;
   for (std::size_t k = 0; k < truth.state.size(); ++k) {
     rep.drop_cells += estimate.state[k] == CellState::kDrop;
     if (truth.state[k] != CellState::kObserved) continue;
     ++rep.truth_cells;
     if (estimate.state[k] != CellState::kObserved) continue;
     const double e = static_cast<double>(estimate.mean_z[k]) - truth.mean_z[k];
-    sum += e;
-    sum2 += e * e;
-    abs_err.push_back(std::abs(e));
+    all.Add(e);
+    (wall[k] ? walls : surface).Add(e);
   }
-  rep.compared_cells = abs_err.size();
+  rep.compared_cells = all.abs_err.size();
   rep.coverage = rep.truth_cells ? static_cast<double>(rep.compared_cells) / rep.truth_cells : 0.0;
-  if (!abs_err.empty()) {
-    const double n = static_cast<double>(abs_err.size());
-    rep.rmse_m = std::sqrt(sum2 / n);
-    rep.mean_error_m = sum / n;
-    rep.max_abs_error_m = *std::max_element(abs_err.begin(), abs_err.end());
-    auto it = abs_err.begin() + static_cast<std::ptrdiff_t>(0.95 * (abs_err.size() - 1));
-    std::nth_element(abs_err.begin(), it, abs_err.end());
+  rep.surface_cells = surface.abs_err.size();
+  rep.wall_cells = walls.abs_err.size();
+  rep.rmse_m = surface.Rmse();
+  rep.max_abs_error_m = surface.Max();
+  rep.wall_rmse_m = walls.Rmse();
+  rep.all_rmse_m = all.Rmse();
+  rep.all_max_abs_error_m = all.Max();
+  if (!surface.abs_err.empty()) {
+    std::vector<double>& a = surface.abs_err;
+    rep.mean_error_m = surface.sum / static_cast<double>(a.size());
+    auto it = a.begin() + static_cast<std::ptrdiff_t>(0.95 * (a.size() - 1));
+    std::nth_element(a.begin(), it, a.end());
     rep.p95_abs_error_m = *it;
   }
   return rep;

@@ -1,6 +1,7 @@
 #pragma once
-// Eq. 4-5 for one move: the single definition that the precomputed edge costs, the peer graph
-// (ListEdges) and the path's cost parts all use, so they agree to the last bit.
+// Eq. 4-5 for one move: the single definition, evaluated once per move into
+// TraversabilityGrid::move_cost, which the searches, the peer graph (ListEdges), the path's cost
+// parts and EvaluatePath all read, so they agree to the last bit.
 
 #include <cmath>
 

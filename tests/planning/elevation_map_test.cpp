@@ -2,13 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <mujoco/mujoco.h>
 #include <GeographicLib/LocalCartesian.hpp>
 #include <GeographicLib/TransverseMercator.hpp>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <memory>
-#include <mujoco/mujoco.h>
 #include <random>
 
 #include "pitchlab/mapping/elevation_io.hpp"
@@ -110,6 +110,23 @@ TEST(ElevationMap, BoxGivesItsHeightAndAStepEdge) {
   EXPECT_NEAR(L.mean_z[k(1.7, 2.0)] - L.mean_z[k(1.3, 2.0)], h, kHeightTolM);
 }
 
+TEST(ElevationMap, PlaneResidualIsZeroOnATiltedPlaneAndAQuarterOfAStepInside) {
+  const GridGeometry g = GridGeometry::FromArea(0, 0, 1, 1, 0.5);
+  ElevationMap map(g);
+  // Cell (0, 0): the plane z = 0.3 x - 0.2 y; cell (1, 0): a 0.2 m step across its middle.
+  auto pts = Lattice(0, 0.5, 0, 0.5, 0.005, [](double x, double y) { return 0.3 * x - 0.2 * y; });
+  const auto step =
+      Lattice(0.5, 1, 0, 0.5, 0.005, [](double x, double) { return x < 0.75 ? 0 : 0.2; });
+  pts.insert(pts.end(), step.begin(), step.end());
+  (void)map.InsertPoints(pts.data(), pts.size());
+  const ElevationLayers L = ComputeLayers(map);
+  EXPECT_NEAR(L.plane_residual[g.Linear({0, 0})], 0.0, 1e-4);
+  // A step h through the middle of uniformly sampled ground: residual variance h^2/4 (the
+  // step's) minus 3 h^2/16 (what the best plane explains), so RMS h / 4.
+  EXPECT_NEAR(L.plane_residual[g.Linear({1, 0})], 0.2 / 4, 1e-3);
+  EXPECT_TRUE(std::isnan(L.plane_residual[g.Linear({0, 1})]));  // unknown
+}
+
 TEST(ElevationMap, RoughnessOfAKnownDistribution) {
   // Heights N(0.5, 0.04^2) in one cell; Eq. 3 T is their standard deviation.
   const double sigma_m = 0.04, tol_m = 0.0005;
@@ -192,6 +209,83 @@ TEST(ElevationMap, DitchShowsAsDropNotAsUnknown) {
   ElevationMap no_rays(map.geometry());
   (void)no_rays.InsertPoints(pts.data(), pts.size());
   EXPECT_EQ(ComputeLayers(no_rays).state[L.geometry.Linear({45, 10})], CellState::kUnknown);
+}
+
+TEST(ElevationMap, ADropSeededBySomethingTallDoesNotFloodTheWholeShadow) {
+  // Ground z = 0 up to x = 3, a fence seen only at its 0.8 m top in the cell [3.0, 3.1), then a
+  // shadow to a far wall at x = 7.95 hit 0.5 m up: its rays cross the shadow at about 0.5 m,
+  // 0.3 m under the fence top. The cell beside the fence is a drop by the rule (its only observed
+  // neighbour is the fence); the flood from it stops after drop_flood_m instead of running over
+  // the whole shadow, which is flat ground the laser merely did not see.
+  const Eigen::Vector3f sensor(0.0f, 0.0f, 0.55f);
+  std::vector<Eigen::Vector3f> pts;
+  for (double y = -0.5; y < 0.5; y += 0.05) {
+    for (double x = 0.52; x < 3.0; x += 0.05) pts.emplace_back(float(x), float(y), 0.0f);
+    pts.emplace_back(3.05f, float(y), 0.8f);
+    pts.emplace_back(7.95f, float(y), 0.5f);
+  }
+  const GridGeometry g = GridGeometry::FromArea(0, -0.5, 8, 1, 0.1);
+  ElevationMap map(g);
+  (void)map.InsertScan(pts.data(), pts.size(), sensor);
+  const ElevationLayers L = ComputeLayers(map);
+  const auto state = [&](double x) { return L.state[g.Linear(g.IndexOf(x, 0.05))]; };
+  EXPECT_EQ(state(3.15), CellState::kDrop);
+  EXPECT_EQ(state(4.35), CellState::kUnknown);  // beyond 1 m of the seed
+  EXPECT_EQ(state(6.05), CellState::kUnknown);
+  LayerConfig unbounded;
+  unbounded.drop_flood_m = 100;
+  EXPECT_EQ(ComputeLayers(map, unbounded).state[g.Linear(g.IndexOf(6.05, 0.05))],
+            CellState::kDrop);  // what the flood did before it was bounded
+}
+
+TEST(ElevationMap, SignOverOpenGroundIsLeftOutOfTheGroundCells) {
+  // Flat ground z = 0 seen from (0, 0, 0.55) out to x = 6, and a sign plate at z = 2.5 over
+  // x in [3, 3.5): the rays to the ground behind it pass under it (at < 0.55 m), so the plate's
+  // points float more than the 0.6 m headroom over a ray of their cell.
+  const Eigen::Vector3f sensor(0.0f, 0.0f, 0.55f);
+  std::vector<Eigen::Vector3f> pts;
+  for (double y = -0.5; y < 0.5; y += 0.05) {
+    for (double x = 0.52; x < 6.0; x += 0.05) pts.emplace_back(float(x), float(y), 0.0f);
+    for (double x = 3.02; x < 3.5; x += 0.05) pts.emplace_back(float(x), float(y), 2.5f);
+  }
+  const GridGeometry g = GridGeometry::FromArea(0, -0.5, 6, 1, 0.1);
+  ElevationMap map(g);
+  const InsertStats s = map.InsertScan(pts.data(), pts.size(), sensor);
+  EXPECT_EQ(s.overhang, 10u * 20u);  // every plate point: 10 along x, 20 along y
+  const ElevationLayers L = ComputeLayers(map);
+  const std::size_t under = g.Linear(g.IndexOf(3.25, 0.05));
+  EXPECT_NEAR(L.mean_z[under], 0.0, kHeightTolM);
+  EXPECT_NEAR(L.max_z[under], 0.0, kHeightTolM);
+  // With the filter off the plate is averaged into the ground, as Eq. 2 alone would do.
+  InsertConfig keep_all;
+  keep_all.overhang_headroom_m = 0;
+  ElevationMap raw(g);
+  EXPECT_EQ(raw.InsertScan(pts.data(), pts.size(), sensor, keep_all).overhang, 0u);
+  EXPECT_GT(ComputeLayers(raw).mean_z[under], 1.0);
+}
+
+TEST(ElevationMap, WallPointsOverTheCellEdgeAboveLowerRaysAreLeftOut) {
+  // A wall face at x = 3 (a cell edge) from z = 0 to 3 m seen from (0, 0, 0.55); range noise
+  // puts part of its points 5 mm short, into the ground cell [2.9, 3.0). The rays that hit the
+  // wall low cross that cell under the high wall points, which go; the low ones stay (a step).
+  const Eigen::Vector3f sensor(0.0f, 0.0f, 0.55f);
+  std::vector<Eigen::Vector3f> pts;
+  for (double y = -0.5; y < 0.5; y += 0.05) {
+    for (double x = 0.52; x < 3.0; x += 0.05) pts.emplace_back(float(x), float(y), 0.0f);
+    int n = 0;
+    for (double z = 0.01; z < 3.0; z += 0.02, ++n)
+      pts.emplace_back(n % 2 ? 2.995f : 3.005f, float(y), float(z));
+  }
+  const GridGeometry g = GridGeometry::FromArea(0, -0.5, 4, 1, 0.1);
+  ElevationMap map(g);
+  (void)map.InsertScan(pts.data(), pts.size(), sensor);
+  const ElevationLayers L = ComputeLayers(map);
+  const std::size_t front = g.Linear(g.IndexOf(2.95, 0.05));
+  // The lowest ray through the cell runs from the laser to the wall at z = 0.01: at x = 3.0 it
+  // is that low, so nothing above 0.6 m (plus the ray's rise across the cell) is kept.
+  EXPECT_LT(L.max_z[front], 0.65);
+  EXPECT_GT(L.max_z[front] - L.mean_z[front], 0.089) << "the wall's foot is still a step";
+  EXPECT_LT(L.mean_z[front], 0.3);  // the ground and the wall's foot; 1.4 m with every point
 }
 
 TEST(ElevationMapIo, SaveLoadIsLosslessAndInsertionContinues) {
@@ -321,6 +415,38 @@ TEST(ElevationTruth, DownwardRaysGiveTheTrueSurfaceAndCompareReportsErrors) {
   EXPECT_NEAR(rep.coverage, 0.5, 1e-9);
   EXPECT_NEAR(rep.rmse_m, 0.02, 1e-4);
   EXPECT_NEAR(rep.mean_error_m, 0.02, 1e-4);
+  EXPECT_EQ(rep.wall_cells, 0u);  // a 0.1 slope is no wall
+  EXPECT_NEAR(rep.all_rmse_m, 0.02, 1e-4);
+}
+
+TEST(ElevationTruth, WallCellsAreScoredApartFromTheSurface) {
+  // Truth: ground at 0 for x < 1, a 3 m roof for x >= 1 (a wall on the edge of cells 9 and 10
+  // at 0.1 m). Estimate: right everywhere but 2 cm high on the ground, and with wall points in
+  // the cells on both sides of the face (mean 1.5 m).
+  const GridGeometry g = GridGeometry::FromArea(0, 0, 2, 0.5, 0.1);
+  const auto surface = [](double x, double) { return x < 1.0 ? 0.0 : 3.0; };
+  ElevationMap truth(g), est(g);
+  const auto t = Lattice(0, 2, 0, 0.5, 0.1 / 3, surface);
+  (void)truth.InsertPoints(t.data(), t.size());
+  auto e = Lattice(0, 2, 0, 0.5, 0.05, [&](double x, double y) {
+    return x > 0.9 && x < 1.1 ? 1.5 : surface(x, y) + (x < 1.0 ? 0.02 : 0.0);
+  });
+  (void)est.InsertPoints(e.data(), e.size());
+  const MapErrorReport r = CompareToTruth(ComputeLayers(est), ComputeLayers(truth));
+  // Wall cells: columns 9 and 10 (the face is in their 3 x 3 blocks), 5 rows.
+  EXPECT_EQ(r.wall_cells, 2u * 5u);
+  EXPECT_EQ(r.surface_cells, 18u * 5u);
+  EXPECT_EQ(r.compared_cells, 20u * 5u);
+  // Surface: 9 columns on the ground 2 cm high, 9 on the roof exact.
+  EXPECT_NEAR(r.rmse_m, std::sqrt(0.5 * 0.02 * 0.02), 1e-5);
+  EXPECT_NEAR(r.max_abs_error_m, 0.02, 1e-5);
+  EXPECT_NEAR(r.wall_rmse_m, 1.5, 1e-5);
+  EXPECT_NEAR(r.all_max_abs_error_m, 1.5, 1e-5);
+  // Without telling walls apart, they are in the surface figures.
+  CompareConfig no_walls;
+  no_walls.wall_slope = 0;
+  EXPECT_NEAR(CompareToTruth(ComputeLayers(est), ComputeLayers(truth), no_walls).max_abs_error_m,
+              1.5, 1e-5);
 }
 
 // Over a plane floor: a table (top 0.72-0.75 m, one leg), a tree (sphere crown of radius 1 m
@@ -397,7 +523,6 @@ TEST(ElevationTruth, FloorUnderAnOverhangCountsNotTheOverhang) {
   EXPECT_NEAR(at(headroom, 1.65, 4.05), 0.14, kRayTolM);
   EXPECT_NEAR(at(headroom, 7.55, 5.05), 0.0, kRayTolM);
 }
-
 
 }  // namespace
 }  // namespace pitchlab::mapping

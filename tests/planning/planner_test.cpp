@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <boost/graph/adjacency_list.hpp>
 #include <boost/graph/dijkstra_shortest_paths.hpp>
 #include <cmath>
@@ -83,8 +84,10 @@ TEST(Planner, SerpentineCorridorGivesItsUniqueOptimalPath) {
     ASSERT_EQ(path->cells.size(), 7u + 4u + 6u);
     EXPECT_EQ(path->cells[6], (CellIndex{6, 0}));
     EXPECT_EQ(path->cells[10], (CellIndex{6, 4}));
-    EXPECT_NEAR(path->cost, 16 * cell, 1e-9);
-    EXPECT_NEAR(path->length_m, 16 * cell, 1e-9);
+    // Move costs are stored in float (TraversabilityGrid::move_cost): 16 moves of float(cell).
+    const double move = static_cast<float>(cell);
+    EXPECT_NEAR(path->cost, 16 * move, 1e-12);
+    EXPECT_NEAR(path->length_m, 16 * move, 1e-12);
     EXPECT_NEAR(path->parts.Total(), path->cost, 1e-9);
   }
 }
@@ -226,6 +229,44 @@ TEST(Planner, UnknownCellsForbiddenOrPenalised) {
       PlanPath(BuildTraversability(L, cfg), {0.55, 0.55}, {2.55, 0.55}, Algorithm::kAStar);
   ASSERT_TRUE(pen) << pen.error().message;
   EXPECT_NEAR(pen->parts.unknown, 2 * 2.0, 1e-9);
+}
+
+TEST(Planner, CurbSplitByAMixedCellIsStillAStep) {
+  // A 0.14 m curb (above the P3-AT's 0.089 m) at x = 1.0 m, 0.2 m cells. The cell [0.8, 1.0)
+  // holds street points and, as range noise puts them there, points of the curb face and top:
+  // its mean, 0.07 m, is under the limit from both sides. Its points off their plane say step.
+  const double cell = 0.2;
+  const GridGeometry g = GridGeometry::FromArea(0, 0, 2, 1, cell);
+  const auto curb = [&](double step_x) {
+    ElevationMap map(g);
+    std::vector<Eigen::Vector3f> pts;
+    for (double y = 0.005; y < 1; y += 0.01)
+      for (double x = 0.005; x < 2; x += 0.01)
+        pts.emplace_back(float(x), float(y), x < step_x ? 0.0f : 0.14f);
+    (void)map.InsertPoints(pts.data(), pts.size());
+    return mapping::ComputeLayers(map);
+  };
+  const ElevationLayers mixed = curb(0.9);  // the curb's edge in the middle of cell 4
+  const std::size_t k = g.Linear({4, 2});
+  ASSERT_NEAR(mixed.mean_z[k], 0.07, 1e-3);
+  EXPECT_NEAR(mixed.plane_residual[k], 0.14 / 4, 1e-3);  // a step's residual: h / 4
+  PlannerConfig cfg = PointRobot();
+  // The plane fit over the cell's neighbours tilts by the curb too (about the P3-AT's 19.3 deg
+  // here); allow 30 deg so that the step rule alone is tested.
+  cfg.robot.max_inclination_rad = 30 * M_PI / 180;
+  const TraversabilityGrid T = BuildTraversability(mixed, cfg);
+  EXPECT_EQ(T.blocked[k], Blocked::kStep);
+  EXPECT_FALSE(PlanPath(T, Centre(T, 1, 2), Centre(T, 8, 2), Algorithm::kAStar));
+  // A ramp with the same mean profile is no step: its points lie on their plane.
+  ElevationMap ramp_map(g);
+  std::vector<Eigen::Vector3f> ramp;
+  for (double y = 0.005; y < 1; y += 0.01)
+    for (double x = 0.005; x < 2; x += 0.01)
+      ramp.emplace_back(float(x), float(y), float(std::clamp((x - 0.8) * 0.3, 0.0, 0.14)));
+  (void)ramp_map.InsertPoints(ramp.data(), ramp.size());
+  const ElevationLayers R = mapping::ComputeLayers(ramp_map);
+  EXPECT_LT(R.plane_residual[g.Linear({5, 2})], 1e-4);
+  EXPECT_EQ(BuildTraversability(R, cfg).blocked[g.Linear({5, 2})], Blocked::kFree);
 }
 
 TEST(Planner, SlopeBeyondTheRobotLimitIsTooSteep) {

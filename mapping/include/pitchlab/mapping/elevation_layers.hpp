@@ -23,13 +23,17 @@ enum class CellState : std::uint8_t {
   kUnknown = 0,   ///< no point fell in it and no ray proves a drop
   kObserved = 1,  ///< at least one point
   kDrop = 2,      ///< no point, but rays passed lower than the lowest point of every observed
-                  ///< neighbour by more than drop_depth_m (or next to such a drop cell, below the
-                  ///< same reference): a negative hazard (ditch, stairs down, cliff edge)
+                  ///< neighbour by more than drop_depth_m (or within drop_flood_m of such a drop
+              ///< cell, below the same reference): a negative hazard (ditch, stairs down, cliff)
 };
 
 /// How the derived layers are made.
 struct LayerConfig {
   double drop_depth_m = 0.2;  ///< clearance this far below an observed neighbour is a drop [m]
+  /// How far a drop grows from the cells next to observed ground, through unknown cells whose
+  /// rays pass below the same reference [m]. The rim is the hazard; an unbounded flood spread a
+  /// reference taken from something tall (a fence seen only above a ray) over whole streets.
+  double drop_flood_m = 1.0;
   /// A region whose point spread is smaller than this along its narrow horizontal axis is
   /// degenerate for the point fit (its sqrt of the smallest eigenvalue of the xy covariance) [m].
   double min_spread_m = 0.005;
@@ -50,6 +54,12 @@ struct ElevationLayers {
   std::vector<float> phi_x;          ///< inclination along x: atan(dz/dx) [rad]; NaN unknown
   std::vector<float> phi_y;          ///< inclination along y: atan(dz/dy) [rad]; NaN unknown
   std::vector<float> clearance_z;    ///< lowest ray height over the cell [m]; +inf none
+  /// RMS vertical distance of the cell's own points from their least-squares plane [m]; NaN with
+  /// fewer than 4 points or points that do not span a plane (a single scan line). Ground of any
+  /// slope leaves the range noise here; a step inside the cell (a curb on the cell's edge, both
+  /// sides seen) leaves about a quarter of its height, which the mean heights alone smear into
+  /// two half steps.
+  std::vector<float> plane_residual;
 
   /// Overall tilt of the cell's plane, atan(sqrt(tan^2 phi_x + tan^2 phi_y)) [rad]; NaN unknown.
   float Tilt(std::size_t k) const;

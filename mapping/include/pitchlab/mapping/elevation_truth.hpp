@@ -4,6 +4,7 @@
 // it.
 
 #include <cstddef>
+#include <vector>
 
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/elevation_map.hpp"
@@ -45,19 +46,52 @@ struct TruthConfig {
 ElevationMap ComputeTrueElevationMap(const sensors::RayCaster& caster, const GridGeometry& geometry,
                                      const TruthConfig& config = {});
 
-/// An estimate's error against the truth, over cells known in both.
+/// How an estimate is scored against the truth.
+///
+/// What the truth means at a wall. The truth of a cell is the surface a ground robot stands on
+/// there, averaged over the cell (the k x k vertical lines). A vertical face (a building wall, a
+/// car's side, the edge of a drop) has no such height: the roof is on one side, the ground on the
+/// other, and the face itself is not a surface. The laser sees the face, and its points (range
+/// noise and the 1 cm range unit move them by a centimetre or so, along the beam) land on both
+/// sides of it; where the face lies on a cell edge, as every wall of a world built on a 0.1 m
+/// raster does, the ground cell in front gets points metres up the wall and the roof cell behind
+/// gets wall points instead of its unseen roof, so their Eq. 2 means are off by up to the wall's
+/// height. Those cells are "wall cells": a cell whose 3 x 3 block of true cells spans more height
+/// than a `wall_slope` face over the block's width (3 cells) could, i.e. a face steeper than that
+/// runs through the cell or along its edge. Their height error says how much of the face the laser
+/// saw, not how well the surface is mapped, so it is reported apart (wall_*) and kept out of the
+/// surface figures (rmse_m, mean, max, p95); the planner treats them as the hazard they are either
+/// way (a step to the neighbour, or a spread within the cell).
+struct CompareConfig {
+  /// Steepness of a vertical face [1]: tan(60 deg), the slope beyond which the layers treat a
+  /// neighbour as a step (LayerConfig::max_fit_slope); <= 0 makes no cell a wall cell.
+  double wall_slope = 1.7320508;
+};
+
+/// An estimate's error against the truth, over cells known (observed) in both.
 struct MapErrorReport {
-  std::size_t compared_cells = 0;  ///< observed in both [1]
+  std::size_t compared_cells = 0;  ///< observed in both, wall cells included [1]
   std::size_t truth_cells = 0;     ///< known in the truth [1]
   double coverage = 0;             ///< compared / truth cells [0-1]
-  double rmse_m = 0;               ///< of mean height [m]
-  double mean_error_m = 0;         ///< estimate - truth, averaged (bias) [m]
-  double max_abs_error_m = 0;      ///< [m]
-  double p95_abs_error_m = 0;      ///< 95th percentile of |error| [m]
+  // The surface: compared cells that are not wall cells (see CompareConfig).
+  std::size_t surface_cells = 0;  ///< [1]
+  double rmse_m = 0;              ///< of mean height [m]
+  double mean_error_m = 0;        ///< estimate - truth, averaged (bias) [m]
+  double max_abs_error_m = 0;     ///< [m]
+  double p95_abs_error_m = 0;     ///< 95th percentile of |error| [m]
+  // Wall cells, and all compared cells together (the figure before walls were told apart).
+  std::size_t wall_cells = 0;      ///< compared cells at a vertical face [1]
+  double wall_rmse_m = 0;          ///< [m]
+  double all_rmse_m = 0;           ///< over every compared cell [m]
+  double all_max_abs_error_m = 0;  ///< [m]
   std::size_t drop_cells = 0;      ///< estimate cells marked drop [1]
 };
 
 /// Compares mean heights cell by cell. Throws std::invalid_argument when the geometries differ.
-MapErrorReport CompareToTruth(const ElevationLayers& estimate, const ElevationLayers& truth);
+MapErrorReport CompareToTruth(const ElevationLayers& estimate, const ElevationLayers& truth,
+                              const CompareConfig& config = {});
+
+/// Wall cells of a true map (see CompareConfig), one flag per cell.
+std::vector<bool> WallCells(const ElevationLayers& truth, const CompareConfig& config = {});
 
 }  // namespace pitchlab::mapping
