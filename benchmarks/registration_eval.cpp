@@ -10,11 +10,16 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
+#include <memory>
+#include <optional>
 #include <random>
 #include <set>
 #include <sstream>
@@ -36,6 +41,9 @@ constexpr double kTargetRotation_deg = 0.5;  // issue 3 accuracy target
 constexpr double kTargetTranslation_m = 0.03;
 constexpr double kMaxTruthDrift_deg = 0.05;  // robot moved during the sweep: truth ambiguous
 constexpr double kMaxTruthDrift_m = 0.005;
+// Poses higher or lower than this above the default start are not stops of a ground robot [m]:
+// above every curb, step and slope the P3 drives in the sampled regions, below any roof.
+constexpr double kMaxClimb_m = 2.0;
 
 struct Options {
   std::vector<std::string> worlds = {"office", "cluttered", "urban", "terrain", "corridor"};
@@ -47,6 +55,9 @@ struct Options {
   int sequence_scans = 20;  // urban scan-to-map sequence
   std::uint64_t seed = 20120917;
   std::string paper_table;                         // JSON with the paper's Table 1, if given
+  std::string pair_cache;                          // directory of simulated pairs, if given
+  std::string config;                              // YAML over our defaults, if given
+  std::set<int> only_pairs;                        // register only these pair ids (all if empty)
   std::set<std::string> near_start = {"terrain"};  // worlds sampled around their start only
   double near_start_radius_m = 3.0;
 };
@@ -80,7 +91,13 @@ Options ParseOptions(int argc, char** argv) {
       o.seed = std::stoull(value());
     else if (a == "--paper-table")
       o.paper_table = value();
-    else if (a == "--near-start") {
+    else if (a == "--pair-cache")
+      o.pair_cache = value();
+    else if (a == "--config")
+      o.config = value();
+    else if (a == "--only-pairs") {
+      for (const std::string& id : Split(value(), ',')) o.only_pairs.insert(std::stoi(id));
+    } else if (a == "--near-start") {
       const auto v = Split(value(), ',');
       o.near_start = std::set<std::string>(v.begin(), v.end());
     } else if (a == "--near-start-radius")
@@ -99,7 +116,8 @@ Options ParseOptions(int argc, char** argv) {
       std::cout
           << "registration_eval [--worlds a,b] [--targets N] [--levels m:deg,...] "
              "[--noise s,...] [--baseline-pairs N] [--table1-pairs N] [--sequence-scans N] "
-             "[--seed S] [--paper-table FILE.json] [--near-start w1,w2] [--near-start-radius M]\n";
+             "[--seed S] [--paper-table FILE.json] [--near-start w1,w2] [--near-start-radius M] "
+             "[--pair-cache DIR] [--config FILE.yaml] [--only-pairs id,...]\n";
       std::exit(0);
     } else {
       throw std::invalid_argument("unknown option " + a);
@@ -122,11 +140,20 @@ class ScanFactory {
     config.lms200.seed = seed;
     rig_ = std::make_unique<sim::SimRig>(std::string(PITCHLAB_WORLDS_DIR) + "/" + world + ".xml",
                                          config);
+    if (Result<Eigen::Isometry3d> start = rig_->PlaceAtDefaultStart())
+      start_z_ = start->translation().z();
   }
   // A scan from (x, y, yaw), or nothing when the robot cannot stand there or moved during the
   // sweep (then the single ground-truth pose would not describe the scan).
   std::optional<SimScan> At(double x, double y, double yaw_rad) {
-    if (!rig_->PlaceRobot(x, y, yaw_rad)) return std::nullopt;
+    Result<Eigen::Isometry3d> placed = rig_->PlaceRobot(x, y, yaw_rad);
+    if (!placed) return std::nullopt;
+    // The placement stands the robot on the topmost surface: in the town that may be a roof (4 to
+    // 12 m up), a flat plane no drive reaches and whose scan constrains nothing but height.
+    if (start_z_ && std::fabs(placed->translation().z() - *start_z_) > kMaxClimb_m) {
+      ++unreachable_;
+      return std::nullopt;
+    }
     Result<sensors::Scan3D> scan = rig_->Acquire();
     if (!scan) return std::nullopt;
     const mapping::PoseError drift =
@@ -148,10 +175,12 @@ class ScanFactory {
             std::min(b[2], s.x() + radius_m), std::min(b[3], s.y() + radius_m)};
   }
   int drifted() const { return drifted_; }
+  int unreachable() const { return unreachable_; }
 
  private:
   std::unique_ptr<sim::SimRig> rig_;
-  int drifted_ = 0;
+  std::optional<double> start_z_;  // ground height at the world's default start [m]
+  int drifted_ = 0, unreachable_ = 0;
 };
 
 struct Pair {
@@ -215,6 +244,94 @@ std::vector<Pair> MakePairs(const Options& o, const std::string& world, double n
     }
   }
   stats["drifted_scans_resampled"] = factory.drifted();
+  stats["unreachable_poses_resampled"] = factory.unreachable();
+  return pairs;
+}
+
+// --pair-cache: the pairs MakePairs simulated, stored with the random generator's state after them,
+// under a name derived from its state before (and the options that shape the pairs), so a cached
+// run draws exactly what a fresh one would.
+std::string CachePath(const Options& o, const std::string& world, double noise_m,
+                      const std::mt19937_64& rng) {
+  std::ostringstream key;
+  key << rng << " " << world << " " << noise_m << " " << o.targets << " "
+      << (o.near_start.count(world) ? o.near_start_radius_m : 0.0) << " climb " << kMaxClimb_m;
+  std::ostringstream name;
+  name << o.pair_cache << "/" << world << "_" << noise_m << "_" << std::hex
+       << std::hash<std::string>{}(key.str()) << ".bin";
+  return name.str();
+}
+
+template <typename T>
+void Put(std::ofstream& out, const T& v) {
+  out.write(reinterpret_cast<const char*>(&v), sizeof v);
+}
+template <typename T>
+void Get(std::ifstream& in, T& v) {
+  in.read(reinterpret_cast<char*>(&v), sizeof v);
+}
+
+void PutScan(std::ofstream& out, const SimScan& s) {
+  Put(out, s.T_world_base.matrix());
+  Put(out, static_cast<std::uint64_t>(s.cloud.size()));
+  out.write(reinterpret_cast<const char*>(s.cloud.data()),
+            static_cast<std::streamsize>(s.cloud.size() * sizeof(Eigen::Vector3f)));
+}
+void GetScan(std::ifstream& in, SimScan& s) {
+  Eigen::Matrix4d m;
+  Get(in, m);
+  s.T_world_base.matrix() = m;
+  std::uint64_t n = 0;
+  Get(in, n);
+  s.cloud.resize(n);
+  in.read(reinterpret_cast<char*>(s.cloud.data()),
+          static_cast<std::streamsize>(n * sizeof(Eigen::Vector3f)));
+}
+
+void SavePairs(const std::string& path, const std::vector<Pair>& pairs, const json& stats,
+               const std::mt19937_64& rng) {
+  std::ofstream out(path + ".tmp", std::ios::binary);
+  std::ostringstream state;
+  state << rng;
+  const std::string header = state.str() + "\n" + stats.dump() + "\n";
+  Put(out, static_cast<std::uint64_t>(header.size()));
+  out.write(header.data(), static_cast<std::streamsize>(header.size()));
+  Put(out, static_cast<std::uint64_t>(pairs.size()));
+  for (const Pair& p : pairs) {
+    PutScan(out, p.target);
+    PutScan(out, p.source);
+    Put(out, p.overlap);
+  }
+  out.close();
+  if (!out) throw std::runtime_error(path + ": cannot be written");
+  std::rename((path + ".tmp").c_str(), path.c_str());
+}
+
+std::optional<std::vector<Pair>> LoadPairs(const std::string& path, const std::string& world,
+                                           double noise_m, json& stats, std::mt19937_64& rng) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::nullopt;
+  std::uint64_t size = 0, n = 0;
+  Get(in, size);
+  std::string header(size, '\0');
+  in.read(header.data(), static_cast<std::streamsize>(size));
+  std::istringstream lines(header);
+  std::string state, stats_text;
+  std::getline(lines, state);
+  std::getline(lines, stats_text);
+  Get(in, n);
+  std::vector<Pair> pairs(n);
+  for (Pair& p : pairs) {
+    p.world = world;
+    p.noise_m = noise_m;
+    GetScan(in, p.target);
+    GetScan(in, p.source);
+    Get(in, p.overlap);
+    p.truth = p.target.T_world_base.inverse() * p.source.T_world_base;
+  }
+  if (!in) return std::nullopt;
+  std::istringstream(state) >> rng;
+  stats = json::parse(stats_text);
   return pairs;
 }
 
@@ -247,6 +364,7 @@ json RunPair(const Pair& p, const mapping::RegistrationPrior& prior,
           {"inlier_ratio", r->inlier_ratio},
           {"degeneracy", r->degeneracy},
           {"iterations", r->iterations},
+          {"sac_inliers", r->sac_inliers},
           {"timings_s",
            {{"voxel", t.voxel_s},
             {"normals", t.normals_s},
@@ -259,16 +377,19 @@ json RunPair(const Pair& p, const mapping::RegistrationPrior& prior,
 json PairInfo(const Pair& p, double level_m, double level_deg, const Eigen::Isometry3d& guess) {
   const mapping::PoseError motion = mapping::ComparePoses(p.truth, Eigen::Isometry3d::Identity());
   const mapping::PoseError offset = mapping::ComparePoses(guess, p.truth);
-  return {{"pair", p.id},
-          {"world", p.world},
-          {"noise_m", p.noise_m},
-          {"motion_m", motion.translation_m},
-          {"motion_deg", motion.rotation_deg},
-          {"level", {level_m, level_deg}},
-          {"guess_offset_m", offset.translation_m},
-          {"guess_offset_deg", offset.rotation_deg},
-          {"overlap", p.overlap},
-          {"points", {p.target.cloud.size(), p.source.cloud.size()}}};
+  const Eigen::Vector3d tt = p.truth.translation();
+  return {
+      {"pair", p.id},
+      {"truth_xyz_yaw", {tt.x(), tt.y(), tt.z(), std::atan2(p.truth(1, 0), p.truth(0, 0)) / kDeg}},
+      {"world", p.world},
+      {"noise_m", p.noise_m},
+      {"motion_m", motion.translation_m},
+      {"motion_deg", motion.rotation_deg},
+      {"level", {level_m, level_deg}},
+      {"guess_offset_m", offset.translation_m},
+      {"guess_offset_deg", offset.rotation_deg},
+      {"overlap", p.overlap},
+      {"points", {p.target.cloud.size(), p.source.cloud.size()}}};
 }
 
 double Percentile(std::vector<double> v, double q) {
@@ -385,7 +506,10 @@ int main(int argc, char** argv) {
   try {
     const Options o = ParseOptions(argc, argv);
     std::mt19937_64 rng(o.seed);
-    const mapping::RegistrationConfig ours;
+    if (!o.pair_cache.empty()) std::filesystem::create_directories(o.pair_cache);
+    const mapping::RegistrationConfig ours = o.config.empty()
+                                                 ? mapping::RegistrationConfig{}
+                                                 : mapping::LoadRegistrationConfig(o.config);
     mapping::RegistrationConfig pcl_default;  // PCL stages with PCL's algorithm defaults
     pcl_default.backend = mapping::RegistrationBackend::kPcl;
     pcl_default.sac_iterations = 1000;  // SampleConsensusInitialAlignment's default
@@ -401,7 +525,11 @@ int main(int argc, char** argv) {
       for (double noise : o.noise_m) {
         std::fprintf(stderr, "simulating %s, noise %.3f m\n", world.c_str(), noise);
         json s;
-        std::vector<Pair> made = MakePairs(o, world, noise, rng, s);
+        const std::string cache = o.pair_cache.empty() ? "" : CachePath(o, world, noise, rng);
+        std::optional<std::vector<Pair>> cached;
+        if (!cache.empty()) cached = LoadPairs(cache, world, noise, s, rng);
+        std::vector<Pair> made = cached ? std::move(*cached) : MakePairs(o, world, noise, rng, s);
+        if (!cache.empty() && !cached) SavePairs(cache, made, s, rng);
         stats[world + "@" + std::to_string(noise)] = s;
         for (Pair& p : made) all.push_back(std::move(p));
       }
@@ -420,6 +548,8 @@ int main(int argc, char** argv) {
         const auto [level_m, level_deg] = o.levels[l];
         mapping::RegistrationPrior prior;
         prior.odometry = OffsetGuess(p.truth, level_m, level_deg, rng);
+        if (!o.only_pairs.empty() && !o.only_pairs.count(p.id))
+          continue;  // guess drawn all the same
         json entry = PairInfo(p, level_m, level_deg, *prior.odometry);
         entry["ours"] = RunPair(p, prior, ours);
         if (l == 0) entry["ours_no_prior"] = RunPair(p, {}, ours);
@@ -432,6 +562,9 @@ int main(int argc, char** argv) {
           narf.features = mapping::FeatureKind::kNarf;
           std::fprintf(stderr, "  Table 1 NARF on %s pair %d\n", p.world.c_str(), p.id);
           entry["table1_narf"] = RunPair(p, prior, narf);
+          mapping::RegistrationConfig narf_ours = ours;  // same RANSAC and ICP as fpfh_ours
+          narf_ours.features = mapping::FeatureKind::kNarf;
+          entry["table1_narf_ours"] = RunPair(p, prior, narf_ours);
         }
         pairs.push_back(entry);
       }
@@ -498,13 +631,14 @@ int main(int argc, char** argv) {
         {"outdoor", {"urban", "terrain"}}};
     json table = json::array();
     std::ostringstream text;
-    text << "Table 1 (PCL backend, same pairs)      | ours: time s / fitness m^2 / within  | "
+    text << "Table 1 (same pairs; _pcl: PCL's SAC-IA + ICP-NL, _ours: our RANSAC + LM ICP)\n"
+            "scene             features   |  time s / fitness m^2 / within (by features) | "
             "paper\n";
     for (const auto& [name, worlds] : classes) {
       json row = {{"scene", name}};
-      for (const char* key : {"table1_narf", "pcl_default", "ours"}) {
+      for (const char* key : {"table1_narf", "pcl_default", "table1_narf_ours", "ours"}) {
         double t = 0, fit = 0;
-        int n = 0, within = 0;
+        int n = 0, within = 0, aligned = 0;  // aligned: within the target by the features path
         for (const json& p : pairs) {
           if (!worlds.count(p["world"]) || !p.contains("table1_narf") || !p.contains(key)) continue;
           const json& r = p[key];
@@ -513,20 +647,27 @@ int main(int argc, char** argv) {
           t += r["timings_s"]["total"].get<double>();
           fit += r["fitness_m2"].get<double>();
           within += r["within_target"].get<bool>() ? 1 : 0;
+          aligned += r["within_target"].get<bool>() && r["path"] == "features" ? 1 : 0;
         }
-        const std::string label = std::string(key) == "table1_narf"   ? "narf"
-                                  : std::string(key) == "pcl_default" ? "fpfh_pcl"
-                                                                      : "fpfh_ours";
+        const std::string k = key;
+        const std::string label = k == "table1_narf"        ? "narf_pcl"
+                                  : k == "pcl_default"      ? "fpfh_pcl"
+                                  : k == "table1_narf_ours" ? "narf_ours"
+                                                            : "fpfh_ours";
         row[label] = {{"pairs", n},
                       {"time_s", n ? t / n : 0.0},
                       {"fitness_m2", n ? fit / n : 0.0},
-                      {"within_target", within}};
-        char line[200];
-        std::snprintf(line, sizeof line, "%-17s %-10s | %8.3f / %9.2e / %d of %d | %s\n",
-                      name.c_str(), label.c_str(), n ? t / n : 0.0, n ? fit / n : 0.0, within, n,
-                      paper.is_null()
-                          ? "not given (--paper-table)"
-                          : paper.value(name, json::object()).value(label, json()).dump().c_str());
+                      {"within_target", within},
+                      {"within_by_features", aligned}};
+        char line[240];
+        std::snprintf(line, sizeof line, "%-17s %-10s | %8.3f / %9.2e / %d (%d) of %d | %s\n",
+                      name.c_str(), label.c_str(), n ? t / n : 0.0, n ? fit / n : 0.0, within,
+                      aligned, n,
+                      paper.is_null() ? "not given (--paper-table)"
+                                      : paper.value(name, json::object())
+                                            .value(label.substr(0, label.find('_')), json())
+                                            .dump()
+                                            .c_str());
         text << line;
       }
       row["paper"] = paper.is_null() ? json(nullptr) : paper.value(name, json(nullptr));

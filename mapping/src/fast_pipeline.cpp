@@ -212,14 +212,37 @@ SacResult SampleConsensus(const PointCloud& source, const PointCloud& target,
                           const std::vector<Correspondence>& corrs,
                           const RegistrationConfig& config,
                           const std::optional<PriorRegion>& region) {
-  SacResult best;
+  SacResult result;
   const int n = static_cast<int>(corrs.size());
-  if (n < 3) return best;
+  if (n < 3) return result;
   std::mt19937 rng(20120917);  // fixed: the same input gives the same output
   std::uniform_int_distribution<int> pick(0, n - 1);
   const float sim = static_cast<float>(config.sac_edge_similarity);
   const float min_edge = static_cast<float>(2.0 * config.feature_voxel_m);
   const float inlier_m = static_cast<float>(config.sac_inlier_m);
+  const std::size_t keep = static_cast<std::size_t>(config.sac_hypotheses);
+  // Hypotheses closer than ICP's capture range end in the same ICP minimum: one stands for all.
+  // A rotation counts as distinct when it moves a point 5 m out (a typical range) that far.
+  const PriorRegion same{Eigen::Isometry3d::Identity(), config.icp_max_distance_m,
+                         config.icp_max_distance_m / 5.0};
+  std::vector<SacHypothesis> top;  // best first
+  auto offer = [&](const SacHypothesis& h) {
+    auto near = std::find_if(top.begin(), top.end(), [&](const SacHypothesis& t) {
+      return same.Contains(t.T_target_source.inverse() * h.T_target_source);
+    });
+    if (near != top.end()) {
+      if (h.inliers <= near->inliers) return;
+      top.erase(near);
+    } else if (top.size() == keep && h.inliers <= top.back().inliers) {
+      return;
+    }
+    top.insert(std::upper_bound(top.begin(), top.end(), h,
+                                [](const SacHypothesis& a, const SacHypothesis& b) {
+                                  return a.inliers > b.inliers;
+                                }),
+               h);
+    if (top.size() > keep) top.pop_back();
+  };
   long needed = config.sac_iterations;
   for (long it = 0; it < needed; ++it) {
     const int idx[3] = {pick(rng), pick(rng), pick(rng)};
@@ -237,24 +260,37 @@ SacResult SampleConsensus(const PointCloud& source, const PointCloud& target,
     const Eigen::Isometry3d T = FitRigid(source, target, sample);
     if (!T.matrix().allFinite() || (region && !region->Contains(T))) continue;
     const int inliers = CountInliers(source, target, corrs, T, inlier_m, nullptr);
-    if (inliers <= best.inliers) continue;
-    best = {true, T, inliers};
+    const int best_before = top.empty() ? 0 : top.front().inliers;
+    offer({T, inliers});
+    if (inliers <= best_before) continue;
     const double w = static_cast<double>(inliers) / n;  // adaptive stop at 99.9 % confidence
     const double k = std::log(1e-3) / std::log(std::max(1e-12, 1.0 - w * w * w));
     needed = std::min<long>(needed, static_cast<long>(it + 1 + 4 * k));
   }
-  if (!best.found) return best;
-  for (int refit = 0; refit < 3; ++refit) {  // least squares on the inliers
-    std::vector<Correspondence> inliers;
-    CountInliers(source, target, corrs, best.T_target_source, inlier_m, &inliers);
-    if (inliers.size() < 3) break;
-    const Eigen::Isometry3d T = FitRigid(source, target, inliers);
-    if (region && !region->Contains(T)) break;
-    best.T_target_source = T;
-    best.inliers = CountInliers(source, target, corrs, T, inlier_m, nullptr);
+  for (SacHypothesis& h : top) {
+    for (int refit = 0; refit < 3; ++refit) {  // least squares on the inliers
+      std::vector<Correspondence> inliers;
+      CountInliers(source, target, corrs, h.T_target_source, inlier_m, &inliers);
+      if (inliers.size() < 3) break;
+      const Eigen::Isometry3d T = FitRigid(source, target, inliers);
+      if (region && !region->Contains(T)) break;
+      h.T_target_source = T;
+      h.inliers = CountInliers(source, target, corrs, T, inlier_m, nullptr);
+    }
   }
-  best.found = best.inliers >= config.sac_min_inliers;
-  return best;
+  if (top.empty()) return result;
+  result.T_target_source = top.front().T_target_source;
+  result.inliers = top.front().inliers;
+  result.found = result.inliers >= config.sac_min_inliers;
+  for (std::size_t i = 1; i < top.size(); ++i) {  // refits may have merged hypotheses
+    const bool repeated = std::any_of(top.begin(), top.begin() + i, [&](const SacHypothesis& t) {
+      return same.Contains(t.T_target_source.inverse() * top[i].T_target_source);
+    });
+    if (!repeated && top[i].inliers >= config.sac_min_inliers) {
+      result.alternatives.push_back(top[i]);
+    }
+  }
+  return result;
 }
 
 IcpResult PointToPlaneLm(const IcpTarget& target, const PointCloud& source,

@@ -40,12 +40,23 @@ struct PriorRegion {
   bool Contains(const Eigen::Isometry3d& T) const;
 };
 
+/// One pose hypothesis of the sample consensus and the correspondences agreeing with it.
+struct SacHypothesis {
+  Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();
+  int inliers = 0;
+};
+
 struct SacResult {
   bool found = false;
   Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();
   int inliers = 0;
+  /// The runners-up: distinct poses (farther apart than ICP's capture range) with at least
+  /// sac_min_inliers agreeing correspondences, best first, at most sac_hypotheses - 1. In repeated
+  /// structure (desk rows, doors along a hall) the true pose is often among them, not the best.
+  std::vector<SacHypothesis> alternatives;
 };
 /// RANSAC over correspondences: 3-point samples, edge-length prerejection, inlier count, refit.
+/// Keeps the sac_hypotheses best distinct poses (see SacResult::alternatives).
 SacResult SampleConsensus(const PointCloud& source, const PointCloud& target,
                           const std::vector<Correspondence>& corrs,
                           const RegistrationConfig& config,

@@ -1,7 +1,9 @@
 #include "pcl_pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 
 #include <pcl/features/fpfh.h>
 #include <pcl/features/narf_descriptor.h>
@@ -52,6 +54,8 @@ PclAlignment RunSacIa(const CloudXyz::Ptr& target, const CloudXyz::Ptr& source,
   sac.setMaxCorrespondenceDistance(config.sac_inlier_m);
   sac.setMaximumIterations(config.sac_iterations);
   CloudXyz aligned;
+  // SAC-IA samples with std::rand: seeded, so the same input gives the same output.
+  std::srand(20120917);
   sac.align(aligned);
   out.found = sac.hasConverged();
   out.T_target_source.matrix() = sac.getFinalTransformation().template cast<double>();
@@ -71,25 +75,35 @@ pcl::PointCloud<pcl::Normal>::Ptr Normals(const CloudXyz::Ptr& cloud, double rad
   return normals;
 }
 
-// NARF keypoints and descriptors on a spherical range image of `cloud` seen from the laser.
+// NARF keypoints and descriptors (Steder et al. 2011) on a spherical range image of `cloud` seen
+// from the laser. The range image wants the dense scan (a pixel per beam): the LMS200 steps 0.5 deg
+// in azimuth and the pitch unit about as much, so the image has the scan's own resolution; on a
+// 0.3 m voxel cloud almost every pixel would be a border. Unseen pixels (outside the pitch sweep,
+// behind the robot) stay unobserved: set to far range they would put borders, and so keypoints,
+// along the edges of the field of view, which move with the robot.
 void Narf(const CloudXyz::Ptr& cloud, const RegistrationConfig& config, CloudXyz::Ptr& keypoints,
           pcl::PointCloud<pcl::Narf36>::Ptr& descriptors) {
   pcl::RangeImage range_image;
   Eigen::Affine3f sensor = Eigen::Affine3f::Identity();
   sensor.translation() = Eigen::Vector3f(0.1f, 0.0f, 0.55f);
-  range_image.createFromPointCloud(*cloud, 0.5f * kDegToRad, 360.0f * kDegToRad, 180.0f * kDegToRad,
-                                   sensor, pcl::RangeImage::CAMERA_FRAME, 0.0f, 0.0f, 1);
-  range_image.setUnseenToMaxRange();
+  const float resolution = static_cast<float>(config.narf_angular_resolution_deg) * kDegToRad;
+  range_image.createFromPointCloud(*cloud, resolution, 360.0f * kDegToRad, 180.0f * kDegToRad,
+                                   sensor, pcl::RangeImage::LASER_FRAME,
+                                   static_cast<float>(config.narf_noise_level_m), 0.0f, 1);
   pcl::RangeImageBorderExtractor border_extractor;
   pcl::NarfKeypoint detector(&border_extractor);
   detector.setRangeImage(&range_image);
-  detector.getParameters().support_size = static_cast<float>(config.feature_radius_m);
+  detector.getParameters().support_size = static_cast<float>(config.narf_support_m);
+  detector.getParameters().add_points_on_straight_edges = true;  // else a few dozen per scan
+  detector.getParameters().distance_for_additional_points = 0.5f;
   pcl::PointCloud<int> keypoint_indices;
   detector.compute(keypoint_indices);
   std::vector<int> indices(keypoint_indices.begin(), keypoint_indices.end());
   pcl::NarfDescriptor narf(&range_image, &indices);
-  narf.getParameters().support_size = static_cast<float>(config.feature_radius_m);
-  narf.getParameters().rotation_invariant = true;
+  narf.getParameters().support_size = static_cast<float>(config.narf_support_m);
+  // The robot stays upright (roll, pitch of a few degrees), so the image's up is the same in both
+  // scans: the descriptor keeps its orientation (matched correctly 15 % vs 8 % rotation-invariant).
+  narf.getParameters().rotation_invariant = false;
   pcl::PointCloud<pcl::Narf36> narfs;
   narf.compute(narfs);
   keypoints.reset(new CloudXyz);
@@ -103,16 +117,19 @@ void Narf(const CloudXyz::Ptr& cloud, const RegistrationConfig& config, CloudXyz
 }  // namespace
 
 PclAlignment PclInitialAlignment(const PointCloud& target, const PointCloud& source,
+                                 const PointCloud& target_dense, const PointCloud& source_dense,
                                  const RegistrationConfig& config) {
   PclAlignment out;
   auto t = std::chrono::steady_clock::now();
   const CloudXyz::Ptr tc = ToPcl(target), sc = ToPcl(source);
   if (config.features == FeatureKind::kNarf) {
+    const CloudXyz::Ptr td_cloud = ToPcl(target_dense), sd_cloud = ToPcl(source_dense);
     CloudXyz::Ptr tk, sk;
     pcl::PointCloud<pcl::Narf36>::Ptr td, sd;
-    Narf(tc, config, tk, td);
-    Narf(sc, config, sk, sd);
+    Narf(td_cloud, config, tk, td);
+    Narf(sd_cloud, config, sk, sd);
     out.features_s = Since(t);
+    out.keypoints = static_cast<int>(std::min(tk->size(), sk->size()));
     if (tk->size() < 3 || sk->size() < 3) return out;
     out = RunSacIa<pcl::Narf36>(tk, sk, td, sd, config, out);
     out.correspondences = static_cast<int>(sk->size());
@@ -153,6 +170,20 @@ PclIcp PclIcpNonLinear(const PointCloud& target, const PointCloud& source,
   out.T_target_source.matrix() = icp.getFinalTransformation().cast<double>();
   out.converged = icp.hasConverged();
   out.iterations = config.icp_max_iterations;  // PCL does not expose the count it ran
+  return out;
+}
+
+NarfFeatures ComputeNarf(const PointCloud& dense, const RegistrationConfig& config) {
+  CloudXyz::Ptr keypoints;
+  pcl::PointCloud<pcl::Narf36>::Ptr descriptors;
+  Narf(ToPcl(dense), config, keypoints, descriptors);
+  NarfFeatures out;
+  out.descriptors.resize(static_cast<int>(descriptors->size()), 36);
+  for (std::size_t i = 0; i < descriptors->size(); ++i) {
+    const pcl::Narf36& d = (*descriptors)[i];
+    out.keypoints.emplace_back(d.x, d.y, d.z);
+    for (int k = 0; k < 36; ++k) out.descriptors(static_cast<int>(i), k) = d.descriptor[k];
+  }
   return out;
 }
 

@@ -1,5 +1,6 @@
 #include "pitchlab/mapping/registration.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -11,7 +12,6 @@
 
 namespace pitchlab::mapping {
 namespace {
-
 constexpr double kPi = 3.14159265358979323846;
 constexpr std::size_t kMinPoints = 30;  // after the voxel grid, per cloud
 // Normals are oriented towards the sensor: roughly above base_link's origin [m].
@@ -132,6 +132,19 @@ IcpResult RunIcp(const PointCloud& source, const IcpTarget& target, const Prepar
   return r;
 }
 
+// NARF on the dense scans (range images need one return per beam) + the same RANSAC.
+SacResult FastNarfAlignment(const PointCloud& target, const PointCloud& source,
+                            const RegistrationConfig& config,
+                            const std::optional<PriorRegion>& region, StageTimings& timings) {
+  Stopwatch lap;
+  const NarfFeatures t = ComputeNarf(target, config), s = ComputeNarf(source, config);
+  timings.features_s += lap.Lap();
+  const SacResult sac = SampleConsensus(
+      s.keypoints, t.keypoints, MatchFeatures(s.descriptors, t.descriptors), config, region);
+  timings.initial_alignment_s += lap.Lap();
+  return sac;
+}
+
 // Our FPFH + RANSAC initial alignment. When it finds nothing at the configured scale (a confined
 // scene: under a desk, between crates), it retries once at half the scale (voxel, radii, inlier
 // distance).
@@ -171,6 +184,181 @@ SacResult FastFeatureAlignment(const Prepared& prep, const RegistrationConfig& c
     if (sac.found) break;
   }
   return sac;
+}
+
+// The winner of the hypothesis verification and where its start came from.
+struct Verified {
+  IcpResult icp;
+  RegistrationPath path = RegistrationPath::kFeatures;
+  int iterations = 0;  // of all the ICP runs
+  std::string note;    // why a runner-up, the prior's guess or a search won, else empty
+};
+
+// Short ICP runs (8 iterations on 300 evenly sampled source points, a tenth of a full run) from
+// each start: screens many starts cheaply; the promising ones are refined with the full ICP.
+std::vector<IcpResult> Screen(const IcpTarget& target, const PointCloud& source,
+                              const std::vector<Eigen::Isometry3d>& starts,
+                              const RegistrationConfig& config, int& iterations) {
+  RegistrationConfig screen = config;
+  screen.icp_max_iterations = 8;
+  const PointCloud few = EvenSubsample(source, 300);
+  std::vector<IcpResult> out;
+  for (const Eigen::Isometry3d& start : starts) {
+    out.push_back(PointToPlaneLm(target, few, start, screen, {}));
+    iterations += out.back().iterations;
+  }
+  return out;
+}
+
+// Two poses in the same ICP minimum (closer than half its capture range).
+bool SamePose(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b,
+              const RegistrationConfig& config) {
+  const PoseError d = ComparePoses(a, b);
+  return d.translation_m < 0.5 * config.icp_max_distance_m && d.rotation_deg < 2.0;
+}
+
+// A start to verify and what to call it.
+struct Start {
+  Eigen::Isometry3d T;
+  RegistrationPath path;
+  std::string name;
+};
+
+// The 3 x 3 x 3 grid over the guess's uncertainty (guess_search_m, guess_search_deg about the
+// vertical): neighbours lie guess_search_m apart, so every pose of the region is within ICP's
+// capture range of one (0.6 m spacing, 0.5 m gate; a 12 deg turn moves a point 5 m out 0.5 m).
+std::vector<Start> GuessGrid(const Start& guess, const RegistrationConfig& config) {
+  std::vector<Start> out;
+  for (int ix = -1; ix <= 1; ++ix) {
+    for (int iy = -1; iy <= 1; ++iy) {
+      for (int iyaw = -1; iyaw <= 1; ++iyaw) {
+        if (ix == 0 && iy == 0 && iyaw == 0) continue;  // the guess itself
+        out.push_back(
+            {guess.T * PoseFromXyzRpyDeg(ix * config.guess_search_m, iy * config.guess_search_m, 0,
+                                         0, 0, iyaw * config.guess_search_deg),
+             guess.path, "a grid of starts around " + guess.name});
+      }
+    }
+  }
+  return out;
+}
+
+// ICP from each hypothesis of the consensus (best first, then the runners-up) and from the prior's
+// guess (odometry, else the constant-velocity motion): the best fit (inlier ratio) that passes the
+// acceptance test wins; a start that ends in the pose already held does not count. The consensus
+// scores a pose by a few dozen sparse feature matches; in repeated structure (desk rows, a hall)
+// a pose one unit off collects as many, while ICP's inliers over thousands of points tell them
+// apart. The other starts are screened (short ICP) and only the two best screened refined. Two
+// searches widen the net:
+// - the consensus is weak (fewer than twice sac_min_inliers agree) and the guess ends elsewhere:
+//   a grid of starts over the guess's uncertainty, as ICP from the guess alone may stop in a local
+//   minimum short of the true pose;
+// - the winner is weakly constrained along a direction (degeneracy_ratio: a hall, a street): starts
+//   along it every half capture range up to degeneracy_search_m, for the repeated unit the
+//   features may have matched instead.
+// Neither decides degeneracy: the caller still probes the winner (a bare corridor stays ambiguous
+// whichever window coincidence scores best). When no start passes, the consensus' best is returned
+// (its rejection is then reported).
+Verified VerifyHypotheses(const PointCloud& source, const IcpTarget& target, const SacResult& sac,
+                          const RegistrationPrior& prior, const RegistrationConfig& config) {
+  Verified best;
+  best.icp = PointToPlaneLm(target, source, sac.T_target_source, config, {});
+  best.iterations = best.icp.iterations;
+  bool accepted = Rejection(best.icp, prior, config).empty();
+  auto offer = [&](const IcpResult& icp, const Start& from) {
+    if (SamePose(icp.T_target_source, best.icp.T_target_source, config)) return;
+    if (!Rejection(icp, prior, config).empty()) return;
+    if (accepted && icp.inlier_ratio <= best.icp.inlier_ratio) return;
+    std::ostringstream os;
+    os.precision(3);
+    os << "ICP from " << from.name << " fits best (" << Percent(icp.inlier_ratio) << " inliers vs "
+       << Percent(best.icp.inlier_ratio) << ")";
+    best.note = os.str();
+    best.icp = icp;
+    best.path = from.path;
+    accepted = true;
+  };
+  // Screens `starts`, refines the `refine` best-screened that end away from the pose held.
+  auto verify = [&](const std::vector<Start>& starts, std::size_t refine) {
+    std::vector<Eigen::Isometry3d> poses;
+    for (const Start& s : starts) poses.push_back(s.T);
+    const std::vector<IcpResult> screened = Screen(target, source, poses, config, best.iterations);
+    std::vector<std::size_t> order(starts.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return screened[a].inlier_ratio > screened[b].inlier_ratio;
+    });
+    std::vector<Eigen::Isometry3d> refined;
+    for (const std::size_t i : order) {
+      if (refined.size() == refine) break;
+      const Eigen::Isometry3d& end = screened[i].T_target_source;
+      if (SamePose(end, best.icp.T_target_source, config)) continue;
+      if (std::any_of(refined.begin(), refined.end(),
+                      [&](const auto& r) { return SamePose(end, r, config); })) {
+        continue;
+      }
+      refined.push_back(end);
+      const IcpResult icp = PointToPlaneLm(target, source, end, config, {});
+      best.iterations += icp.iterations;
+      offer(icp, starts[i]);
+    }
+    return screened;
+  };
+  std::vector<Start> starts;
+  for (std::size_t i = 0; i < sac.alternatives.size(); ++i) {
+    starts.push_back({sac.alternatives[i].T_target_source, RegistrationPath::kFeatures,
+                      "runner-up hypothesis " + std::to_string(i + 1) + " of the consensus"});
+  }
+  std::optional<Start> guess;
+  if (prior.odometry) {
+    guess = Start{*prior.odometry, RegistrationPath::kOdometry, "the odometry guess"};
+  } else if (prior.previous_motion && config.constant_velocity_fallback) {
+    guess = Start{*prior.previous_motion, RegistrationPath::kFallback, "the fallback guess"};
+  }
+  if (guess) starts.push_back(*guess);
+  const std::vector<IcpResult> screened = verify(starts, 2);
+  if (guess && config.guess_search_m > 0 && sac.inliers < 2 * config.sac_min_inliers &&
+      !SamePose(screened.back().T_target_source, best.icp.T_target_source, config)) {
+    verify(GuessGrid(*guess, config), 2);
+  }
+  if (best.icp.degeneracy < config.degeneracy_ratio && config.degeneracy_search_m > 0) {
+    const Weakness weak = WeakDirections(target, source, best.icp.T_target_source, config);
+    if (weak.translation) {
+      const double step = 0.5 * config.icp_max_distance_m;
+      const int steps = static_cast<int>(std::ceil(config.degeneracy_search_m / step));
+      std::vector<Start> along;
+      for (int k = -steps; k <= steps; ++k) {
+        if (k == 0) continue;
+        along.push_back(
+            {Eigen::Translation3d(k * step * *weak.translation) * best.icp.T_target_source,
+             best.path, "starts along the weakly constrained direction"});
+      }
+      verify(along, 2);
+    }
+  }
+  return best;
+}
+
+// ICP from the guess was rejected (a confined scene: under desks, between crates, where the guess
+// lies outside ICP's basin): the grid over the guess's uncertainty, screened, the two best refined;
+// the best-fitting accepted result, if any.
+std::optional<IcpResult> SearchAroundGuess(const IcpTarget& target, const PointCloud& source,
+                                           const Start& guess, const RegistrationPrior& prior,
+                                           const RegistrationConfig& config, int& iterations) {
+  std::vector<Eigen::Isometry3d> poses;
+  for (const Start& s : GuessGrid(guess, config)) poses.push_back(s.T);
+  std::vector<IcpResult> screened = Screen(target, source, poses, config, iterations);
+  std::stable_sort(screened.begin(), screened.end(),
+                   [](const auto& a, const auto& b) { return a.inlier_ratio > b.inlier_ratio; });
+  std::optional<IcpResult> best;
+  for (std::size_t i = 0; i < std::min<std::size_t>(2, screened.size()); ++i) {
+    const IcpResult icp = PointToPlaneLm(target, source, screened[i].T_target_source, config, {});
+    iterations += icp.iterations;
+    if (Rejection(icp, prior, config).empty() && (!best || icp.inlier_ratio > best->inlier_ratio)) {
+      best = icp;
+    }
+  }
+  return best;
 }
 
 void Fill(RegistrationResult& out, const IcpResult& icp, RegistrationPath path) {
@@ -268,12 +456,17 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
     SacResult sac;
     if (config.backend == RegistrationBackend::kPcl) {
       const PclAlignment pcl =
-          PclInitialAlignment(prep.target_features, prep.source_features, config);
+          PclInitialAlignment(prep.target_features, prep.source_features, target, source, config);
       out.timings.normals_s += pcl.normals_s;
       out.timings.features_s = pcl.features_s;
       out.timings.initial_alignment_s = pcl.sac_s;
-      sac = {pcl.found && (!region || region->Contains(pcl.T_target_source)), pcl.T_target_source,
-             pcl.correspondences};
+      sac = SacResult{};  // PCL's SAC-IA gives one pose, no runners-up
+      sac.found = pcl.found && (!region || region->Contains(pcl.T_target_source));
+      sac.T_target_source = pcl.T_target_source;
+      sac.inliers = pcl.correspondences;
+      lap.Lap();
+    } else if (config.features == FeatureKind::kNarf) {
+      sac = FastNarfAlignment(target, source, config, region, out.timings);
       lap.Lap();
     } else {
       sac = FastFeatureAlignment(prep, config, region, out.timings);
@@ -281,14 +474,23 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
     }
     out.sac_inliers = sac.inliers;
     if (sac.found) {
-      const IcpResult icp =
-          RunIcp(icp_source, icp_target, prep, sac.T_target_source, config, false, &ambiguous);
+      IcpResult icp;
+      RegistrationPath path = RegistrationPath::kFeatures;
+      std::string note;
+      if (config.backend == RegistrationBackend::kPcl) {
+        icp = RunIcp(icp_source, icp_target, prep, sac.T_target_source, config, false, &ambiguous);
+      } else {
+        const Verified v = VerifyHypotheses(icp_source, icp_target, sac, prior, config);
+        icp = v.icp, path = v.path, note = v.note;
+        out.iterations += v.iterations - icp.iterations;  // Fill adds the winner's own
+        ambiguous = DegenerateDirections(icp_target, icp_source, icp, config).any();
+      }
       out.timings.icp_s += lap.Lap();
-      Fill(out, icp, RegistrationPath::kFeatures);
+      Fill(out, icp, path);
       const std::string rejection = Rejection(icp, prior, config);
       if (!ambiguous && rejection.empty()) {
         out.success = true;
-        out.reason = "features";
+        out.reason = note.empty() ? std::string(ToString(path)) : note;
         out.timings.total_s = total.Lap();
         return out;
       }
@@ -317,14 +519,35 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
   }
   for (const auto& [path, guess] : guesses) {
     bool degenerate = false;
-    const IcpResult icp = RunIcp(icp_source, icp_target, prep, guess, config, true, &degenerate);
+    IcpResult icp = RunIcp(icp_source, icp_target, prep, guess, config, true, &degenerate);
+    std::string rejection = Rejection(icp, prior, config);
+    bool searched = false;
+    if (!rejection.empty() && config.backend == RegistrationBackend::kFast &&
+        config.guess_search_m > 0) {
+      int iterations = 0;
+      const std::optional<IcpResult> found = SearchAroundGuess(
+          icp_target, icp_source, {guess, path, ToString(path)}, prior, config, iterations);
+      out.iterations += iterations;
+      // Only a pose the scene pins down may replace the guess: in a corridor a grid start fits
+      // anywhere along the axis, and nothing says where.
+      if (found && !DegenerateDirections(icp_target, icp_source, *found, config).any()) {
+        notes.push_back(std::string("ICP from the ") + ToString(path) + " guess: " + rejection);
+        icp = *found, rejection.clear(), searched = true, degenerate = false;
+        out.iterations -= icp.iterations;  // Fill adds the winner's own
+      } else if (found) {
+        rejection +=
+            " (a grid of starts around the guess fits, but degenerate geometry leaves the "
+            "pose undetermined there)";
+      }
+    }
     out.timings.icp_s += lap.Lap();
     Fill(out, icp, path);
-    const std::string rejection = Rejection(icp, prior, config);
     if (rejection.empty()) {
       out.success = true;
-      notes.push_back(std::string("took the ") + ToString(path) + " path" +
-                      (degenerate ? " (degenerate: the weak directions kept from the guess)" : ""));
+      notes.push_back(
+          std::string("took the ") + ToString(path) + " path" +
+          (degenerate ? " (degenerate: the weak directions kept from the guess)" : "") +
+          (searched ? " (ICP from the best of a grid of starts around the guess)" : ""));
       break;
     }
     notes.push_back(std::string(ToString(path)) + " path rejected: " + rejection);

@@ -44,13 +44,20 @@ void VisitFields(RegistrationConfig& c, Visitor&& v) {
   v("feature_radius_m", c.feature_radius_m);
   v("max_neighbors", c.max_neighbors);
   v("max_feature_points", c.max_feature_points);
+  v("narf_angular_resolution_deg", c.narf_angular_resolution_deg);
+  v("narf_noise_level_m", c.narf_noise_level_m);
+  v("narf_support_m", c.narf_support_m);
   v("sac_iterations", c.sac_iterations);
   v("sac_inlier_m", c.sac_inlier_m);
   v("sac_edge_similarity", c.sac_edge_similarity);
   v("sac_min_inliers", c.sac_min_inliers);
+  v("sac_hypotheses", c.sac_hypotheses);
   v("degeneracy_ratio", c.degeneracy_ratio);
   v("degeneracy_probe_m", c.degeneracy_probe_m);
   v("degeneracy_probe_deg", c.degeneracy_probe_deg);
+  v("degeneracy_search_m", c.degeneracy_search_m);
+  v("guess_search_m", c.guess_search_m);
+  v("guess_search_deg", c.guess_search_deg);
   v("icp_max_iterations", c.icp_max_iterations);
   v("icp_epsilon", c.icp_epsilon);
   v("icp_max_distance_m", c.icp_max_distance_m);
@@ -104,16 +111,26 @@ void RegistrationConfig::Validate() const {
           "must exceed half the normal radius");
   require(max_neighbors >= 5, "max_neighbors", max_neighbors, "must be >= 5");
   require(max_feature_points >= 10, "max_feature_points", max_feature_points, "must be >= 10");
+  require(narf_angular_resolution_deg > 0 && narf_angular_resolution_deg <= 10,
+          "narf_angular_resolution_deg", narf_angular_resolution_deg, "must be in (0, 10]");
+  require(narf_noise_level_m >= 0, "narf_noise_level_m", narf_noise_level_m, "must be >= 0");
+  require(narf_support_m > 0, "narf_support_m", narf_support_m, "must be > 0");
   require(sac_iterations >= 1, "sac_iterations", sac_iterations, "must be >= 1");
   require(sac_inlier_m > 0, "sac_inlier_m", sac_inlier_m, "must be > 0");
   require(sac_edge_similarity > 0 && sac_edge_similarity < 1, "sac_edge_similarity",
           sac_edge_similarity, "must be in (0, 1)");
   require(sac_min_inliers >= 3, "sac_min_inliers", sac_min_inliers, "must be >= 3");
+  require(sac_hypotheses >= 1 && sac_hypotheses <= 16, "sac_hypotheses", sac_hypotheses,
+          "must be in [1, 16]");
   require(degeneracy_ratio >= 0 && degeneracy_ratio < 1, "degeneracy_ratio", degeneracy_ratio,
           "must be in [0, 1)");
   require(degeneracy_probe_m > 0, "degeneracy_probe_m", degeneracy_probe_m, "must be > 0");
   require(degeneracy_probe_deg > 0 && degeneracy_probe_deg < 90, "degeneracy_probe_deg",
           degeneracy_probe_deg, "must be in (0, 90)");
+  require(degeneracy_search_m >= 0, "degeneracy_search_m", degeneracy_search_m, "must be >= 0");
+  require(guess_search_m >= 0, "guess_search_m", guess_search_m, "must be >= 0");
+  require(guess_search_deg >= 0 && guess_search_deg < 90, "guess_search_deg", guess_search_deg,
+          "must be in [0, 90)");
   require(icp_max_iterations >= 1, "icp_max_iterations", icp_max_iterations, "must be >= 1");
   require(icp_epsilon > 0, "icp_epsilon", icp_epsilon, "must be > 0");
   require(icp_max_distance_m > 0, "icp_max_distance_m", icp_max_distance_m, "must be > 0");
@@ -128,9 +145,6 @@ void RegistrationConfig::Validate() const {
   require(min_inlier_ratio >= 0 && min_inlier_ratio <= 1, "min_inlier_ratio", min_inlier_ratio,
           "must be in [0, 1]");
   require(max_rmse_m > 0, "max_rmse_m", max_rmse_m, "must be > 0");
-  if (backend == RegistrationBackend::kFast && features == FeatureKind::kNarf) {
-    throw std::invalid_argument("registration.features = narf needs registration.backend = pcl");
-  }
 }
 
 RegistrationConfig ParseRegistrationConfig(const std::string& yaml_text,

@@ -47,7 +47,11 @@ TEST(RegistrationConfig, AWrongTypeOrValueIsAnErrorNamingFieldAndValue) {
             std::string::npos);
   EXPECT_NE(ErrorOf("registration: {backend: gpu}").find("must be fast or pcl ('gpu')"),
             std::string::npos);
-  EXPECT_NE(ErrorOf("registration: {features: narf}").find("needs registration.backend = pcl"),
+  EXPECT_NE(ErrorOf("registration: {narf_support_m: 0}").find("registration.narf_support_m = 0"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("registration: {sac_hypotheses: 0}").find("registration.sac_hypotheses = 0"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("registration: {guess_search_deg: 90}").find("must be in [0, 90)"),
             std::string::npos);
 }
 

@@ -15,7 +15,7 @@ enum class RegistrationBackend {
 /// Descriptor used for the sample-consensus initial alignment (the paper's Table 1).
 enum class FeatureKind {
   kFpfh,  ///< Fast Point Feature Histograms (33 bins)
-  kNarf,  ///< Normal-Aligned Radial Features on a range image (PCL backend only)
+  kNarf,  ///< Normal-Aligned Radial Features on range images of the dense scans (PCL's NARF)
   kNone,  ///< no feature alignment: ICP starts from the odometry prior / constant velocity
 };
 
@@ -35,16 +35,34 @@ struct RegistrationConfig {
   int max_neighbors = 40;            ///< neighbours used per feature at most [1]
   int max_feature_points = 2500;     ///< keypoints (evenly sampled) matched per cloud at most [1]
 
+  // NARF (Table 1's alternative): range images of the dense scans, seen from the laser.
+  double narf_angular_resolution_deg = 0.5;  ///< range image pixel: the LMS200's step [deg]
+  double narf_noise_level_m = 0.02;  ///< z-buffer averages returns within this of the nearest [m]
+  /// Keypoint and descriptor support diameter [m]. Small: a wider support takes in what lies
+  /// behind a border, which changes with the viewpoint (known-motion test: 0.5 m aligns the
+  /// town and the clutter, 1 m neither).
+  double narf_support_m = 0.5;
+
   // Sample-consensus initial alignment.
   int sac_iterations = 20000;        ///< hypotheses drawn at most [1]
   double sac_inlier_m = 0.6;         ///< a correspondence agrees within this distance [m]
   double sac_edge_similarity = 0.9;  ///< prerejection: sampled edge lengths agree to this ratio [1]
   int sac_min_inliers = 10;          ///< fewer agreeing correspondences: alignment failed [1]
+  /// Distinct hypotheses of the consensus (best and runners-up) that ICP refines; the one that
+  /// fits best (inlier ratio) wins. 1: only the consensus' best [1].
+  int sac_hypotheses = 4;
   /// Weakest / strongest point-to-plane constraint (translation or rotation) below this: the
   /// solution is probed for degeneracy (a corridor, an open plane) by restarting ICP off it [1].
   double degeneracy_ratio = 0.05;
   double degeneracy_probe_m = 1.0;     ///< restart offset of the probe; it must come back [m]
   double degeneracy_probe_deg = 10.0;  ///< restart rotation of the probe about a weak axis [deg]
+  /// A weakly constrained feature alignment is also tried this far along its weak direction
+  /// (repeated structure along a hall or street; 0 disables) [m].
+  double degeneracy_search_m = 2.0;
+  /// The prior's guess and the features disagree: ICP from a grid of starts within this of the
+  /// guess (0 disables) [m] ...
+  double guess_search_m = 0.6;
+  double guess_search_deg = 12.0;  ///< ... turned up to this about the vertical [deg]
 
   // Non-linear ICP (Levenberg-Marquardt).
   int icp_max_iterations = 40;       ///< [1]
