@@ -413,6 +413,7 @@ int RunHwMission(int argc, char** argv) {
   context.config_yaml =
       AppConfigToYaml(config) + RunSettingsToYaml(settings) + HwRigConfigToYaml(hw_config);
   context.planner = MissionPlanner(mission);
+  context.layers = mission.layers;
   context.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   WriteFinalOutputs(folder, context, result, std::nullopt, nullptr, std::nullopt);

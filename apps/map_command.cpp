@@ -24,6 +24,13 @@
 namespace pitchlab::apps {
 namespace {
 
+// The library's default, as --help shows it.
+std::string DefaultClearance() {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", mapping::InsertConfig{}.clearance_length_m);
+  return text;
+}
+
 CliArgs MapArgs() {
   CliArgs args("map",
                "Builds an elevation map from point clouds (PCD; points moved into the world by\n"
@@ -39,7 +46,8 @@ CliArgs MapArgs() {
               "world the clouds came from: geodetic origin and ground truth (" +
                   BuiltinWorldNames() + ")")
       .Option("clearance", "METRES",
-              "ray length behind each hit that marks free space (drops); 0 disables", "2.0")
+              "ray length behind each hit that marks free space (drops, overhangs); 0 disables",
+              DefaultClearance())
       .Flag("json", "print the summary as JSON on stdout");
   return args;
 }
@@ -58,7 +66,7 @@ LoadedCloud LoadCloud(const std::string& path) {
   for (const sensors::ScanPoint& p : scan->points)
     c.points.push_back(T * Eigen::Vector3f(p.x, p.y, p.z));
   // The mirror at zero pitch; it moves by a few centimetres while pitching, which shifts the
-  // clearance rays' ends (the last 2 m) by well under a centimetre.
+  // clearance rays' ends (the last few metres) by well under a centimetre.
   const sensors::MountConfig mount;
   c.sensor_origin = T * (mount.t_base_mount_m + mount.t_mount_laser_m).cast<float>();
   return c;
@@ -68,10 +76,14 @@ nlohmann::json ErrorJson(const mapping::MapErrorReport& r) {
   return {{"compared_cells", r.compared_cells},
           {"truth_cells", r.truth_cells},
           {"coverage", r.coverage},
+          {"surface_cells", r.surface_cells},
           {"rmse_m", r.rmse_m},
           {"mean_error_m", r.mean_error_m},
           {"max_abs_error_m", r.max_abs_error_m},
           {"p95_abs_error_m", r.p95_abs_error_m},
+          {"wall_cells", r.wall_cells},
+          {"wall_rmse_m", r.wall_rmse_m},
+          {"all_rmse_m", r.all_rmse_m},
           {"drop_cells", r.drop_cells}};
 }
 
@@ -190,9 +202,12 @@ int RunMap(int argc, char** argv) {
       out.string().c_str());
   if (summary.contains("truth")) {
     const auto& t = summary["truth"];
-    std::printf("vs ground truth: RMSE %.4f m, max %.4f m, bias %.4f m, coverage %.1f %%\n",
-                t["rmse_m"].get<double>(), t["max_abs_error_m"].get<double>(),
-                t["mean_error_m"].get<double>(), 100 * t["coverage"].get<double>());
+    std::printf(
+        "vs ground truth: surface RMSE %.4f m, max %.4f m, bias %.4f m, coverage %.1f %%; "
+        "%zu wall cells (no single true height), RMSE %.3f m\n",
+        t["rmse_m"].get<double>(), t["max_abs_error_m"].get<double>(),
+        t["mean_error_m"].get<double>(), 100 * t["coverage"].get<double>(),
+        t["wall_cells"].get<std::size_t>(), t["wall_rmse_m"].get<double>());
   }
   return 0;
 }

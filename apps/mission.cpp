@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 
@@ -23,7 +24,9 @@ constexpr double kTurnGain_per_s = 2.0;                    // yaw rate per radia
 constexpr double kMinDrive_m = 0.1;  // a drive shorter than this is no progress
 constexpr double kBackOff_m = 0.6;   // reverse this far from a tilt beyond caution
 constexpr double kBackOffSpeed_mps = 0.2;
-constexpr double kFeltAhead_m = 0.2;       // the tilting ground: under the front axle and on
+constexpr double kFeltAhead_m = 0.2;           // the tilting ground: under the front axle and on
+constexpr double kMaxCentripetal_mps2 = 0.15;  // v * omega while following a path
+constexpr double kSlopeYawRate_rps = 0.3;      // skid-steer turns on a slope at most this fast
 constexpr double kSlopeLookahead_m = 1.0;  // slow down this far before a slope (braking distance)
 
 double Yaw(const Eigen::Isometry3d& T) { return std::atan2(T.linear()(1, 0), T.linear()(0, 0)); }
@@ -213,10 +216,10 @@ bool Mission::Stop(int k) {
   std::snprintf(line, sizeof(line), "stop %d: %.1f m to goal, registration %s, %s", k,
                 s.distance_to_goal_m,
                 s.merge.merged ? mapping::ToString(s.merge.registration.path) : "FAILED",
-                arrived           ? "goal reached"
-                : !s.plan         ? "no path"
-                : s.through_drops ? "path planned through inferred drops, to look closer"
-                                  : "path planned");
+                arrived         ? "goal reached"
+                : !s.plan       ? "no path"
+                : s.look_closer ? "path planned through doubtful hazards, to look closer"
+                                : "path planned");
   Progress(line);
   if (arrived) {
     result_.success = true;
@@ -304,44 +307,59 @@ tl::expected<planning::Path, planning::NoPath> Mission::PlanOn(
 }
 
 void Mission::Plan(StopRecord& stop) const {
-  mapping::ElevationLayers layers = mapping::ComputeLayers(result_.elevation);
+  mapping::ElevationLayers layers = mapping::ComputeLayers(result_.elevation, config_.layers);
   for (const FeltHazard& f : felt_) MarkFelt(layers, f);
   stop.felt_hazards = static_cast<int>(felt_.size());
   const planning::PlannerConfig planner = MissionPlanner(config_);
   planning::TraversabilityGrid grid = planning::BuildTraversability(layers, planner);
   const Eigen::Vector2d here = stop.T_world_base.translation().head<2>();
   auto path = PlanOn(grid, here);
-  if (!path) {
-    // Recovery: drops are inferred from rays passing low, and at range a small attitude error
-    // makes them where there are none. If they cut every way, plan through them as unknown: the
-    // robot drives only over what it has seen, stops short of them and looks from closer.
-    std::vector<bool> drop(layers.state.size(), false);
-    std::size_t drops = 0;
+  // Recoveries, when the map cuts every way: plan through the cells it is least sure of, as
+  // unknown. The robot drives only over what it has seen, stops short of them (never onto one)
+  // and looks from closer; what is truly there stays in the map and ends the run honestly.
+  const auto look_closer = [&](const std::function<bool(std::size_t)>& doubtful,
+                               const std::string& what) {
+    mapping::ElevationLayers relaxed_layers = layers;
+    std::vector<bool> doubt(layers.state.size(), false);
+    std::size_t n = 0;
     for (std::size_t k = 0; k < layers.state.size(); ++k) {
-      if (layers.state[k] != mapping::CellState::kDrop) continue;
-      layers.state[k] = mapping::CellState::kUnknown;
-      drop[k] = true;
-      ++drops;
+      if (!doubtful(k)) continue;
+      relaxed_layers.state[k] = mapping::CellState::kUnknown;
+      doubt[k] = true;
+      ++n;
     }
-    if (drops > 0) {
-      planning::TraversabilityGrid relaxed = planning::BuildTraversability(layers, planner);
-      if (auto through = PlanOn(relaxed, here)) {
-        stop.plan_note =
-            "no path around the inferred drops: planning through them as unknown, "
-            "to look from closer (" +
-            path.error().message + ")";
-        stop.through_drops = true;
-        path = std::move(through);
-        grid = std::move(relaxed);
-        // How far the robot may go before the first of those cells.
-        stop.plan_to_drop_m = 0;
-        for (std::size_t i = 1; i < path->waypoints.size(); ++i) {
-          const planning::Waypoint &v = path->waypoints[i - 1], &w = path->waypoints[i];
-          if (drop[grid.geometry.Linear(grid.geometry.IndexOf(w.x_m, w.y_m))]) break;
-          stop.plan_to_drop_m += std::hypot(w.x_m - v.x_m, w.y_m - v.y_m);
-        }
-      }
+    if (n == 0) return;
+    planning::TraversabilityGrid relaxed = planning::BuildTraversability(relaxed_layers, planner);
+    auto through = PlanOn(relaxed, here);
+    if (!through) return;
+    stop.plan_note = "no path: planning through " + what + " as unknown, to look from closer (" +
+                     path.error().message + ")";
+    stop.look_closer = true;
+    stop.plan_to_doubt_m = 0;  // how far the robot may go before the first of those cells
+    for (std::size_t i = 1; i < through->waypoints.size(); ++i) {
+      const planning::Waypoint &v = through->waypoints[i - 1], &w = through->waypoints[i];
+      if (doubt[relaxed.geometry.Linear(relaxed.geometry.IndexOf(w.x_m, w.y_m))]) break;
+      stop.plan_to_doubt_m += std::hypot(w.x_m - v.x_m, w.y_m - v.y_m);
     }
+    path = std::move(through);
+    grid = std::move(relaxed);
+  };
+  // Drops are inferred from rays passing low; at range a small attitude error makes them where
+  // there are none.
+  if (!path) {
+    look_closer([&](std::size_t k) { return layers.state[k] == mapping::CellState::kDrop; },
+                "the inferred drops");
+  }
+  // A goal seen from afar on sparse points can look steep or stepped.
+  if (!path && path.error().reason == planning::NoPath::Reason::kGoalBlocked &&
+      (config_.goal_m - here).norm() > kGoalApproach_m) {
+    look_closer(
+        [&](std::size_t k) {
+          return layers.state[k] != mapping::CellState::kUnknown &&
+                 (layers.geometry.CenterOf(layers.geometry.FromLinear(k)) - config_.goal_m).norm() <
+                     kGoalApproach_m;
+        },
+        "the hazards seen around the goal");
   }
   if (!path) {
     stop.plan_error = path.error().message;
@@ -379,12 +397,12 @@ bool Mission::Drive(const StopRecord& stop) {
   // ahead: drive a little onto it, but never up to a cell the map took for a drop.
   if (!turn_only) {
     length = std::max(length, std::min(config_.drive_per_stop_m, 1.0));
-    if (stop.through_drops)
-      length = std::min(length, stop.plan_to_drop_m - config_.unknown_margin_m);
+    if (stop.look_closer)
+      length = std::min(length, stop.plan_to_doubt_m - config_.unknown_margin_m);
     if (length < kMinDrive_m) {
-      // Looked from as close as it may go: the drops stand, so there is no way on.
+      // Looked from as close as it may go: the hazards stand, so there is no way on.
       result_.reason = "no path at stop " + std::to_string(stop.index) +
-                       ": the drops that block the way stay drops seen from close by";
+                       ": the hazards that block the way stay hazards seen from close by";
       return false;
     }
   }
@@ -393,6 +411,15 @@ bool Mission::Drive(const StopRecord& stop) {
   if (!turn_only && !Follow(path, length)) return false;
   // After backing off, the next scan looks at the slope from where the robot stands.
   if (!backed_off_ && !TurnTo(PathHeading(path, turn_only ? 0.0 : length))) return false;
+  // Never scan standing steeply: back off the way it came (once) and mark what it stood on.
+  if (!backed_off_ && Tilt() > config_.scan_tilt_deg * kPi / 180) {
+    Result<sensors::Odometry> odo = base_.ReadOdometry();
+    if (!odo) {
+      result_.reason = "base: " + odo.error().message;
+      return false;
+    }
+    if (!BackOff(*odo, Tilt())) return false;
+  }
   Result<sensors::Odometry> stopped = base_.Drive(0.0, 0.0, kStopTime_s);
   if (!stopped) {
     result_.reason = "base: " + stopped.error().message;
@@ -468,12 +495,22 @@ bool Mission::Follow(const planning::Path& path, double length_m) {
     if (cmd.done) return true;
     const double tilt = Tilt();
     if (tilt > config_.caution_tilt_deg * kPi / 180) return BackOff(odo, tilt);
+    // Turning fast while driving fast makes the skid-steer P3-AT brake its inner wheels hard,
+    // and a top-heavy robot pitches over its front wheels: keep the centripetal acceleration
+    // v * omega small, on the same arc.
+    const double centripetal = std::abs(cmd.v_mps * cmd.omega_rps);
+    if (centripetal > kMaxCentripetal_mps2) {
+      const double s = std::sqrt(kMaxCentripetal_mps2 / centripetal);
+      cmd.v_mps *= s;
+      cmd.omega_rps *= s;
+    }
     const double arc = prefix_m - follower.remaining_m();
     if (tilt > config_.slope_tilt_deg * kPi / 180 ||
         MaxGrade(path, arc, arc + kSlopeLookahead_m) > slope_grade) {
       // Slower on slopes, on the same arc: braking and turning pitch a top-heavy robot over.
       const double scale =
-          std::min(1.0, config_.slope_speed_mps / std::max(std::abs(cmd.v_mps), 1e-9));
+          std::min({1.0, config_.slope_speed_mps / std::max(std::abs(cmd.v_mps), 1e-9),
+                    kSlopeYawRate_rps / std::max(std::abs(cmd.omega_rps), 1e-9)});
       cmd.v_mps *= scale;
       cmd.omega_rps *= scale;
     }
@@ -545,10 +582,11 @@ MissionResult RunMission(sensors::ScanSource& source, sensors::MobileBase& base,
   if (config.map_area.cell_count() == 0) throw std::invalid_argument("mission: empty map area");
   if (!(config.caution_tilt_deg > 0 && config.caution_tilt_deg < config.max_tilt_deg) ||
       !(config.slope_tilt_deg > 0 && config.slope_tilt_deg < config.caution_tilt_deg) ||
+      !(config.scan_tilt_deg > 0 && config.scan_tilt_deg < config.caution_tilt_deg) ||
       !(config.slope_speed_mps > 0)) {
     throw std::invalid_argument(
-        "mission: need 0 < slope_tilt_deg < caution_tilt_deg < max_tilt_deg and "
-        "slope_speed_mps > 0");
+        "mission: need 0 < slope_tilt_deg < caution_tilt_deg < max_tilt_deg, "
+        "0 < scan_tilt_deg < caution_tilt_deg and slope_speed_mps > 0");
   }
   if (!(config.drive_per_stop_m > 0) || config.max_stops < 1 || !(config.goal_tolerance_m > 0)) {
     throw std::invalid_argument(

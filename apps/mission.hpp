@@ -28,8 +28,12 @@ struct MissionConfig {
   double time_budget_s = 1800.0;  ///< mission time at most (simulated or real) [s]
   double max_tilt_deg = 30.0;     ///< beyond this the robot is tipping over [deg]
   /// Beyond this tilt the robot backs off and marks the ground ahead as too steep, then plans
-  /// again: a top-heavy P3 (the laser sits 0.45 m up) pitches over a rim before the map says so.
-  double caution_tilt_deg = 22.0;
+  /// again: the loaded P3-AT (laser 0.45 m up) pitches over forward at 21 deg standing, less while
+  /// braking downhill [deg].
+  double caution_tilt_deg = 18.0;
+  /// A drive that ends tilted more than this backs off before the robot stops to scan: sweeping
+  /// the laser down shifts its weight forward, and the wheel hold creeps on steep ground [deg].
+  double scan_tilt_deg = 13.0;
   /// Beyond this tilt the follower slows to slope_speed_mps (same curvature) [deg].
   double slope_tilt_deg = 10.0;
   double slope_speed_mps = 0.2;   ///< cruise speed on slopes [m/s]
@@ -42,6 +46,7 @@ struct MissionConfig {
   double unknown_margin_m = 0.5;
   PurePursuitConfig follower;
   planning::PlannerConfig planner;
+  mapping::LayerConfig layers;  ///< how the elevation map's layers are derived for planning
   planning::Algorithm algorithm = planning::Algorithm::kAStar;
   mapping::MapConfig registration;  ///< scan-to-map merging
   mapping::GridGeometry map_area;   ///< the elevation map's grid, world frame
@@ -77,8 +82,10 @@ struct StopRecord {
   std::optional<planning::Path> plan;    ///< to the goal, world frame
   std::string plan_error;                ///< why there was no plan
   std::string plan_note;                 ///< how the plan was found, when not the plain way
-  bool through_drops = false;            ///< planned through inferred drops as unknown (recovery)
-  double plan_to_drop_m = 0;             ///< with through_drops: plan length before the first [m]
+  /// Recovery: planned through cells taken for hazards (inferred drops, hazards around a goal
+  /// seen from afar) as unknown, to look from closer (plan_note says which).
+  bool look_closer = false;
+  double plan_to_doubt_m = 0;  ///< with look_closer: plan length before the first such cell [m]
   double plan_known_m = 0;               ///< length of the plan over observed cells [m]
   int felt_hazards = 0;                  ///< places marked too steep by the tilt so far
   bool elevation_from_odometry = false;  ///< registration failed: the scan entered the elevation

@@ -141,7 +141,7 @@ int RunRun(int argc, char** argv) {
   // Ground truth on the same grid: the true map, what is truly traversable, the true optimum.
   if (!quiet) std::fprintf(stderr, "run: ground truth of %s\n", world.c_str());
   mapping::ElevationMap truth_map = mapping::ComputeTrueElevationMap(rig.caster(), mission.map_area);
-  const mapping::ElevationLayers truth_layers = mapping::ComputeLayers(truth_map);
+  const mapping::ElevationLayers truth_layers = mapping::ComputeLayers(truth_map, mission.layers);
   const planning::TraversabilityGrid truth_grid =
       planning::BuildTraversability(truth_layers, mission.planner);
   auto optimum = planning::PlanPath(truth_grid, start.head<2>(), goal, mission.algorithm);
@@ -188,6 +188,7 @@ int RunRun(int argc, char** argv) {
   context.geodetic_origin = origin;
   context.config_yaml = AppConfigToYaml(config) + RunSettingsToYaml(settings);
   context.planner = MissionPlanner(mission);
+  context.layers = mission.layers;
   context.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   WriteFinalOutputs(folder, context, result, score, &truth_layers, *optimum);

@@ -47,7 +47,8 @@ void DrawPolyline(mapping::RgbImage& image, const mapping::GridGeometry& g,
                   const std::vector<Eigen::Vector2d>& points_m, std::uint8_t r, std::uint8_t gr,
                   std::uint8_t b) {
   for (std::size_t k = 1; k < points_m.size(); ++k) {
-    const Eigen::Vector2d a = mapping::MapToPixel(g, image, points_m[k - 1].x(), points_m[k - 1].y());
+    const Eigen::Vector2d a =
+        mapping::MapToPixel(g, image, points_m[k - 1].x(), points_m[k - 1].y());
     const Eigen::Vector2d c = mapping::MapToPixel(g, image, points_m[k].x(), points_m[k].y());
     const int steps = std::max(1, static_cast<int>(std::ceil((c - a).norm())));
     for (int s = 0; s <= steps; ++s) {
@@ -64,7 +65,8 @@ void DrawPolyline(mapping::RgbImage& image, const mapping::GridGeometry& g,
 
 std::vector<Eigen::Vector2d> EstimatedXy(const MissionResult& r) {
   std::vector<Eigen::Vector2d> xy;
-  for (const TrajectorySample& s : r.trajectory) xy.push_back(s.T_world_base_est.translation().head<2>());
+  for (const TrajectorySample& s : r.trajectory)
+    xy.push_back(s.T_world_base_est.translation().head<2>());
   return xy;
 }
 
@@ -105,11 +107,13 @@ void WriteTrajectoryGeoJson(const std::filesystem::path& file, const MissionResu
       coords.push_back({lon, lat, h});
     }
     if (coords.size() < 2) continue;
-    features.push_back({{"type", "Feature"},
-                        {"properties", {{"name", truth ? "true trajectory" : "estimated trajectory"}}},
-                        {"geometry", {{"type", "LineString"}, {"coordinates", coords}}}});
+    features.push_back(
+        {{"type", "Feature"},
+         {"properties", {{"name", truth ? "true trajectory" : "estimated trajectory"}}},
+         {"geometry", {{"type", "LineString"}, {"coordinates", coords}}}});
   }
-  WriteTextFile(file, nlohmann::json{{"type", "FeatureCollection"}, {"features", features}}.dump(1));
+  WriteTextFile(file,
+                nlohmann::json{{"type", "FeatureCollection"}, {"features", features}}.dump(1));
 }
 
 nlohmann::json RegistrationJson(const StopRecord& stop) {
@@ -129,10 +133,12 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
                       {"inlier_ratio", reg.inlier_ratio},
                       {"iterations", reg.iterations},
                       {"timings_s",
-                       {{"voxel", reg.timings.voxel_s}, {"normals", reg.timings.normals_s},
+                       {{"voxel", reg.timings.voxel_s},
+                        {"normals", reg.timings.normals_s},
                         {"features", reg.timings.features_s},
                         {"initial_alignment", reg.timings.initial_alignment_s},
-                        {"icp", reg.timings.icp_s}, {"total", reg.timings.total_s}}},
+                        {"icp", reg.timings.icp_s},
+                        {"total", reg.timings.total_s}}},
                       {"T_map_base", matrix},
                       {"estimate", PoseJson(stop.T_world_base)},
                       {"odometry", PoseJson(stop.T_world_base_odom)}};
@@ -146,7 +152,7 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
   j["plan"] = {{"found", stop.plan.has_value()},
                {"known_m", stop.plan_known_m},
                {"felt_hazards", stop.felt_hazards},
-               {"through_inferred_drops", stop.through_drops}};
+               {"look_closer", stop.look_closer}};
   if (!stop.plan_note.empty()) j["plan"]["note"] = stop.plan_note;
   if (!stop.plan_error.empty()) j["plan"]["error"] = stop.plan_error;
   return j;
@@ -174,7 +180,8 @@ void WriteStopOutputs(RunFolder& folder, const StopRecord& stop, const MissionRe
   if (stop.plan) {
     Check(planning::WritePathCsv(*stop.plan, folder.File(d + "path.csv").string()));
     if (origin) {
-      Check(planning::WritePathGeoJson(*stop.plan, origin, folder.File(d + "path.geojson").string()));
+      Check(
+          planning::WritePathGeoJson(*stop.plan, origin, folder.File(d + "path.geojson").string()));
     }
   }
   Check(mapping::WritePng(RenderWithPath(so_far.elevation, stop.plan),
@@ -184,20 +191,20 @@ void WriteStopOutputs(RunFolder& folder, const StopRecord& stop, const MissionRe
 nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
                           const std::optional<RunScore>& score) {
   const double sim_s = r.end_s - r.start_s;
-  nlohmann::json m = {{"success", r.success},
-                      {"reason", r.reason},
-                      {"world", c.world},
-                      {"robot", c.robot},
-                      {"seed", c.seed},
-                      {"start", {{"x_m", c.start.x()}, {"y_m", c.start.y()},
-                                 {"yaw_deg", c.start.z() * kRadToDeg}}},
-                      {"goal", {{"x_m", c.goal.x()}, {"y_m", c.goal.y()}}},
-                      {"stops", r.stops.size()},
-                      {"sim_time_s", sim_s},
-                      {"wall_time_s", c.wall_time_s},
-                      {"real_time_factor", c.wall_time_s > 0 ? sim_s / c.wall_time_s : 0.0},
-                      {"odometry_distance_m", r.odometry_distance_m},
-                      {"max_tilt_deg", r.max_tilt_rad * kRadToDeg}};
+  nlohmann::json m = {
+      {"success", r.success},
+      {"reason", r.reason},
+      {"world", c.world},
+      {"robot", c.robot},
+      {"seed", c.seed},
+      {"start", {{"x_m", c.start.x()}, {"y_m", c.start.y()}, {"yaw_deg", c.start.z() * kRadToDeg}}},
+      {"goal", {{"x_m", c.goal.x()}, {"y_m", c.goal.y()}}},
+      {"stops", r.stops.size()},
+      {"sim_time_s", sim_s},
+      {"wall_time_s", c.wall_time_s},
+      {"real_time_factor", c.wall_time_s > 0 ? sim_s / c.wall_time_s : 0.0},
+      {"odometry_distance_m", r.odometry_distance_m},
+      {"max_tilt_deg", r.max_tilt_rad * kRadToDeg}};
   std::size_t failed = 0;
   for (const StopRecord& s : r.stops) failed += !s.merge.merged && s.index > 0;
   m["registration_failures"] = failed;
@@ -214,8 +221,8 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
     m["true_optimal_cost"] =
         score->true_optimal_cost ? nlohmann::json(*score->true_optimal_cost) : nlohmann::json();
     if (!score->true_optimum_note.empty()) m["true_optimum_note"] = score->true_optimum_note;
-    m["cost_ratio"] = score->cost_ratio && r.success ? nlohmann::json(*score->cost_ratio)
-                                                     : nlohmann::json();
+    m["cost_ratio"] =
+        score->cost_ratio && r.success ? nlohmann::json(*score->cost_ratio) : nlohmann::json();
     m["forbidden_cells_crossed"] = score->forbidden_cells_crossed;
     if (std::isfinite(score->closest_hazard_m)) {
       m["closest_approach_to_forbidden_m"] = score->closest_hazard_m;
@@ -240,8 +247,9 @@ void WriteFinalOutputs(RunFolder& folder, const RunContext& c, const MissionResu
   }
   Check(sensors::WriteScanPcd(cloud, folder.File("map_cloud.pcd").string()));
   Check(mapping::SaveElevationMap(r.elevation, folder.File("elevation.plem").string()));
-  const mapping::ElevationLayers layers = mapping::ComputeLayers(r.elevation);
-  Check(mapping::WriteEsriAsciiGrid(layers, c.geodetic_origin, folder.File("elevation.asc").string()));
+  const mapping::ElevationLayers layers = mapping::ComputeLayers(r.elevation, c.layers);
+  Check(mapping::WriteEsriAsciiGrid(layers, c.geodetic_origin,
+                                    folder.File("elevation.asc").string()));
   WriteTrajectoryCsv(folder.File("trajectory_estimated.csv"), r, false);
   WriteTrajectoryCsv(folder.File("trajectory_true.csv"), r, true);
   if (c.geodetic_origin) {
@@ -279,23 +287,27 @@ void WriteFinalOutputs(RunFolder& folder, const RunContext& c, const MissionResu
   }
   report.KeyValues(rows);
   report.Heading("Map and trajectories");
-  report.Paragraph("Estimated elevation map with every planned path (red), the estimated "
-                   "trajectory (orange) and the true one (blue). Unknown cells are checkered.");
+  report.Paragraph(
+      "Estimated elevation map with every planned path (red), the estimated "
+      "trajectory (orange) and the true one (blue). Unknown cells are checkered.");
   report.Png(ReadBinaryFile(folder.File("elevation.png")), "estimated elevation map", 900);
   if (truth) {
     report.Png(ReadBinaryFile(folder.File("truth_elevation.png")),
                "true elevation map, true optimal path (red), true trajectory (blue)", 900);
   }
-  report.Paragraph("Where the planner may go, on the estimated map at the end and on the true "
-                   "map. " + TraversabilityLegend());
+  report.Paragraph(
+      "Where the planner may go, on the estimated map at the end and on the true "
+      "map. " +
+      TraversabilityLegend());
   report.Png(ReadBinaryFile(folder.File("traversability.png")), "traversability, estimated map",
              900);
   if (truth) {
-    report.Png(ReadBinaryFile(folder.File("truth_traversability.png")),
-               "traversability, true map", 900);
+    report.Png(ReadBinaryFile(folder.File("truth_traversability.png")), "traversability, true map",
+               900);
   }
-    report.Plot({{"estimated", "#e08000", EstimatedXy(r), false}, {"true", "#1e50ff", TrueXy(r), true}},
-              "trajectories (world frame, metres)");
+  report.Plot(
+      {{"estimated", "#e08000", EstimatedXy(r), false}, {"true", "#1e50ff", TrueXy(r), true}},
+      "trajectories (world frame, metres)");
   report.Heading("Stops");
   std::vector<std::vector<std::string>> table;
   std::vector<std::pair<std::string, std::string>> strip;

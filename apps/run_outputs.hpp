@@ -23,10 +23,11 @@ struct RunContext {
   Eigen::Vector3d start{0, 0, 0};  ///< x [m], y [m], yaw [rad]
   Eigen::Vector2d goal{0, 0};      ///< [m]
   std::optional<mapping::GeodeticOrigin> geodetic_origin;
-  std::string config_yaml;         ///< the configuration as used
+  std::string config_yaml;  ///< the configuration as used
   /// The planner as the mission used it (robot width including the safety margin).
   planning::PlannerConfig planner;
-  double wall_time_s = 0;          ///< whole run including set-up [s]
+  mapping::LayerConfig layers;  ///< how the mission derived the map's layers
+  double wall_time_s = 0;       ///< whole run including set-up [s]
 };
 
 /// Writes stops/NN/{scan.pcd, registration.json, path.csv, path.geojson, map.png}.

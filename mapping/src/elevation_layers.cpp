@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <stdexcept>
+#include <string>
 
 namespace pitchlab::mapping {
 namespace {
@@ -61,8 +63,9 @@ void Inclination(const ElevationMap& map, int ci, int cj, const LayerConfig& con
   const GridGeometry& g = map.geometry();
   Moments points, centres;
   const float z_c = map.at({ci, cj}).mean_z;
-  for (int dj = -1; dj <= 1; ++dj) {
-    for (int di = -1; di <= 1; ++di) {
+  const int r = config.inclination_radius_cells;
+  for (int dj = -r; dj <= r; ++dj) {
+    for (int di = -r; di <= r; ++di) {
       const CellIndex nb{ci + di, cj + dj};
       if (!g.Contains(nb)) continue;
       const CellStats& c = map.at(nb);
@@ -156,6 +159,11 @@ float ElevationLayers::Tilt(std::size_t k) const {
 }
 
 ElevationLayers ComputeLayers(const ElevationMap& map, const LayerConfig& config) {
+  if (config.inclination_radius_cells < 1 || config.inclination_radius_cells > 16) {
+    throw std::invalid_argument("LayerConfig::inclination_radius_cells = " +
+                                std::to_string(config.inclination_radius_cells) +
+                                " is outside 1 .. 16");
+  }
   const GridGeometry& g = map.geometry();
   const std::size_t n = g.cell_count();
   ElevationLayers L;

@@ -25,6 +25,29 @@ TEST(RunSettings, APlannerLimitOverridesOnlyThatLimitOfThePreset) {
   EXPECT_EQ(s.mission.planner.unknown, planning::UnknownPolicy::kPenalise);
 }
 
+// The loaded P3-AT plans to 16 deg (it tips near 21 deg with the laser up top), also when a
+// planner section leaves the limit out; the P3-DX keeps its own, lower preset.
+TEST(RunSettings, TheLoadedP3AtPlansToSixteenDegrees) {
+  const RunSettings at = ParseRunSettings("", "test", sim::P3Model::kP3AT);
+  EXPECT_NEAR(at.mission.planner.robot.max_inclination_rad, 16 * kDeg, 1e-9);
+  const RunSettings weights =
+      ParseRunSettings("planner: {weights: {roughness: 5}}\n", "test", sim::P3Model::kP3AT);
+  EXPECT_NEAR(weights.mission.planner.robot.max_inclination_rad, 16 * kDeg, 1e-9);
+  const RunSettings dx = ParseRunSettings("", "test", sim::P3Model::kP3DX);
+  EXPECT_NEAR(dx.mission.planner.robot.max_inclination_rad,
+              planning::RobotLimits::P3DX().max_inclination_rad, 1e-12);
+  // The inclination's fit region in cells: 3 x 3 by default, 5 x 5 for half a robot length.
+  EXPECT_EQ(at.mission.layers.inclination_radius_cells, 1);
+  const RunSettings footprint =
+      ParseRunSettings("run: {inclination_radius_m: 0.25}\n", "test", sim::P3Model::kP3AT);
+  EXPECT_EQ(footprint.mission.layers.inclination_radius_cells, 2);
+  const RunSettings coarse = ParseRunSettings(
+      "run: {cell_m: 0.25, inclination_radius_m: 0.25}\n", "test", sim::P3Model::kP3AT);
+  EXPECT_EQ(coarse.mission.layers.inclination_radius_cells, 1);
+  EXPECT_THROW(ParseRunSettings("run: {scan_tilt_deg: 25}\n", "t", sim::P3Model::kP3AT),
+               std::invalid_argument);  // above caution_tilt_deg
+}
+
 TEST(RunSettings, RunKeysAreReadAndBadOnesNamed) {
   const RunSettings s =
       ParseRunSettings("run: {drive_per_stop_m: 2.5, cell_m: 0.2, algorithm: dijkstra}\n", "f.yaml",

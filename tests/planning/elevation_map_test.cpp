@@ -71,6 +71,35 @@ TEST(ElevationMap, TiltedPlaneGivesItsInclination) {
   EXPECT_NEAR(L.Tilt(0), std::atan(std::hypot(bx, by)), kAngleTolRad);
 }
 
+// A wide fit region (a robot's footprint) reads a plane as exactly, and a cell-sized bump on it
+// much less: the bump tilts the 3 x 3 fits around it, hardly the 5 x 5 ones.
+TEST(ElevationMap, AWiderInclinationRegionReadsThePlaneNotTheBump) {
+  const double bx = 0.2;
+  const auto ground = [&](double x, double y) {
+    const bool bump = x > 1.0 && x < 1.1 && y > 1.0 && y < 1.1;
+    return bx * x + (bump ? 0.05 : 0.0);
+  };
+  ElevationMap map(GridGeometry::FromArea(0, 0, 2, 2, 0.1));
+  const auto pts = Lattice(0, 2, 0, 2, 0.01, ground);
+  map.InsertPoints(pts.data(), pts.size());
+  LayerConfig narrow, wide;
+  wide.inclination_radius_cells = 2;
+  const ElevationLayers a = ComputeLayers(map, narrow), b = ComputeLayers(map, wide);
+  // Far from the bump both read the plane.
+  const std::size_t far = a.geometry.Linear({4, 4});
+  EXPECT_NEAR(a.phi_x[far], std::atan(bx), kAngleTolRad);
+  EXPECT_NEAR(b.phi_x[far], std::atan(bx), kAngleTolRad);
+  // Beside the bump (one cell west of it) the 3 x 3 fit tilts more than the 5 x 5 one.
+  const std::size_t beside = a.geometry.Linear({9, 10});
+  const double err_narrow = std::abs(a.Tilt(beside) - std::atan(bx));
+  const double err_wide = std::abs(b.Tilt(beside) - std::atan(bx));
+  EXPECT_GT(err_narrow, 0.02);
+  EXPECT_LT(err_wide, 0.5 * err_narrow);
+  LayerConfig bad;
+  bad.inclination_radius_cells = 0;
+  EXPECT_THROW(ComputeLayers(map, bad), std::invalid_argument);
+}
+
 TEST(ElevationMap, SingleScanLineStillGetsAnInclinationFromItsNeighbours) {
   // Each cell sees points on one line along x only: the pooled fit along y is degenerate per
   // cell, but the 3 x 3 region spans rows, so the inclination is still known.

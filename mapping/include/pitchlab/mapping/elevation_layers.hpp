@@ -2,8 +2,8 @@
 // The layers users and the planner read, derived from an ElevationMap's running statistics:
 // mean height (Eq. 2), roughness T (Eq. 3), inclination phi_x, phi_y, and what is known.
 //
-// Inclination: a least-squares plane z = a + b x + c y through all points of the cell and its 8
-// neighbours (the 3 x 3 cell region), computed from the pooled co-moments (no point is re-read):
+// Inclination: a least-squares plane z = a + b x + c y through all points of the cell and its
+// neighbours (the 3 x 3 cell region by default, LayerConfig::inclination_radius_cells), computed from the pooled co-moments (no point is re-read):
 // phi_x = atan(b), phi_y = atan(c). When the pooled points do not span the plane (fewer than 3, or
 // all on one line, e.g. a single scan line), the same fit is made through the centres of the known
 // cells of the region at their mean heights; with fewer than 3 non-collinear known cells the
@@ -29,6 +29,11 @@ enum class CellState : std::uint8_t {
 
 /// How the derived layers are made.
 struct LayerConfig {
+  /// The inclination's fit region: the (2r + 1) x (2r + 1) cells around a cell. 1 (3 x 3) follows
+  /// the ground closely; a robot tips over with the slope under its whole footprint, so a planner
+  /// for a 0.5 m robot on 0.1 m cells reads it better with 2 (5 x 5), where rocks and cracks
+  /// still show as steps and roughness.
+  int inclination_radius_cells = 1;
   double drop_depth_m = 0.2;  ///< clearance this far below an observed neighbour is a drop [m]
   /// How far a drop grows from the cells next to observed ground, through unknown cells whose
   /// rays pass below the same reference [m]. The rim is the hazard; an unbounded flood spread a
