@@ -26,7 +26,8 @@ constexpr double kBackOff_m = 0.6;   // reverse this far from a tilt beyond caut
 constexpr double kBackOffSpeed_mps = 0.2;
 constexpr double kFeltAhead_m = 0.2;           // the tilting ground: under the front axle and on
 constexpr double kMaxCentripetal_mps2 = 0.15;  // v * omega while following a path
-constexpr double kSlopeYawRate_rps = 0.3;      // skid-steer turns on a slope at most this fast
+constexpr double kUnexpectedTilt_rad = 8.0 * kPi / 180;  // beyond the path's own grade: a bump
+constexpr double kSlopeYawRate_rps = 0.3;  // skid-steer turns on a slope at most this fast
 constexpr double kSlopeLookahead_m = 1.0;  // slow down this far before a slope (braking distance)
 
 double Yaw(const Eigen::Isometry3d& T) { return std::atan2(T.linear()(1, 0), T.linear()(0, 0)); }
@@ -102,7 +103,8 @@ class Mission {
                                                         const Eigen::Vector2d& here) const;
   bool Drive(const StopRecord& stop);
   bool Follow(const planning::Path& path, double length_m);
-  bool BackOff(const sensors::Odometry& odo, double tilt_rad);  // false: the mission ends
+  // false: the mission ends. `obstacle`: the tilt came from something it ran onto.
+  bool BackOff(const sensors::Odometry& odo, double tilt_rad, bool obstacle);
   std::optional<Eigen::Vector2d> Attitude() const {
     if (!probes_.roll_pitch_rad) return std::nullopt;
     return probes_.roll_pitch_rad();
@@ -355,11 +357,12 @@ void Mission::Plan(StopRecord& stop) const {
       (config_.goal_m - here).norm() > kGoalApproach_m) {
     look_closer(
         [&](std::size_t k) {
+          if (layers.state[k] == mapping::CellState::kDrop) return true;  // as above, too
           return layers.state[k] != mapping::CellState::kUnknown &&
                  (layers.geometry.CenterOf(layers.geometry.FromLinear(k)) - config_.goal_m).norm() <
                      kGoalApproach_m;
         },
-        "the hazards seen around the goal");
+        "the inferred drops and the hazards seen around the goal");
   }
   if (!path) {
     stop.plan_error = path.error().message;
@@ -418,7 +421,7 @@ bool Mission::Drive(const StopRecord& stop) {
       result_.reason = "base: " + odo.error().message;
       return false;
     }
-    if (!BackOff(*odo, Tilt())) return false;
+    if (!BackOff(*odo, Tilt(), false)) return false;
   }
   Result<sensors::Odometry> stopped = base_.Drive(0.0, 0.0, kStopTime_s);
   if (!stopped) {
@@ -494,7 +497,13 @@ bool Mission::Follow(const planning::Path& path, double length_m) {
         follower.Command(T_est.translation().x(), T_est.translation().y(), Yaw(T_est));
     if (cmd.done) return true;
     const double tilt = Tilt();
-    if (tilt > config_.caution_tilt_deg * kPi / 180) return BackOff(odo, tilt);
+    if (tilt > config_.caution_tilt_deg * kPi / 180) return BackOff(odo, tilt, false);
+    {
+      // A tilt the planned ground does not explain is something the robot ran onto.
+      const double arc_now = prefix_m - follower.remaining_m();
+      const double expected = std::atan(MaxGrade(path, arc_now - 0.5, arc_now + 0.5));
+      if (tilt > expected + kUnexpectedTilt_rad) return BackOff(odo, tilt, true);
+    }
     // Turning fast while driving fast makes the skid-steer P3-AT brake its inner wheels hard,
     // and a top-heavy robot pitches over its front wheels: keep the centripetal acceleration
     // v * omega small, on the same arc.
@@ -534,17 +543,22 @@ bool Mission::Follow(const planning::Path& path, double length_m) {
 }
 
 // Reverses straight out of a tilt beyond caution and remembers the ground ahead as too steep.
-bool Mission::BackOff(const sensors::Odometry& odo, double tilt_rad) {
+bool Mission::BackOff(const sensors::Odometry& odo, double tilt_rad, bool obstacle) {
   const Eigen::Isometry3d T = Estimate(odo);
   const double heading = Yaw(T);
-  felt_.push_back({T.translation().head<2>() +
-                       kFeltAhead_m * Eigen::Vector2d(std::cos(heading), std::sin(heading)),
-                   heading, tilt_rad, T.translation().z()});
+  FeltHazard felt;
+  felt.centre_m = T.translation().head<2>() +
+                  kFeltAhead_m * Eigen::Vector2d(std::cos(heading), std::sin(heading));
+  felt.heading_rad = heading;
+  felt.tilt_rad = tilt_rad;
+  felt.z_m = T.translation().z();
+  felt.obstacle = obstacle;
+  felt_.push_back(felt);
   backed_off_ = true;
   char line[160];
-  std::snprintf(line, sizeof(line),
-                "tilt %.1f deg at (%.2f, %.2f): backing off, the ground ahead is too steep",
-                tilt_rad * 180 / kPi, T.translation().x(), T.translation().y());
+  std::snprintf(line, sizeof(line), "tilt %.1f deg at (%.2f, %.2f): backing off, %s",
+                tilt_rad * 180 / kPi, T.translation().x(), T.translation().y(),
+                obstacle ? "ran onto something ahead" : "the ground ahead is too steep");
   Progress(line);
   const Eigen::Vector2d from(odo.x_m, odo.y_m);
   const double start_s = probes_.now_s();

@@ -13,6 +13,10 @@ namespace {
 
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 constexpr double kMissionMinInlierRatio = 0.15;
+// Gyro-aided odometry drifts a few per cent over the 4 m between stops; a pose farther than this
+// from it is the scan matched to a neighbouring copy of repeated structure (the office's doors
+// and desk rows, 2 m apart), not the robot's motion.
+constexpr double kMissionConstraint_m = 1.0;
 constexpr double kMissionUnknownPenalty = 5.0;
 // The P3-AT's 35 % grade (19.3 deg) is the bare robot's. Carrying the LMS200 on its pitching
 // mount (4.5 kg, 0.45 m up) its centre of mass is 0.25 m high and 0.1 m behind the front axle: it
@@ -97,6 +101,7 @@ RunSettings ParseRunSettings(const std::string& yaml_text, const std::string& so
   // Scan-to-map after a 4 m drive sees much new ground: accept a smaller overlapping share
   // than the pairwise default unless the config says otherwise.
   m.registration.registration.min_inlier_ratio = kMissionMinInlierRatio;
+  m.registration.registration.constraint_translation_m = kMissionConstraint_m;
   YAML::Node root;
   try {
     root = yaml_text.empty() ? YAML::Node() : YAML::Load(yaml_text);
@@ -120,8 +125,13 @@ RunSettings ParseRunSettings(const std::string& yaml_text, const std::string& so
       if (!section["unknown_penalty"]) m.planner.unknown_penalty = penalty;
     }
     const bool has_ratio = root["registration"] && root["registration"]["min_inlier_ratio"];
+    const bool has_constraint =
+        root["registration"] && root["registration"]["constraint_translation_m"];
     m.registration.registration = mapping::ParseRegistrationConfig(yaml_text, source);
     if (!has_ratio) m.registration.registration.min_inlier_ratio = kMissionMinInlierRatio;
+    if (!has_constraint) {
+      m.registration.registration.constraint_translation_m = kMissionConstraint_m;
+    }
   }
   if (!(m.slope_tilt_deg > 0 && m.slope_tilt_deg < m.caution_tilt_deg &&
         m.caution_tilt_deg < m.max_tilt_deg) ||

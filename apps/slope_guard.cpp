@@ -4,6 +4,11 @@
 #include <cmath>
 
 namespace pitchlab::apps {
+namespace {
+
+constexpr float kObstacleHeight_m = 0.5f;  // what a felt obstacle stands above its cells
+
+}  // namespace
 
 double MaxGrade(const planning::Path& path, double from_m, double to_m, double baseline_m) {
   const std::vector<planning::Waypoint>& w = path.waypoints;
@@ -43,6 +48,7 @@ void MarkFelt(mapping::ElevationLayers& L, const FeltHazard& f) {
       }
       L.phi_x[k] = phi_x;
       L.phi_y[k] = phi_y;
+      if (f.obstacle) L.max_z[k] = std::max(L.max_z[k], L.mean_z[k] + kObstacleHeight_m);
     }
   }
 }

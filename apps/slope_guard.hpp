@@ -25,11 +25,14 @@ struct FeltHazard {
   double tilt_rad = 0;                                 ///< the tilt it felt [rad]
   double z_m = 0;                                      ///< base_link height estimate there [m]
   double radius_m = 0.35;                              ///< about the robot's half length [m]
+  /// Something the robot ran onto (a tilt the ground it planned over does not explain: a wall's
+  /// foot, a desk leg, a crack's edge): the cells become a step, not a slope.
+  bool obstacle = false;
 };
 
 /// Gives every cell within f.radius_m of f.centre_m the felt slope (along the heading), so the
 /// planner's inclination limit forbids them; unobserved cells there become observed at f.z_m.
-/// Drop cells stay drops.
+/// An obstacle makes them a step (a point 0.5 m above the cell's mean). Drop cells stay drops.
 void MarkFelt(mapping::ElevationLayers& layers, const FeltHazard& f);
 
 }  // namespace pitchlab::apps

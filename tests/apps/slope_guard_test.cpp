@@ -97,6 +97,23 @@ TEST(MarkFelt, ATiltBeyondTheLimitForbidsTheDiscAndNothingElse) {
   EXPECT_EQ(BlockedAt(L, 3.15, 2.45), planning::Blocked::kFree);
 }
 
+// A bump the planned ground does not explain (a wall's foot, a desk leg): a shallow tilt, but the
+// cells become a step the planner keeps the robot away from.
+TEST(MarkFelt, AnObstacleIsAStepEvenAtAShallowTilt) {
+  mapping::ElevationLayers L = FlatLayers();
+  FeltHazard f;
+  f.centre_m = Eigen::Vector2d(1.5, 1.5);
+  f.tilt_rad = 10.0 * kPi / 180;  // below the 19.3 deg limit: a slope this steep is allowed
+  MarkFelt(L, f);
+  EXPECT_EQ(BlockedAt(L, 1.55, 1.55), planning::Blocked::kFree);
+  f.centre_m = Eigen::Vector2d(1.0, 1.0);
+  f.obstacle = true;
+  MarkFelt(L, f);
+  EXPECT_EQ(BlockedAt(L, 1.05, 1.05), planning::Blocked::kStep);
+  EXPECT_EQ(BlockedAt(L, 1.25, 1.05), planning::Blocked::kStep);
+  EXPECT_EQ(BlockedAt(L, 1.55, 1.05), planning::Blocked::kFree);  // outside the disc
+}
+
 TEST(MarkFelt, DropCellsStayDrops) {
   mapping::ElevationLayers L = FlatLayers();
   FeltHazard f;
