@@ -177,6 +177,15 @@ bool Mission::Stop(int k) {
   StopRecord stop;
   stop.index = k;
   Result<sensors::Scan3D> scan = source_.Acquire();
+  if (!scan && scan.error().code == Error::Code::kTimeout &&
+      Tilt() > config_.slope_tilt_deg * kPi / 180 && !OverBudget()) {
+    // On a slope the wheel hold can creep and the scan waits for a standstill in vain: back off
+    // the way it came (marking the ground) and scan once more.
+    Progress("scan at stop " + std::to_string(k) + " timed out on a slope (" +
+             scan.error().message + "): backing off to scan again");
+    Result<sensors::Odometry> odo = base_.ReadOdometry();
+    if (odo && BackOff(*odo, Tilt(), false)) scan = source_.Acquire();
+  }
   if (!scan) {
     result_.reason = "scan at stop " + std::to_string(k) + " failed: " + scan.error().message;
     return false;
