@@ -19,6 +19,7 @@ constexpr double kFootprintHalf_m = 0.2;  // ground known under the robot: it st
 constexpr double kStopTime_s = 0.5;       // braking before a scan
 constexpr double kEscapeRadius_m = 1.0;   // how far a start inside a hazard margin looks out
 constexpr double kGoalApproach_m = 2.0;   // a blocked goal farther than this: approach it
+constexpr double kFarDoubt_m = 6.0;       // beyond this a hazard may be a sparse view (recovery)
 constexpr double kHeadingTolerance_rad = 3.0 * kPi / 180;  // turning in place ends within this
 constexpr double kTurnGain_per_s = 2.0;                    // yaw rate per radian of heading error
 constexpr double kMinDrive_m = 0.1;  // a drive shorter than this is no progress
@@ -372,6 +373,20 @@ void Mission::Plan(StopRecord& stop) const {
                      kGoalApproach_m;
         },
         "the inferred drops and the hazards seen around the goal");
+  }
+  // Far ground is seen on sparse points at a grazing angle: a few of them make a step or a slope
+  // that closer scans do not confirm (the corridor's far end, distant hill sides).
+  if (!path && (path.error().reason == planning::NoPath::Reason::kDisconnected ||
+                path.error().reason == planning::NoPath::Reason::kGoalBlocked)) {
+    look_closer(
+        [&](std::size_t k) {
+          if (layers.state[k] == mapping::CellState::kDrop) return true;
+          return layers.state[k] != mapping::CellState::kUnknown &&
+                 (layers.geometry.CenterOf(layers.geometry.FromLinear(k)) - here).norm() >
+                     kFarDoubt_m;
+        },
+        "the inferred drops and everything seen farther than " + std::to_string(int(kFarDoubt_m)) +
+            " m away");
   }
   if (!path) {
     stop.plan_error = path.error().message;
