@@ -509,6 +509,7 @@ bool Mission::Follow(const planning::Path& path, double length_m) {
   double prefix_m = 0;
   for (std::size_t i = 1; i < prefix.size(); ++i) prefix_m += (prefix[i] - prefix[i - 1]).norm();
   const double slope_grade = std::tan(config_.slope_tilt_deg * kPi / 180);
+  const PathGrade grade(path);
   PurePursuit follower(prefix, config_.follower);
   sensors::Odometry odo = odo_ref_;
   if (Result<sensors::Odometry> now = base_.ReadOdometry(); now) odo = *now;
@@ -522,30 +523,25 @@ bool Mission::Follow(const planning::Path& path, double length_m) {
     if (cmd.done) return true;
     const double tilt = Tilt();
     if (tilt > config_.caution_tilt_deg * kPi / 180) return BackOff(odo, tilt, false);
-    {
-      // A tilt the planned ground does not explain is something the robot ran onto.
-      const double arc_now = prefix_m - follower.remaining_m();
-      const double expected = std::atan(MaxGrade(path, arc_now - 0.5, arc_now + 0.5));
-      if (tilt > expected + kUnexpectedTilt_rad) return BackOff(odo, tilt, true);
+    const double arc = prefix_m - follower.remaining_m();
+    // A tilt the planned ground does not explain is something the robot ran onto.
+    if (tilt > std::atan(grade.Max(arc - 0.5, arc + 0.5)) + kUnexpectedTilt_rad) {
+      return BackOff(odo, tilt, true);
     }
-    // Turning fast while driving fast makes the skid-steer P3-AT brake its inner wheels hard,
-    // and a top-heavy robot pitches over its front wheels: keep the centripetal acceleration
-    // v * omega small, on the same arc.
-    const double centripetal = std::abs(cmd.v_mps * cmd.omega_rps);
-    if (centripetal > kMaxCentripetal_mps2) {
-      const double s = std::sqrt(kMaxCentripetal_mps2 / centripetal);
+    // Speed and turn rate scale together, so the robot stays on the follower's arc. Turning fast
+    // while driving fast makes the skid-steer P3-AT brake its inner wheels hard and a top-heavy
+    // robot pitch over its front wheels: keep the centripetal acceleration v * omega small. On
+    // slopes (ahead on the path, or under the robot) drive slower still.
+    const auto scale = [&cmd](double s) {
       cmd.v_mps *= s;
       cmd.omega_rps *= s;
-    }
-    const double arc = prefix_m - follower.remaining_m();
+    };
+    const double centripetal = std::abs(cmd.v_mps * cmd.omega_rps);
+    if (centripetal > kMaxCentripetal_mps2) scale(std::sqrt(kMaxCentripetal_mps2 / centripetal));
     if (tilt > config_.slope_tilt_deg * kPi / 180 ||
-        MaxGrade(path, arc, arc + kSlopeLookahead_m) > slope_grade) {
-      // Slower on slopes, on the same arc: braking and turning pitch a top-heavy robot over.
-      const double scale =
-          std::min({1.0, config_.slope_speed_mps / std::max(std::abs(cmd.v_mps), 1e-9),
-                    kSlopeYawRate_rps / std::max(std::abs(cmd.omega_rps), 1e-9)});
-      cmd.v_mps *= scale;
-      cmd.omega_rps *= scale;
+        grade.Max(arc, arc + kSlopeLookahead_m) > slope_grade) {
+      scale(std::min({1.0, config_.slope_speed_mps / std::max(std::abs(cmd.v_mps), 1e-9),
+                      kSlopeYawRate_rps / std::max(std::abs(cmd.omega_rps), 1e-9)}));
     }
     Result<sensors::Odometry> next =
         base_.Drive(cmd.v_mps, cmd.omega_rps, config_.control_period_s);

@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "pitchlab/mapping/registration.hpp"
 #include "pitchlab/sensors/scan_pcd.hpp"
+#include "registration_json.hpp"
 
 namespace pitchlab::apps {
 namespace {
@@ -50,7 +51,6 @@ nlohmann::json ResultJson(const mapping::RegistrationResult& r) {
   for (int row = 0; row < 4; ++row) {
     for (int col = 0; col < 4; ++col) matrix.push_back(r.T_target_source.matrix()(row, col));
   }
-  const mapping::StageTimings& t = r.timings;
   return {{"T_target_source", matrix},
           {"success", r.success},
           {"reason", r.reason},
@@ -61,13 +61,7 @@ nlohmann::json ResultJson(const mapping::RegistrationResult& r) {
           {"degeneracy", r.degeneracy},
           {"sac_inliers", r.sac_inliers},
           {"iterations", r.iterations},
-          {"timings_s",
-           {{"voxel", t.voxel_s},
-            {"normals", t.normals_s},
-            {"features", t.features_s},
-            {"initial_alignment", t.initial_alignment_s},
-            {"icp", t.icp_s},
-            {"total", t.total_s}}}};
+          {"timings_s", StageTimingsJson(r.timings)}};
 }
 
 }  // namespace

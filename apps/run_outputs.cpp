@@ -1,4 +1,5 @@
 #include "run_outputs.hpp"
+#include "registration_json.hpp"
 #include "traversability_image.hpp"
 
 #include <cmath>
@@ -132,13 +133,7 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
                       {"rmse_m", reg.rmse_m},
                       {"inlier_ratio", reg.inlier_ratio},
                       {"iterations", reg.iterations},
-                      {"timings_s",
-                       {{"voxel", reg.timings.voxel_s},
-                        {"normals", reg.timings.normals_s},
-                        {"features", reg.timings.features_s},
-                        {"initial_alignment", reg.timings.initial_alignment_s},
-                        {"icp", reg.timings.icp_s},
-                        {"total", reg.timings.total_s}}},
+                      {"timings_s", StageTimingsJson(reg.timings)},
                       {"T_map_base", matrix},
                       {"estimate", PoseJson(stop.T_world_base)},
                       {"odometry", PoseJson(stop.T_world_base_odom)}};

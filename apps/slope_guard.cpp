@@ -10,22 +10,32 @@ constexpr float kObstacleHeight_m = 0.5f;  // what a felt obstacle stands above 
 
 }  // namespace
 
-double MaxGrade(const planning::Path& path, double from_m, double to_m, double baseline_m) {
+PathGrade::PathGrade(const planning::Path& path, double baseline_m)
+    : path_(path), baseline_m_(baseline_m) {
   const std::vector<planning::Waypoint>& w = path.waypoints;
-  std::vector<double> arc{0.0};
+  arc_m_.reserve(w.size());
+  if (!w.empty()) arc_m_.push_back(0.0);
   for (std::size_t i = 1; i < w.size(); ++i) {
-    arc.push_back(arc.back() + std::hypot(w[i].x_m - w[i - 1].x_m, w[i].y_m - w[i - 1].y_m));
+    arc_m_.push_back(arc_m_.back() + std::hypot(w[i].x_m - w[i - 1].x_m, w[i].y_m - w[i - 1].y_m));
   }
+}
+
+double PathGrade::Max(double from_m, double to_m) const {
+  const std::vector<planning::Waypoint>& w = path_.waypoints;
   double grade = 0;
   std::size_t j = 0;
-  for (std::size_t i = 0; i < arc.size() && arc[i] <= to_m; ++i) {
-    if (arc[i] + baseline_m < from_m) continue;
+  for (std::size_t i = 0; i < arc_m_.size() && arc_m_[i] <= to_m; ++i) {
+    if (arc_m_[i] + baseline_m_ < from_m) continue;
     j = std::max(j, i + 1);
-    while (j < arc.size() && arc[j] < arc[i] + baseline_m) ++j;
-    if (j == arc.size()) break;
-    grade = std::max(grade, std::abs(w[j].z_m - w[i].z_m) / (arc[j] - arc[i]));
+    while (j < arc_m_.size() && arc_m_[j] < arc_m_[i] + baseline_m_) ++j;
+    if (j == arc_m_.size()) break;
+    grade = std::max(grade, std::abs(w[j].z_m - w[i].z_m) / (arc_m_[j] - arc_m_[i]));
   }
   return grade;
+}
+
+double MaxGrade(const planning::Path& path, double from_m, double to_m, double baseline_m) {
+  return PathGrade(path, baseline_m).Max(from_m, to_m);
 }
 
 void MarkFelt(mapping::ElevationLayers& L, const FeltHazard& f) {

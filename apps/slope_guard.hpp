@@ -13,8 +13,22 @@
 
 namespace pitchlab::apps {
 
-/// The steepest grade |dz| / ds of the path between arc lengths from_m and to_m [m], measured over
-/// baselines of baseline_m along the path (single cells are too noisy to tell a slope) [1].
+/// The grades of a path: its arc lengths computed once, so a controller can ask every step.
+class PathGrade {
+ public:
+  /// Grades are measured over baselines of baseline_m along the path (single cells are too noisy
+  /// to tell a slope). Keeps a reference to `path`.
+  explicit PathGrade(const planning::Path& path, double baseline_m = 0.3);
+  /// The steepest grade |dz| / ds between arc lengths from_m and to_m [m] [1].
+  double Max(double from_m, double to_m) const;
+
+ private:
+  const planning::Path& path_;
+  double baseline_m_;
+  std::vector<double> arc_m_;  // arc length at each waypoint
+};
+
+/// PathGrade(path, baseline_m).Max(from_m, to_m), for a single question.
 double MaxGrade(const planning::Path& path, double from_m, double to_m, double baseline_m = 0.3);
 
 /// Ground the robot's own tilt showed to be too steep: an attitude sensor measures the slope over
