@@ -18,6 +18,7 @@ P3Params MakeP3At() {
   p.width_m = 0.497;
   p.height_m = 0.277;
   p.base_mass_kg = 12.0;
+  p.battery_x_m = -0.05;  // battery box behind the centre, loaded through the rear door
   p.wheels = 4;
   p.wheel_radius_m = 0.1075;  // 215 mm pneumatic tyres
   p.wheel_width_m = 0.095;
@@ -29,10 +30,10 @@ P3Params MakeP3At() {
   p.max_yaw_rate_rps = 140.0 * M_PI / 180.0;
   p.max_accel_mps2 = 0.5;
   p.max_yaw_accel_rps2 = 100.0 * M_PI / 180.0;  // ARIA RotAccel default
-  p.wheel_torque_nm = 8.0;
+  p.wheel_torque_nm = 12.0;
   p.wheel_kv = 10.0;
   p.wheel_armature_kgm2 = 0.02;
-  p.track_factor = 1.85;  // calibrated: yaw from wheel tracks / true yaw, 0.3-2 rad/s
+  p.track_factor = 2.4;  // calibrated: commanded / true yaw rate, 0.3-1 rad/s (spread 2.3-2.6)
   return p;
 }
 
@@ -54,12 +55,13 @@ P3Params MakeP3Dx() {
   p.max_yaw_rate_rps = 300.0 * M_PI / 180.0;
   p.max_accel_mps2 = 0.5;
   p.max_yaw_accel_rps2 = 100.0 * M_PI / 180.0;
-  p.wheel_torque_nm = 5.0;
+  p.wheel_torque_nm = 12.0;
   p.wheel_kv = 8.0;
   p.wheel_armature_kgm2 = 0.02;
   p.track_factor = 1.0;
   p.footprint_x_m = -0.045;   // p2os_urdf: chassis centre 45 mm behind the axle
-  p.chassis_com_x_m = -0.09;  // batteries at the back keep the laser's weight off the nose
+  p.chassis_com_x_m = p.footprint_x_m;
+  p.battery_x_m = -0.09;  // batteries behind the axle keep the laser's weight off the nose
   p.caster_radius_m = 0.04;
   p.caster_x_m = -0.20;
   return p;
@@ -109,6 +111,15 @@ void AppendCaster(std::ostringstream& os, const P3Params& p) {
      << "      <joint name=\"robot_caster_ball\" type=\"ball\" damping=\"0.001\"/>\n"
      << "      <geom name=\"robot_caster_ball\" type=\"sphere\" size=\"" << r
      << "\" rgba=\"0.2 0.2 0.2 1\"/>\n"
+     << "    </body>\n";
+}
+
+// Rigidly attached (no joint): only their mass and inertia matter, not their shape.
+void AppendBatteries(std::ostringstream& os, const P3Params& p) {
+  const Eigen::Vector3d size(0.151, 3 * 0.065, 0.094);
+  const Eigen::Vector3d pos(p.battery_x_m, 0, p.chassis_bottom_m + 0.005 + size.z() / 2);
+  os << "    <body name=\"robot_batteries\" pos=\"" << Vec(pos) << "\">\n"
+     << "      " << BoxInertial(Eigen::Vector3d::Zero(), p.battery_mass_kg, size) << "\n"
      << "    </body>\n";
 }
 
@@ -223,6 +234,7 @@ RobotMjcf MakeRobotMjcf(const RobotConfig& config) {
        << "    <geom name=\"robot_chassis\" type=\"box\" size=\"" << Vec(chassis_size / 2)
        << "\" pos=\"" << Vec(chassis_pos) << "\" rgba=\"0.8 0.1 0.1 1\"/>\n";
   AppendBracket(body, config, p);
+  AppendBatteries(body, p);
   for (const WheelSpec& w : wheels) AppendWheel(body, p, w);
   if (p.caster_radius_m > 0) AppendCaster(body, p);
   AppendLaser(body, config, p);

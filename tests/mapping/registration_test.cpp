@@ -246,7 +246,11 @@ TEST(Register, ThePclBackendAlsoRecoversAKnownTransform) {
       Register(EveryOther(cloud), MovedCopy(cloud, truth, 5), {}, config);
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_TRUE(r->success) << r->reason;
-  ExpectNear(*r, truth);
+  // PCL's point-to-point ICP between voxel centroids settles where the two samplings' bias puts
+  // it (0.4-0.6 deg on this pair): a looser bound than our point-to-plane backend's above.
+  const PoseError e = ComparePoses(r->T_target_source, truth);
+  EXPECT_LT(e.rotation_deg, 1.0) << r->reason;
+  EXPECT_LT(e.translation_m, 0.05) << r->reason;
 }
 
 TEST(Register, TheSameInputGivesTheSameOutput) {

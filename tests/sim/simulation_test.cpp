@@ -59,7 +59,36 @@ TEST_P(RobotModels, RobotDocumentLoadsInMujocoWithAllNamedElements) {
   EXPECT_GE(mj_name2id(m, mjOBJ_ACTUATOR, kPitchActuator), 0);
   const P3Params& p = ParamsFor(GetParam());
   const int body = mj_name2id(m, mjOBJ_BODY, kRobotBody);
-  EXPECT_NEAR(m->body_subtreemass[body], p.base_mass_kg + p.laser_mass_kg, 1e-6);
+  EXPECT_NEAR(m->body_subtreemass[body], p.base_mass_kg + p.laser_mass_kg + p.battery_mass_kg, 1e-6);
+  mj_deleteModel(m);
+}
+
+// The LMS200 (4.5 kg, half a metre up, ahead of the centre) makes the robot top-heavy; the three
+// batteries low in the chassis keep the P3-AT upright well past the 35 % grade (19.3 deg) it is
+// rated to climb: standing, it would tip forward over the front tyres' contact only past ~30 deg.
+TEST(Simulation, LoadedP3AtTipsForwardOnlyWellPastItsRatedGrade) {
+  const std::string xml = RobotMjcfDocument(Robot(P3Model::kP3AT));
+  char error[1000] = "";
+  char path[] = "/tmp/pitchlab_robot_tip_XXXXXX.xml";
+  const int fd = mkstemps(path, 4);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(write(fd, xml.data(), xml.size()), static_cast<ssize_t>(xml.size()));
+  close(fd);
+  mjModel* m = mj_loadXML(path, nullptr, error, sizeof error);
+  unlink(path);
+  ASSERT_NE(m, nullptr) << error;
+  mjData* d = mj_makeData(m);
+  mj_forward(m, d);
+  const int body = mj_name2id(m, mjOBJ_BODY, kRobotBody);
+  const int site = mj_name2id(m, mjOBJ_SITE, kBaseLinkSite);
+  const double com_x = d->subtree_com[3 * body] - d->site_xpos[3 * site];
+  const double com_z = d->subtree_com[3 * body + 2] - d->site_xpos[3 * site + 2];
+  const double front_contact_x = ParamsFor(P3Model::kP3AT).wheelbase_m / 2;
+  const double tip_deg = std::atan2(front_contact_x - com_x, com_z) * 180.0 / M_PI;
+  constexpr double kRatedGrade_deg = 19.3, kMargin_deg = 6.0;  // braking, bumps, a turning pivot
+  EXPECT_GT(tip_deg, kRatedGrade_deg + kMargin_deg) << "CoM x " << com_x << " z " << com_z;
+  EXPECT_LT(com_z, 0.25);  // chassis, batteries, wheels and laser: not the laser's height
+  mj_deleteData(d);
   mj_deleteModel(m);
 }
 

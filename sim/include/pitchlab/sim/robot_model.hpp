@@ -50,7 +50,7 @@ struct RobotConfig {
 struct P3Params {
   const char* name = "";
   double length_m = 0, width_m = 0, height_m = 0;  ///< overall, wheels included [m]
-  double base_mass_kg = 0;                         ///< without the laser [kg]
+  double base_mass_kg = 0;  ///< body and wheels, without batteries and laser [kg]
   int wheels = 0;                                  ///< 4 (AT) or 2 (DX)
   double wheel_radius_m = 0;                       ///< [m]
   double wheel_width_m = 0;                        ///< [m]
@@ -61,7 +61,7 @@ struct P3Params {
   /// Footprint centre's x in base_link [m]: 0 for the AT; the DX's base_link is its wheel axle
   /// (the turning centre, as in p2os_urdf), 4.5 cm ahead of the footprint centre.
   double footprint_x_m = 0;
-  double chassis_com_x_m = 0;      ///< chassis centre of mass x in base_link (batteries) [m]
+  double chassis_com_x_m = 0;      ///< chassis centre of mass x in base_link [m]
   double max_speed_mps = 0;        ///< [m/s]
   double max_yaw_rate_rps = 0;     ///< [rad/s]
   double max_accel_mps2 = 0;       ///< forward acceleration limit [m/s^2]
@@ -76,6 +76,10 @@ struct P3Params {
   double caster_radius_m = 0;  ///< DX rear ball caster [m]
   double caster_x_m = 0;       ///< DX caster position [m]
   double laser_mass_kg = 4.5;  ///< LMS200 [kg]
+  /// Three 12 V 7.2 Ah lead-acid batteries (2.4 kg each, 151 x 65 x 94 mm) side by side in the
+  /// battery box on the chassis floor: the lowest, and with the laser the heaviest, load [kg].
+  double battery_mass_kg = 3 * 2.4;
+  double battery_x_m = 0;  ///< battery pack centre x in base_link [m]
 };
 
 /// Datasheet parameters of `model`.
