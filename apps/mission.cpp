@@ -25,6 +25,7 @@ constexpr double kTurnGain_per_s = 2.0;                    // yaw rate per radia
 constexpr double kMinDrive_m = 0.1;  // a drive shorter than this is no progress
 constexpr double kBackOff_m = 0.6;   // reverse this far from a tilt beyond caution
 constexpr double kBackOffSpeed_mps = 0.2;
+constexpr double kBackOffTiltRise_rad = 4.0 * kPi / 180;  // reversing tilts it this much more: stop
 constexpr double kFeltAhead_m = 0.2;           // the tilting ground: under the front axle and on
 constexpr double kMaxCentripetal_mps2 = 0.15;  // v * omega while following a path
 constexpr double kUnexpectedTilt_rad = 8.0 * kPi / 180;  // beyond the path's own grade: a bump
@@ -104,8 +105,11 @@ class Mission {
                                                         const Eigen::Vector2d& here) const;
   bool Drive(const StopRecord& stop);
   bool Follow(const planning::Path& path, double length_m);
-  // false: the mission ends. `obstacle`: the tilt came from something it ran onto.
+  // Marks the ground ahead as felt (`obstacle`: the tilt came from something it ran onto), then
+  // backs off. false: the mission ends.
   bool BackOff(const sensors::Odometry& odo, double tilt_rad, bool obstacle);
+  // Drives back kBackOff_m the way it came (or as far as it goes). false: the mission ends.
+  bool DriveBack(const sensors::Odometry& odo);
   std::optional<Eigen::Vector2d> Attitude() const {
     if (!probes_.roll_pitch_rad) return std::nullopt;
     return probes_.roll_pitch_rad();
@@ -178,14 +182,15 @@ bool Mission::Stop(int k) {
   StopRecord stop;
   stop.index = k;
   Result<sensors::Scan3D> scan = source_.Acquire();
-  if (!scan && scan.error().code == Error::Code::kTimeout &&
-      Tilt() > config_.slope_tilt_deg * kPi / 180 && !OverBudget()) {
-    // On a slope the wheel hold can creep and the scan waits for a standstill in vain: back off
-    // the way it came (marking the ground) and scan once more.
-    Progress("scan at stop " + std::to_string(k) + " timed out on a slope (" +
+  if (!scan && scan.error().code == Error::Code::kTimeout && !OverBudget()) {
+    // The scan waits for a standstill in vain where the base creeps: the wheel hold on a slope,
+    // or a rigid four-wheeler rocking on two diagonal tyres over a bump. Back off the way it came
+    // (marking the ground) and scan once more.
+    Progress("scan at stop " + std::to_string(k) + " timed out waiting for a standstill (" +
              scan.error().message + "): backing off to scan again");
     Result<sensors::Odometry> odo = base_.ReadOdometry();
-    if (odo && BackOff(*odo, Tilt(), false)) scan = source_.Acquire();
+    const bool steep = Tilt() > config_.slope_tilt_deg * kPi / 180;
+    if (odo && (steep ? BackOff(*odo, Tilt(), false) : DriveBack(*odo))) scan = source_.Acquire();
   }
   if (!scan) {
     result_.reason = "scan at stop " + std::to_string(k) + " failed: " + scan.error().message;
@@ -249,7 +254,12 @@ void Mission::UpdateElevation(const StopRecord& stop) {
   const Eigen::Isometry3f T = stop.T_world_base.cast<float>();
   const Eigen::Vector3f laser =
       (stop.T_world_base * config_.mount.BaseToLaser(0.0)).translation().cast<float>();
-  result_.elevation.Insert(stop.scan.points, T, laser);
+  std::vector<sensors::ScanPoint> near;
+  near.reserve(stop.scan.points.size());
+  for (const sensors::ScanPoint& p : stop.scan.points) {
+    if (p.range_m <= config_.map_range_m) near.push_back(p);
+  }
+  result_.elevation.Insert(near, T, laser);
   // The laser cannot see under the robot, but the robot stands on that ground; only a registered
   // pose knows its height well enough (odometry's z drifts, and a wrong one makes a step around
   // the robot that traps it).
@@ -264,10 +274,11 @@ void Mission::UpdateElevation(const StopRecord& stop) {
 }
 
 // The robot may stand where the footprint rule forbids a path to go (a hazard seen late, drift):
-// the nearest free cell it can reach in a straight line, crossing no step, slope or drop.
+// the nearest free cell it can reach in a straight line, crossing no step, slope or drop beyond
+// the footprint it stands on.
 std::optional<Eigen::Vector2d> EscapeCell(const planning::TraversabilityGrid& grid,
-                                          const Eigen::Vector2d& from,
-                                          double radius_m = kEscapeRadius_m) {
+                                          const Eigen::Vector2d& from, double radius_m,
+                                          double footprint_radius_m) {
   const mapping::GridGeometry& g = grid.geometry;
   const int reach = static_cast<int>(std::ceil(radius_m / g.cell_m));
   const mapping::CellIndex c = g.IndexOf(from.x(), from.y());
@@ -282,6 +293,9 @@ std::optional<Eigen::Vector2d> EscapeCell(const planning::TraversabilityGrid& gr
       bool clear = true;
       for (double t = 0; t <= 1.0 && clear; t += 0.5 * g.cell_m / std::max(d, g.cell_m)) {
         const Eigen::Vector2d p = from + t * (to - from);
+        // What the robot stands on it has already crossed (a slope it backed down, a step it
+        // straddles): only the ground beyond its footprint decides.
+        if (t * d < footprint_radius_m) continue;
         const planning::Blocked b = grid.blocked[g.Linear(g.IndexOf(p.x(), p.y()))];
         clear = b == planning::Blocked::kFree || b == planning::Blocked::kNearHazard ||
                 b == planning::Blocked::kUnknown;
@@ -299,7 +313,8 @@ tl::expected<planning::Path, planning::NoPath> Mission::PlanOn(
     const planning::TraversabilityGrid& grid, const Eigen::Vector2d& here) const {
   auto path = planning::PlanPath(grid, here, config_.goal_m, config_.algorithm);
   if (!path && path.error().reason == planning::NoPath::Reason::kStartBlocked) {
-    if (const auto escape = EscapeCell(grid, here)) {
+    if (const auto escape =
+            EscapeCell(grid, here, kEscapeRadius_m, config_.planner.robot.width_m / 2)) {
       path = planning::PlanPath(grid, *escape, config_.goal_m, config_.algorithm);
       if (path) {  // drive out to the free cell first
         path->waypoints.insert(path->waypoints.begin(),
@@ -310,7 +325,7 @@ tl::expected<planning::Path, planning::NoPath> Mission::PlanOn(
   if (!path && path.error().reason == planning::NoPath::Reason::kGoalBlocked) {
     const bool far = (config_.goal_m - here).norm() > kGoalApproach_m;
     const double radius = far ? kGoalApproach_m : config_.goal_tolerance_m;
-    if (const auto near = EscapeCell(grid, config_.goal_m, radius)) {
+    if (const auto near = EscapeCell(grid, config_.goal_m, radius, 0.0)) {
       auto to_near = planning::PlanPath(grid, here, *near, config_.algorithm);
       if (to_near) path = std::move(to_near);
     }
@@ -580,12 +595,22 @@ bool Mission::BackOff(const sensors::Odometry& odo, double tilt_rad, bool obstac
                 tilt_rad * 180 / kPi, T.translation().x(), T.translation().y(),
                 obstacle ? "ran onto something ahead" : "the ground ahead is too steep");
   Progress(line);
+  return DriveBack(odo);
+}
+
+bool Mission::DriveBack(const sensors::Odometry& odo) {
   const Eigen::Vector2d from(odo.x_m, odo.y_m);
   const double start_s = probes_.now_s();
+  const double start_tilt = Tilt();
   sensors::Odometry now = odo;
   while ((Eigen::Vector2d(now.x_m, now.y_m) - from).norm() < kBackOff_m) {
     if (OverBudget()) return false;
     if (probes_.now_s() - start_s > config_.stuck_timeout_s) break;  // as far as it goes
+    // Reversing blind over a rim or into a hollow can tilt it more than what it backs away from.
+    if (Tilt() > std::min(start_tilt + kBackOffTiltRise_rad,
+                          std::max(start_tilt, config_.caution_tilt_deg * kPi / 180))) {
+      break;
+    }
     Result<sensors::Odometry> next = base_.Drive(-kBackOffSpeed_mps, 0.0, config_.control_period_s);
     if (!next) {
       result_.reason = "base: " + next.error().message;

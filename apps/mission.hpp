@@ -28,17 +28,23 @@ struct MissionConfig {
   double time_budget_s = 1800.0;  ///< mission time at most (simulated or real) [s]
   double max_tilt_deg = 30.0;     ///< beyond this the robot is tipping over [deg]
   /// Beyond this tilt the robot backs off and marks the ground ahead as too steep, then plans
-  /// again: the loaded P3-AT (laser 0.45 m up) pitches over forward at 21 deg standing, less while
-  /// braking downhill [deg].
-  double caution_tilt_deg = 18.0;
+  /// again: the loaded P3-AT (laser 0.45 m up, batteries low) pitches over forward at 31 deg
+  /// standing, less while braking downhill [deg].
+  double caution_tilt_deg = 24.0;
   /// A drive that ends tilted more than this backs off before the robot stops to scan: sweeping
   /// the laser down shifts its weight forward, and the wheel hold creeps on steep ground [deg].
-  double scan_tilt_deg = 13.0;
+  double scan_tilt_deg = 17.0;
   /// Beyond this tilt the follower slows to slope_speed_mps (same curvature) [deg].
   double slope_tilt_deg = 10.0;
   double slope_speed_mps = 0.2;   ///< cruise speed on slopes [m/s]
   double stuck_timeout_s = 8.0;   ///< no progress while commanded for this long: stuck [s]
   double control_period_s = 0.1;  ///< path follower rate [s]
+  /// Returns farther than this from the laser stay out of the elevation map the robot plans on
+  /// (the merged cloud and registration keep them). Far ground is seen at a grazing angle on
+  /// sparse lines, and a scan's attitude or registration error of 0.2-0.3 deg shifts it by
+  /// centimetres a cell: overlapping far views of two scans read as steps and slopes that cut
+  /// every way (terrain). The robot rescans every drive_per_stop_m, well inside this [m].
+  double map_range_m = 10.0;
   /// Clearance kept beyond the robot's half width when planning, for tracking error [m].
   double safety_margin_m = 0.08;
   /// The robot stops this far before the first unobserved cell of its plan, turns to face it and

@@ -18,10 +18,11 @@ constexpr double kMissionMinInlierRatio = 0.15;
 // and desk rows, 2 m apart), not the robot's motion.
 constexpr double kMissionConstraint_m = 1.0;
 constexpr double kMissionUnknownPenalty = 5.0;
-// The P3-AT's 35 % grade (19.3 deg) is the bare robot's. Carrying the LMS200 on its pitching
-// mount (4.5 kg, 0.45 m up) its centre of mass is 0.25 m high and 0.1 m behind the front axle: it
-// pitches over forward at 21 deg standing, earlier braking downhill or sweeping the laser down
-// (the simulator shows both). Runs plan to 16 deg unless the config says otherwise.
+// The P3-AT's 35 % grade (19.3 deg) is the bare robot's. With the LMS200 on its pitching mount
+// (4.5 kg, 0.45 m up) the loaded robot tips forward at 31 deg standing (sim/README.md), less
+// braking downhill, sweeping the laser down or over a rock on rough ground; planning to 19.3 deg
+// took the terrain runs onto rims they tipped on (3 of 6 seeds). Runs plan to 16 deg unless the
+// config says otherwise.
 constexpr double kLoadedP3AtInclination_deg = 16.0;
 
 double MissionInclinationLimit(const planning::RobotLimits& robot) {
@@ -48,6 +49,7 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
       {"inclination_radius_m", &s.inclination_radius_m},
       {"safety_margin_m", &m.safety_margin_m},
       {"unknown_margin_m", &m.unknown_margin_m},
+      {"map_range_m", &m.map_range_m},
       {"lookahead_m", &m.follower.lookahead_m},
       {"max_speed_mps", &m.follower.max_speed_mps},
       {"max_yaw_rate_rps", &m.follower.max_yaw_rate_rps}};
@@ -141,6 +143,10 @@ RunSettings ParseRunSettings(const std::string& yaml_text, const std::string& so
                                 "max_tilt_deg, 0 < scan_tilt_deg < caution_tilt_deg and "
                                 "slope_speed_mps > 0");
   }
+  if (!(m.map_range_m > 1.0)) {
+    throw std::invalid_argument(source + ": run.map_range_m = " + std::to_string(m.map_range_m) +
+                                " must be > 1 m (the robot needs to see past its own footprint)");
+  }
   if (!(s.inclination_radius_m >= 0 && s.inclination_radius_m <= 16 * s.cell_m)) {
     throw std::invalid_argument(
         source + ": run.inclination_radius_m = " + std::to_string(s.inclination_radius_m) +
@@ -175,6 +181,7 @@ std::string RunSettingsToYaml(const RunSettings& s) {
      << (s.map_size_m ? "  map_size_m: " + std::to_string(*s.map_size_m) + "\n" : std::string())
      << "  safety_margin_m: " << m.safety_margin_m << "\n"
      << "  unknown_margin_m: " << m.unknown_margin_m << "\n"
+     << "  map_range_m: " << m.map_range_m << "\n"
      << "  algorithm: " << planning::ToString(m.algorithm) << "\n"
      << "  lookahead_m: " << m.follower.lookahead_m << "\n"
      << "  max_speed_mps: " << m.follower.max_speed_mps << "\n"

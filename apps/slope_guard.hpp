@@ -1,7 +1,7 @@
 #pragma once
 // Driving on slopes with a top-heavy P3: the laser sits 0.45 m up, so the loaded P3-AT pitches
-// over forward at about 21 deg (its centre of mass is 0.25 m high and 0.1 m behind the front axle),
-// close to the 19.3 deg the planner allows. The mission slows where the planned path is steep and
+// over forward at about 31 deg standing (centre of mass 0.22 m high), less braking downhill or
+// over a rock. The mission slows where the planned path is steep and
 // backs off when its own tilt passes a caution limit; these helpers are the geometry of that.
 
 #include <vector>

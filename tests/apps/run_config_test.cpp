@@ -25,7 +25,7 @@ TEST(RunSettings, APlannerLimitOverridesOnlyThatLimitOfThePreset) {
   EXPECT_EQ(s.mission.planner.unknown, planning::UnknownPolicy::kPenalise);
 }
 
-// The loaded P3-AT plans to 16 deg (it tips near 21 deg with the laser up top), also when a
+// The loaded P3-AT plans to 16 deg (it tips near 31 deg standing, less over rocks), also when a
 // planner section leaves the limit out; the P3-DX keeps its own, lower preset.
 TEST(RunSettings, TheLoadedP3AtPlansToSixteenDegrees) {
   const RunSettings at = ParseRunSettings("", "test", sim::P3Model::kP3AT);
@@ -46,6 +46,11 @@ TEST(RunSettings, TheLoadedP3AtPlansToSixteenDegrees) {
   EXPECT_EQ(coarse.mission.layers.inclination_radius_cells, 1);
   EXPECT_THROW(ParseRunSettings("run: {scan_tilt_deg: 25}\n", "t", sim::P3Model::kP3AT),
                std::invalid_argument);  // above caution_tilt_deg
+  EXPECT_THROW(ParseRunSettings("run: {map_range_m: 0.5}\n", "t", sim::P3Model::kP3AT),
+               std::invalid_argument);  // inside the robot's own footprint
+  EXPECT_NEAR(ParseRunSettings("run: {map_range_m: 25}\n", "t", sim::P3Model::kP3AT)
+                  .mission.map_range_m,
+              25.0, 1e-12);
 }
 
 TEST(RunSettings, RunKeysAreReadAndBadOnesNamed) {
