@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "bucket_queue.hpp"
+#include "move_cost.hpp"
 
 namespace pitchlab::planning {
 namespace {
@@ -30,7 +31,7 @@ constexpr std::size_t kPrefetch = 16;
 // Eq. 4 and 5 for the move m out of cell a (to b), whether allowed or not, with its parts.
 inline double RawEdgeCost(const TraversabilityGrid& T, std::size_t a, std::size_t b, int m,
                           CostParts* parts) {
-  const double cost = T.move_cost[8 * a + m];
+  const double cost = (T.moves[a] >> m & 1) ? T.move_cost[a][m] : MoveCostOf(T, a, m);
   if (parts) {
     const CostWeights& w = T.config.weights;
     const bool unknown = !std::isfinite(T.z_m[b]);
@@ -64,14 +65,30 @@ double TiltOf(const TraversabilityGrid& T, std::size_t k) {
   return std::atan(std::sqrt(tx * tx + ty * ty));
 }
 
-// One search's labels: tentative cost and a visited bit per cell. No parent pointers: the path is
-// read back from the costs (see Predecessor), which saves a store per relaxation.
-struct Labels {
-  explicit Labels(std::size_t n) : dist(n, kInf), visited((n + 63) / 64, 0) {}
-  bool Visited(std::uint32_t k) const { return visited[k >> 6] >> (k & 63) & 1; }
-  void Visit(std::uint32_t k) { visited[k >> 6] |= std::uint64_t{1} << (k & 63); }
-  std::vector<double> dist;
-  std::vector<std::uint64_t> visited;
+// One search's labels: tentative cost and a visited bit per cell. The costs are padded by a row
+// and a cell on either side, so that k + delta of every move of every cell k is inside the array
+// (a move off the grid costs +inf and never wins: no bounds test). No parent pointers: the path
+// is read back from the costs (see Predecessor), which saves a store per relaxation.
+class Labels {
+ public:
+  Labels(std::size_t cells, int size_x)
+      : pad_(static_cast<std::size_t>(size_x) + 1),
+        padded_(cells + 2 * pad_, kInf),
+        visited_((cells + 63) / 64, 0) {}
+  Labels(const Labels&) = delete;
+  Labels& operator=(const Labels&) = delete;
+
+  /// Cost labels, indexable from -(size_x + 1) to cells + size_x.
+  double* Dist() { return padded_.data() + pad_; }
+  double Dist(std::uint32_t k) const { return padded_[pad_ + k]; }
+  std::uint64_t* VisitedBits() { return visited_.data(); }
+  bool Visited(std::uint32_t k) const { return visited_[k >> 6] >> (k & 63) & 1; }
+  void Visit(std::uint32_t k) { visited_[k >> 6] |= std::uint64_t{1} << (k & 63); }
+
+ private:
+  std::size_t pad_;
+  std::vector<double> padded_;
+  std::vector<std::uint64_t> visited_;
 };
 
 // A*'s lower bound: kHeuristicShare times the distance to the goal on an obstacle-free 8-grid
@@ -99,16 +116,14 @@ Heuristic MakeHeuristic(const TraversabilityGrid& T, const CellIndex& goal, bool
 }
 
 // Relaxes the moves out of one cell (Algorithm 2's inner loop): the 8 precomputed move costs
-// (TraversabilityGrid::move_cost) added to the cell's cost, compared with the neighbours' labels,
-// nothing virtual, raw pointers so the compiler keeps them in registers. No visited test: a
-// settled neighbour's label is final and lower than any new offer (every move raises the key by
-// at least two bucket widths), so the comparison already leaves it alone.
+// (TraversabilityGrid::move_cost, +inf where not allowed) added to the cell's cost, compared with
+// the neighbours' labels: no mask, no bounds test, no branch. No visited test: a settled
+// neighbour's label is final and lower than any new offer (every move raises the key by at least
+// two bucket widths), so the comparison already leaves it alone.
 template <bool kAStar>
 struct Relaxer {
-  const float* cost;
-  const std::uint8_t* moves;
-  double* dist;
-  std::size_t cells;
+  const MoveCosts* cost;
+  double* dist;             // Labels::Dist()
   std::ptrdiff_t delta[8];  // linear index step of each move
   int size_x;
   double inv_size_x;
@@ -116,27 +131,19 @@ struct Relaxer {
   double h_start;
 
   void Prefetch(std::uint32_t k) const {
-    __builtin_prefetch(cost + 8 * static_cast<std::size_t>(k));
-    __builtin_prefetch(moves + k);
-    // The labels of the rows above and below (clamped: no pointer off the array).
-    __builtin_prefetch(dist + std::min<std::size_t>(k + size_x, cells - 1));
-    __builtin_prefetch(dist + (k >= static_cast<std::uint32_t>(size_x) ? k - size_x : 0));
+    __builtin_prefetch(cost + k);
+    __builtin_prefetch(dist + k - size_x);  // the labels of the rows below and above
+    __builtin_prefetch(dist + k + size_x);
   }
 
   template <typename Queue>
   void operator()(std::uint32_t k, Queue& queue) const {
-    const unsigned allowed = moves[k];
     const double gk = dist[k];
-    const float* c = cost + 8 * static_cast<std::size_t>(k);
-    // A move that is not allowed compares with cell k itself (no read off the grid) and loses:
-    // its index step is masked to 0, no branch.
+    const float* c = cost[k].to;
     unsigned better = 0;
-    double nd[8];
-    for (int b = 0; b < 8; ++b) {
-      const std::ptrdiff_t d = delta[b] & -static_cast<std::ptrdiff_t>(allowed >> b & 1);
-      nd[b] = gk + static_cast<double>(c[b]);
-      better |= static_cast<unsigned>(nd[b] < dist[k + d]) << b;
-    }
+    for (int b = 0; b < 8; ++b)
+      better |= static_cast<unsigned>(gk + static_cast<double>(c[b]) < dist[k + delta[b]]) << b;
+    if (better == 0) return;
     int ci = 0, cj = 0;
     if constexpr (kAStar) {
       cj = static_cast<int>(k * inv_size_x);  // k / size_x without a division, then exact:
@@ -144,14 +151,16 @@ struct Relaxer {
       if (ci < 0) ci += size_x, --cj;
       if (ci >= size_x) ci -= size_x, ++cj;
     }
-    for (better &= allowed; better != 0; better &= better - 1) {
+    do {
       const int b = __builtin_ctz(better);
+      better &= better - 1;
       const auto kn = static_cast<std::uint32_t>(k + delta[b]);
-      dist[kn] = nd[b];
-      double key = nd[b];
+      const double g = gk + static_cast<double>(c[b]);
+      dist[kn] = g;
+      double key = g;
       if constexpr (kAStar) key += h(ci + kMoveDi[b], cj + kMoveDj[b]) - h_start;
       queue.Push(key, kn);
-    }
+    } while (better != 0);
   }
 };
 
@@ -162,21 +171,13 @@ template <bool kAStar, typename Queue>
 std::size_t Search(const TraversabilityGrid& T, std::uint32_t ks, std::uint32_t kt,
                    const Heuristic& h, Queue& queue, Labels& L) {
   const GridGeometry& g = T.geometry;
-  Relaxer<kAStar> relax{T.move_cost.data(),
-                        T.moves.data(),
-                        L.dist.data(),
-                        g.cell_count(),
-                        {},
-                        g.size_x,
-                        1.0 / g.size_x,
-                        h,
-                        0.0};
+  Relaxer<kAStar> relax{T.move_cost.data(), L.Dist(), {}, g.size_x, 1.0 / g.size_x, h, 0.0};
   for (int b = 0; b < 8; ++b)
     relax.delta[b] = kMoveDi[b] + static_cast<std::ptrdiff_t>(kMoveDj[b]) * g.size_x;
   const CellIndex s = g.FromLinear(ks);
   if constexpr (kAStar) relax.h_start = h(s.i, s.j);
   std::size_t expanded = 0;
-  L.dist[ks] = 0.0;
+  L.Dist()[ks] = 0.0;
   queue.Push(0.0, ks);
   while (!queue.Empty()) {
     if constexpr (std::is_same_v<Queue, BucketQueue>) {
@@ -236,7 +237,7 @@ std::uint32_t Predecessor(const TraversabilityGrid& T, const Labels& L, std::uin
     if (!g.Contains(cu)) continue;
     const auto u = static_cast<std::uint32_t>(g.Linear(cu));
     if (!(T.moves[u] >> b & 1) || !L.Visited(u)) continue;
-    const double c = L.dist[u] + static_cast<double>(T.move_cost[8 * std::size_t{u} + b]);
+    const double c = L.Dist(u) + static_cast<double>(T.move_cost[u][b]);
     if (c < best_cost) best_cost = c, best = u;
   }
   if (best == v) throw std::logic_error("plan path: a settled cell has no settled predecessor");
@@ -247,7 +248,7 @@ Path Reconstruct(const TraversabilityGrid& T, const Labels& L, std::uint32_t sta
                  std::uint32_t goal) {
   const GridGeometry& g = T.geometry;
   Path path;
-  path.cost = L.dist[goal];
+  path.cost = L.Dist(goal);
   std::vector<std::uint32_t> ks;
   for (std::uint32_t k = goal; k != start; k = Predecessor(T, L, k)) ks.push_back(k);
   ks.push_back(start);
@@ -320,7 +321,7 @@ tl::expected<Path, NoPath> PlanPath(const TraversabilityGrid& T, const Eigen::Ve
 
   const bool astar = algorithm == Algorithm::kAStar;
   const Heuristic h = MakeHeuristic(T, t, astar);
-  Labels labels(g.cell_count());
+  Labels labels(g.cell_count(), g.size_x);
   const std::size_t expanded =
       astar ? RunSearch<true>(T, ks, kt, h, labels) : RunSearch<false>(T, ks, kt, h, labels);
   if (!labels.Visited(kt)) {
