@@ -130,10 +130,10 @@ Heuristic MakeHeuristic(const TraversabilityGrid& T, const CellIndex& goal, bool
 template <bool kAStar>
 struct Relaxer {
   const MoveCosts* cost;
-  double* dist;               // Labels::Dist()
-  std::uint64_t* visited;     // Labels::VisitedBits()
-  std::ptrdiff_t delta[8];    // linear index step of each move
-  std::ptrdiff_t row;         // size_x
+  double* dist;             // Labels::Dist()
+  std::uint64_t* visited;   // Labels::VisitedBits()
+  std::ptrdiff_t delta[8];  // linear index step of each move
+  std::ptrdiff_t row;       // size_x
   unsigned size_x;
   Heuristic h;
   double h_start;

@@ -183,8 +183,8 @@ TEST(Planner, ManyStartGoalPairsGiveBglsCostAndTheirOwnEdgeSums) {
         const auto a = PlanPath(T, centre(s), centre(t), Algorithm::kAStar);
         ASSERT_TRUE(d && a) << "seed " << seed << " pair " << pair;
         const double peer = BglCost(T, s, t);
-        const std::string where = (rough ? "rough, seed " : "flat, seed ") +
-                                  std::to_string(seed) + ", pair " + std::to_string(pair);
+        const std::string where = (rough ? "rough, seed " : "flat, seed ") + std::to_string(seed) +
+                                  ", pair " + std::to_string(pair);
         EXPECT_NEAR(d->cost, peer, kCostRelTol * peer) << where;
         EXPECT_NEAR(a->cost, peer, kCostRelTol * peer) << where;
         EXPECT_NEAR(EvaluatePath(T, *d).cost, d->cost, kCostRelTol * peer) << where;
