@@ -1,5 +1,5 @@
 #pragma once
-// Monotone priority queues for the label-setting searches (private to planning/).
+// Monotone priority queues for the searches (private to planning/).
 
 #include <array>
 #include <cstddef>
@@ -9,35 +9,39 @@
 
 namespace pitchlab::planning {
 
-/// Dinitz's bucket queue: buckets of `width` over the key, kept in a ring of at least `ring`
-/// buckets (a power of two, so the ring index is a mask, not a division).
-/// Contract: every key pushed lies in [current bucket + 1, current bucket + ring) whenever the
-/// caller is inside a bucket, i.e. each edge adds at least `width` and less than (ring-1)*width
-/// to the key. Then every cell in the lowest bucket already has its final key, and a bucket is
-/// settled in any order: no heap, O(1) per push and pop. Keys are >= 0.
+/// Dinitz's bucket queue, label-correcting inside the current bucket: buckets of `width` over the
+/// key in a ring of at least `ring` buckets (a power of two, so the ring index is a mask, not a
+/// division). The caller works through the current bucket by index while it may still grow: a key
+/// below the current bucket's end lands in it (a label lowered after its cell was expanded is
+/// expanded again). Contract: every key pushed is >= 0 and below the current bucket's start plus
+/// (ring - 1) widths. O(1) per push, no heap.
 class BucketQueue {
  public:
   BucketQueue(double width, std::size_t ring)
       : inv_width_(1.0 / width), buckets_(RoundUpToPowerOfTwo(ring)), mask_(buckets_.size() - 1) {}
 
-  /// Bucket of a key [1].
-  std::size_t BucketOf(double key) const { return static_cast<std::size_t>(key * inv_width_); }
   void Push(double key, std::uint32_t value) {
-    std::size_t b = BucketOf(key);
-    if (started_ && b <= current_) b = current_ + 1;  // rounding at a bucket's edge: never back
+    std::int64_t b = static_cast<std::int64_t>(key * inv_width_);
+    if (b <= current_) {
+      b = current_;
+    } else {
+      ++pending_;
+    }
     buckets_[b & mask_].push_back(value);
-    ++size_;
   }
-  bool Empty() const { return size_ == 0; }
-  /// The next non-empty bucket's values, handed over whole (cleared by the next call); the
-  /// caller settles them in any order. Precondition: !Empty().
-  std::vector<std::uint32_t>& NextBucket() {
-    if (started_) buckets_[current_++ & mask_].clear();
-    started_ = true;
-    while (buckets_[current_ & mask_].empty()) ++current_;
-    std::vector<std::uint32_t>& b = buckets_[current_ & mask_];
-    size_ -= b.size();
-    return b;
+  /// The bucket being worked through (initially bucket 0).
+  std::vector<std::uint32_t>& Current() { return buckets_[current_ & mask_]; }
+  /// The bucket after it, for prefetching (it may still grow).
+  const std::vector<std::uint32_t>& Following() const { return buckets_[(current_ + 1) & mask_]; }
+  /// Empties the current bucket and makes the next non-empty one current; false when none is left.
+  bool Advance() {
+    Current().clear();
+    if (pending_ == 0) return false;
+    do {
+      ++current_;
+    } while (Current().empty());
+    pending_ -= Current().size();
+    return true;
   }
 
  private:
@@ -48,9 +52,9 @@ class BucketQueue {
   }
   double inv_width_;
   std::vector<std::vector<std::uint32_t>> buckets_;
-  std::size_t mask_;
-  std::size_t current_ = 0, size_ = 0;
-  bool started_ = false;
+  std::int64_t mask_;
+  std::int64_t current_ = 0;
+  std::size_t pending_ = 0;  // entries in buckets after the current one
 };
 
 /// Radix heap (Ahuja, Mehlhorn, Orlin, Tarjan 1990) on the bit pattern of non-negative doubles,

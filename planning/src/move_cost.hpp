@@ -1,18 +1,17 @@
 #pragma once
-// Eq. 4-5 for one move: the single definition, evaluated once per move into
-// TraversabilityGrid::move_cost, which the searches, the peer graph (ListEdges), the path's cost
-// parts and EvaluatePath all read, so they agree to the last bit.
+// Eq. 4-5 for one move: the single definition. BuildTraversability stores it for every allowed
+// move (TraversabilityGrid::move_cost); the cost of a move that is not allowed (a path costed on
+// another map) is evaluated on demand by the same function, so all agree to the last bit.
 
-#include <cmath>
+#include <cstddef>
+
+#include "pitchlab/planning/traversability.hpp"
 
 namespace pitchlab::planning {
 
-/// Cost of moving from a cell at height za to a neighbour at zb, d_m apart in the plane [m]:
-/// the neighbour's entry cost plus W_P times the 3D length P (Eq. 4; dz = 0 when either height
-/// is unknown) [1].
-inline double MoveCost(float enter_b, float za, float zb, double d_m, double w_length) {
-  const double dz = (std::isfinite(za) && std::isfinite(zb)) ? double(zb) - za : 0.0;
-  return enter_b + w_length * std::sqrt(d_m * d_m + dz * dz);  // Eq. 5 with Eq. 4's P
-}
+/// Eq. 4-5 cost of move b (kMoveDi/kMoveDj) out of cell k, whether allowed or not, rounded to
+/// float as stored in move_cost; +inf when the neighbour is off the grid [1]. Reads z_m and
+/// enter_cost only.
+float MoveCostOf(const TraversabilityGrid& grid, std::size_t k, int b);
 
 }  // namespace pitchlab::planning

@@ -6,9 +6,9 @@
 #include <memory>
 #include <sstream>
 #include <stdexcept>
-#include <type_traits>
 
 #include "bucket_queue.hpp"
+#include "move_cost.hpp"
 
 namespace pitchlab::planning {
 namespace {
@@ -17,20 +17,28 @@ using mapping::CellIndex;
 using mapping::GridGeometry;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-// A* weighs its lower bound by this share: each move then raises f = g + h by at least
-// (1 - share) of the cheapest move, which lets a bucket queue order A* exactly (see Search).
-// 0.99 made the buckets 3 x narrower (a ring too long for the cache) for 3 % fewer cells.
-constexpr double kHeuristicShare = 0.97;
+// A*'s lower bound is the relaxed octile distance (see Heuristic) times this share: under 1 by
+// far more than the rounding of the summed costs, so that no cell on an optimal path gets a key
+// above the goal's (finishing the goal's bucket, or popping the goal, then ends the search
+// exactly); 1 - share costs 0.2 % more cells than the full bound on the benchmark map.
+constexpr double kHeuristicShare = 0.999;
+// Bucket width as a share of the cheapest move: a Dijkstra key then rises by two buckets or more
+// per move, so no cell is expanded twice and the next bucket is complete when the current one is
+// started (prefetched across the boundary). A* keys may rise by less (f = g + h rises by the
+// move's cost less the drop of h), which the label-correcting buckets absorb: 0.1 % of the cells
+// expanded twice on the benchmark map, against 33 x more buckets for an exact order.
+constexpr double kBucketShare = 0.5;
 // A bucket ring longer than this (moves far dearer than the cheapest, e.g. a huge unknown
 // penalty) is replaced by a radix heap [buckets].
 constexpr std::size_t kMaxRing = std::size_t{1} << 21;
-// How many cells ahead in a bucket their data is prefetched [cells].
-constexpr std::size_t kPrefetch = 16;
+// How many cells ahead in the queue their data is prefetched [cells] (8 and 12 measured alike,
+// 4 and 16 slower).
+constexpr std::size_t kPrefetch = 8;
 
 // Eq. 4 and 5 for the move m out of cell a (to b), whether allowed or not, with its parts.
 inline double RawEdgeCost(const TraversabilityGrid& T, std::size_t a, std::size_t b, int m,
                           CostParts* parts) {
-  const double cost = T.move_cost[8 * a + m];
+  const double cost = (T.moves[a] >> m & 1) ? T.move_cost[a][m] : MoveCostOf(T, a, m);
   if (parts) {
     const CostWeights& w = T.config.weights;
     const bool unknown = !std::isfinite(T.z_m[b]);
@@ -64,14 +72,30 @@ double TiltOf(const TraversabilityGrid& T, std::size_t k) {
   return std::atan(std::sqrt(tx * tx + ty * ty));
 }
 
-// One search's labels: tentative cost and a visited bit per cell. No parent pointers: the path is
-// read back from the costs (see Predecessor), which saves a store per relaxation.
-struct Labels {
-  explicit Labels(std::size_t n) : dist(n, kInf), visited((n + 63) / 64, 0) {}
-  bool Visited(std::uint32_t k) const { return visited[k >> 6] >> (k & 63) & 1; }
-  void Visit(std::uint32_t k) { visited[k >> 6] |= std::uint64_t{1} << (k & 63); }
-  std::vector<double> dist;
-  std::vector<std::uint64_t> visited;
+// One search's labels: tentative cost and a visited bit per cell. The costs are padded by a row
+// and a cell on either side, so that k + delta of every move of every cell k is inside the array
+// (a move off the grid costs +inf and never wins: no bounds test). No parent pointers: the path
+// is read back from the costs (see Predecessor), which saves a store per relaxation.
+class Labels {
+ public:
+  Labels(std::size_t cells, int size_x)
+      : pad_(static_cast<std::size_t>(size_x) + 1),
+        padded_(cells + 2 * pad_, kInf),
+        visited_((cells + 63) / 64, 0) {}
+  Labels(const Labels&) = delete;
+  Labels& operator=(const Labels&) = delete;
+
+  /// Cost labels, indexable from -(size_x + 1) to cells + size_x.
+  double* Dist() { return padded_.data() + pad_; }
+  double Dist(std::uint32_t k) const { return padded_[pad_ + k]; }
+  std::uint64_t* VisitedBits() { return visited_.data(); }
+  bool Visited(std::uint32_t k) const { return visited_[k >> 6] >> (k & 63) & 1; }
+  void Visit(std::uint32_t k) { visited_[k >> 6] |= std::uint64_t{1} << (k & 63); }
+
+ private:
+  std::size_t pad_;
+  std::vector<double> padded_;
+  std::vector<std::uint64_t> visited_;
 };
 
 // A*'s lower bound: kHeuristicShare times the distance to the goal on an obstacle-free 8-grid
@@ -98,129 +122,148 @@ Heuristic MakeHeuristic(const TraversabilityGrid& T, const CellIndex& goal, bool
   return h;
 }
 
-// Relaxes the moves out of one cell (Algorithm 2's inner loop): the 8 precomputed move costs
-// (TraversabilityGrid::move_cost) added to the cell's cost, compared with the neighbours' labels,
-// nothing virtual, raw pointers so the compiler keeps them in registers. No visited test: a
-// settled neighbour's label is final and lower than any new offer (every move raises the key by
-// at least two bucket widths), so the comparison already leaves it alone.
+// Expands one cell (Algorithm 2's inner loop): its 8 precomputed move costs
+// (TraversabilityGrid::move_cost, +inf where not allowed) added to its cost and compared with the
+// neighbours' labels, no mask, no bounds test, no branch; then the better offers are stored and
+// queued at g (Dijkstra) or g + h - h(start) (A*). A neighbour lowered after its own expansion
+// (A* inside the current bucket) loses its visited bit, to be expanded again.
 template <bool kAStar>
 struct Relaxer {
-  const float* cost;
-  const std::uint8_t* moves;
-  double* dist;
-  std::size_t cells;
+  const MoveCosts* cost;
+  double* dist;             // Labels::Dist()
+  std::uint64_t* visited;   // Labels::VisitedBits()
   std::ptrdiff_t delta[8];  // linear index step of each move
-  int size_x;
-  double inv_size_x;
+  std::ptrdiff_t row;       // size_x
+  unsigned size_x;
   Heuristic h;
   double h_start;
 
   void Prefetch(std::uint32_t k) const {
-    __builtin_prefetch(cost + 8 * static_cast<std::size_t>(k));
-    __builtin_prefetch(moves + k);
-    // The labels of the rows above and below (clamped: no pointer off the array).
-    __builtin_prefetch(dist + std::min<std::size_t>(k + size_x, cells - 1));
-    __builtin_prefetch(dist + (k >= static_cast<std::uint32_t>(size_x) ? k - size_x : 0));
+    __builtin_prefetch(cost + k);
+    __builtin_prefetch(dist + k - row);  // the labels of the rows below and above
+    __builtin_prefetch(dist + k + row);
   }
 
   template <typename Queue>
   void operator()(std::uint32_t k, Queue& queue) const {
-    const unsigned allowed = moves[k];
     const double gk = dist[k];
-    const float* c = cost + 8 * static_cast<std::size_t>(k);
-    // A move that is not allowed compares with cell k itself (no read off the grid) and loses:
-    // its index step is masked to 0, no branch.
+    const float* c = cost[k].to;
     unsigned better = 0;
-    double nd[8];
-    for (int b = 0; b < 8; ++b) {
-      const std::ptrdiff_t d = delta[b] & -static_cast<std::ptrdiff_t>(allowed >> b & 1);
-      nd[b] = gk + static_cast<double>(c[b]);
-      better |= static_cast<unsigned>(nd[b] < dist[k + d]) << b;
-    }
+    for (int b = 0; b < 8; ++b)
+      better |= static_cast<unsigned>(gk + static_cast<double>(c[b]) < dist[k + delta[b]]) << b;
+    if (better == 0) return;
     int ci = 0, cj = 0;
     if constexpr (kAStar) {
-      cj = static_cast<int>(k * inv_size_x);  // k / size_x without a division, then exact:
-      ci = static_cast<int>(k) - cj * size_x;
-      if (ci < 0) ci += size_x, --cj;
-      if (ci >= size_x) ci -= size_x, ++cj;
+      cj = static_cast<int>(k / size_x);
+      ci = static_cast<int>(k - static_cast<unsigned>(cj) * size_x);
     }
-    for (better &= allowed; better != 0; better &= better - 1) {
+    do {
       const int b = __builtin_ctz(better);
+      better &= better - 1;
       const auto kn = static_cast<std::uint32_t>(k + delta[b]);
-      dist[kn] = nd[b];
-      double key = nd[b];
-      if constexpr (kAStar) key += h(ci + kMoveDi[b], cj + kMoveDj[b]) - h_start;
+      const double g = gk + static_cast<double>(c[b]);
+      dist[kn] = g;
+      double key = g;
+      if constexpr (kAStar) {
+        // Only A* lowers an expanded cell: Dijkstra's keys rise by two buckets or more per move.
+        visited[kn >> 6] &= ~(std::uint64_t{1} << (kn & 63));
+        key += h(ci + kMoveDi[b], cj + kMoveDj[b]) - h_start;
+      }
       queue.Push(key, kn);
-    }
+    } while (better != 0);
   }
 };
 
-// Algorithm 2 from ks until kt is settled; returns the cells settled. Keys are g + h - h(start)
-// (g for Dijkstra): they rise along every move by at least the queue's contract, so they are
-// monotone and the queue may be a bucket queue or a radix heap. Each cell is expanded once.
-template <bool kAStar, typename Queue>
-std::size_t Search(const TraversabilityGrid& T, std::uint32_t ks, std::uint32_t kt,
-                   const Heuristic& h, Queue& queue, Labels& L) {
+// Algorithm 2 from ks over the buckets, until the bucket in which kt was settled is worked
+// through (every cell keyed below the goal is then final: no key of an optimal path's cell
+// exceeds the goal's, see kHeuristicShare); returns the cells expanded. A bucket is worked
+// through in any order, label-correcting: a cell lowered into the current bucket after its
+// expansion is queued there again.
+template <bool kAStar>
+std::size_t SearchBuckets(const Relaxer<kAStar>& relax, std::uint32_t ks, std::uint32_t kt,
+                          BucketQueue& queue, Labels& L) {
+  std::size_t expanded = 0;
+  bool goal_settled = false;
+  queue.Push(0.0, ks);
+  do {
+    std::vector<std::uint32_t>& bucket = queue.Current();
+    // Drop the stale entries (cells expanded in an earlier bucket, queued again at a higher key)
+    // first, without a branch: the expansion loop then has no unpredictable test.
+    std::size_t live = 0;
+    for (const std::uint32_t k : bucket) {
+      bucket[live] = k;
+      live += !L.Visited(k);
+    }
+    bucket.resize(live);
+    for (std::size_t n = 0; n < bucket.size(); ++n) {  // it may grow as we go
+      // The queue says which cells come next: fetch their move costs and labels early (the
+      // search is bound by memory latency), on into the next bucket.
+      const std::size_t ahead = n + kPrefetch, size = bucket.size();
+      if (ahead < size) {
+        relax.Prefetch(bucket[ahead]);
+      } else if (ahead - size < queue.Following().size()) {
+        relax.Prefetch(queue.Following()[ahead - size]);
+      }
+      const std::uint32_t k = bucket[n];
+      if (L.Visited(k)) continue;  // queued twice in this bucket
+      L.Visit(k);
+      ++expanded;
+      if (k == kt) {
+        goal_settled = true;
+        continue;
+      }
+      relax(k, queue);
+    }
+  } while (!goal_settled && queue.Advance());
+  return expanded;
+}
+
+// The same with a radix heap: cells in key order, until kt is popped.
+template <bool kAStar>
+std::size_t SearchHeap(const Relaxer<kAStar>& relax, std::uint32_t ks, std::uint32_t kt,
+                       RadixHeap& queue, Labels& L) {
+  std::size_t expanded = 0;
+  queue.Push(0.0, ks);
+  while (!queue.Empty()) {
+    const std::uint32_t k = queue.Pop();
+    if (L.Visited(k)) continue;  // a stale entry: the cell was expanded at a lower key
+    L.Visit(k);
+    ++expanded;
+    if (k == kt) break;
+    relax(k, queue);
+  }
+  return expanded;
+}
+
+// Algorithm 2 from ks to kt with keys g + h - h(start) (g for Dijkstra), which never fall along a
+// move by more than rounding (h is consistent): a bucket queue whose width is kBucketShare of the
+// cheapest move, or a radix heap when the ring of buckets would be too long. Returns the cells
+// expanded.
+template <bool kAStar>
+std::size_t RunSearch(const TraversabilityGrid& T, std::uint32_t ks, std::uint32_t kt,
+                      const Heuristic& h, Labels& L) {
   const GridGeometry& g = T.geometry;
   Relaxer<kAStar> relax{T.move_cost.data(),
-                        T.moves.data(),
-                        L.dist.data(),
-                        g.cell_count(),
+                        L.Dist(),
+                        L.VisitedBits(),
                         {},
                         g.size_x,
-                        1.0 / g.size_x,
+                        static_cast<unsigned>(g.size_x),
                         h,
                         0.0};
   for (int b = 0; b < 8; ++b)
     relax.delta[b] = kMoveDi[b] + static_cast<std::ptrdiff_t>(kMoveDj[b]) * g.size_x;
   const CellIndex s = g.FromLinear(ks);
   if constexpr (kAStar) relax.h_start = h(s.i, s.j);
-  std::size_t expanded = 0;
-  L.dist[ks] = 0.0;
-  queue.Push(0.0, ks);
-  while (!queue.Empty()) {
-    if constexpr (std::is_same_v<Queue, BucketQueue>) {
-      // Every cell in the lowest bucket is final (no move stays inside a bucket): any order.
-      const std::vector<std::uint32_t>& bucket = queue.NextBucket();
-      const std::size_t size = bucket.size();
-      for (std::size_t n = 0; n < size; ++n) {
-        // The bucket says which cells come next: fetch their move costs and labels early (the
-        // search is bound by memory latency, not arithmetic).
-        if (n + kPrefetch < size) relax.Prefetch(bucket[n + kPrefetch]);
-        const std::uint32_t k = bucket[n];
-        if (L.Visited(k)) continue;  // a stale entry: the cell was settled at a lower key
-        L.Visit(k);
-        ++expanded;
-        if (k == kt) return expanded;
-        relax(k, queue);
-      }
-    } else {
-      const std::uint32_t k = queue.Pop();
-      if (L.Visited(k)) continue;
-      L.Visit(k);
-      ++expanded;
-      if (k == kt) return expanded;
-      relax(k, queue);
-    }
-  }
-  return expanded;
-}
-
-// Runs Search with a bucket queue whose width is half the least key rise of a move (Dinitz), or
-// a radix heap when the ring of buckets would be too long.
-template <bool kAStar>
-std::size_t RunSearch(const TraversabilityGrid& T, std::uint32_t ks, std::uint32_t kt,
-                      const Heuristic& h, Labels& L) {
-  const double cheapest = std::min(T.min_straight_cost, T.min_diagonal_cost);
-  const double min_rise = kAStar ? (1 - kHeuristicShare) * cheapest : cheapest;
-  const double width = 0.5 * min_rise;
-  const double span = (T.max_edge_cost + h.diagonal) / width + 3;  // a move's largest rise
+  L.Dist()[ks] = 0.0;
+  const double width = kBucketShare * std::min(T.min_straight_cost, T.min_diagonal_cost);
+  const double span = (T.max_edge_cost + h.diagonal) / width + 3;  // a move's largest key rise
   if (std::isfinite(width) && width > 0 && span < double(kMaxRing)) {
     BucketQueue queue(width, static_cast<std::size_t>(span));
-    return Search<kAStar>(T, ks, kt, h, queue, L);
+    return SearchBuckets<kAStar>(relax, ks, kt, queue, L);
   }
   RadixHeap queue;
-  return Search<kAStar>(T, ks, kt, h, queue, L);
+  return SearchHeap<kAStar>(relax, ks, kt, queue, L);
 }
 
 // The settled neighbour u of v that minimises cost(u) + Eq. 5 cost of u -> v: v's parent in the
@@ -236,7 +279,7 @@ std::uint32_t Predecessor(const TraversabilityGrid& T, const Labels& L, std::uin
     if (!g.Contains(cu)) continue;
     const auto u = static_cast<std::uint32_t>(g.Linear(cu));
     if (!(T.moves[u] >> b & 1) || !L.Visited(u)) continue;
-    const double c = L.dist[u] + static_cast<double>(T.move_cost[8 * std::size_t{u} + b]);
+    const double c = L.Dist(u) + static_cast<double>(T.move_cost[u][b]);
     if (c < best_cost) best_cost = c, best = u;
   }
   if (best == v) throw std::logic_error("plan path: a settled cell has no settled predecessor");
@@ -247,7 +290,7 @@ Path Reconstruct(const TraversabilityGrid& T, const Labels& L, std::uint32_t sta
                  std::uint32_t goal) {
   const GridGeometry& g = T.geometry;
   Path path;
-  path.cost = L.dist[goal];
+  path.cost = L.Dist(goal);
   std::vector<std::uint32_t> ks;
   for (std::uint32_t k = goal; k != start; k = Predecessor(T, L, k)) ks.push_back(k);
   ks.push_back(start);
@@ -320,7 +363,7 @@ tl::expected<Path, NoPath> PlanPath(const TraversabilityGrid& T, const Eigen::Ve
 
   const bool astar = algorithm == Algorithm::kAStar;
   const Heuristic h = MakeHeuristic(T, t, astar);
-  Labels labels(g.cell_count());
+  Labels labels(g.cell_count(), g.size_x);
   const std::size_t expanded =
       astar ? RunSearch<true>(T, ks, kt, h, labels) : RunSearch<false>(T, ks, kt, h, labels);
   if (!labels.Visited(kt)) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -120,22 +121,33 @@ void ComputeMoves(TraversabilityGrid& T) {
     }
 }
 
-// The Eq. 4-5 cost of every move of every cell (TraversabilityGrid::move_cost).
+// Eq. 4-5 for move b out of cell (i, j), whether allowed or not, rounded to float: the one
+// definition behind MoveCostOf and TraversabilityGrid::move_cost; +inf off the grid [1].
+float MoveCostAt(const TraversabilityGrid& T, int i, int j, int b) {
+  const GridGeometry& g = T.geometry;
+  const CellIndex nb{i + kMoveDi[b], j + kMoveDj[b]};
+  if (!g.Contains(nb)) return std::numeric_limits<float>::infinity();
+  const std::size_t k = g.Linear({i, j}), kn = g.Linear(nb);
+  const float za = T.z_m[k], zb = T.z_m[kn];
+  const double dz = (std::isfinite(za) && std::isfinite(zb)) ? double(zb) - za : 0.0;
+  const double d_m = (b < 4 ? 1.0 : M_SQRT2) * g.cell_m;
+  // Eq. 5 with Eq. 4's P, the 3D length between the cell centres (dz = 0 when a height is unknown).
+  return static_cast<float>(T.enter_cost[kn] +
+                            T.config.weights.length * std::sqrt(d_m * d_m + dz * dz));
+}
+
+// The Eq. 4-5 cost of every allowed move of every cell, +inf for the others
+// (TraversabilityGrid::move_cost).
 void ComputeMoveCosts(TraversabilityGrid& T) {
   const GridGeometry& g = T.geometry;
-  const double w_p = T.config.weights.length;
-  T.move_cost.assign(8 * g.cell_count(), std::numeric_limits<float>::infinity());
+  MoveCosts none;
+  std::fill(std::begin(none.to), std::end(none.to), std::numeric_limits<float>::infinity());
+  T.move_cost.assign(g.cell_count(), none);
   for (int j = 0; j < g.size_y; ++j)
     for (int i = 0; i < g.size_x; ++i) {
       const std::size_t k = g.Linear({i, j});
-      for (int b = 0; b < 8; ++b) {
-        const CellIndex nb{i + kMoveDi[b], j + kMoveDj[b]};
-        if (!g.Contains(nb)) continue;
-        const std::size_t kn = g.Linear(nb);
-        const double d_m = (b < 4 ? 1.0 : M_SQRT2) * g.cell_m;
-        T.move_cost[8 * k + b] =
-            static_cast<float>(MoveCost(T.enter_cost[kn], T.z_m[k], T.z_m[kn], d_m, w_p));
-      }
+      for (int b = 0; b < 8; ++b)
+        if (T.moves[k] >> b & 1) T.move_cost[k].to[b] = MoveCostAt(T, i, j, b);
     }
 }
 
@@ -151,7 +163,7 @@ void ComputeMoveCostRange(TraversabilityGrid& T) {
     if (!source) continue;
     for (int b = 0; b < 8; ++b) {
       if (!(T.moves[k] >> b & 1)) continue;
-      const double c = T.move_cost[8 * k + b];
+      const double c = T.move_cost[k][b];
       double& lo = b < 4 ? T.min_straight_cost : T.min_diagonal_cost;
       lo = std::min(lo, c);
       T.max_edge_cost = std::max(T.max_edge_cost, c);
@@ -160,6 +172,11 @@ void ComputeMoveCostRange(TraversabilityGrid& T) {
 }
 
 }  // namespace
+
+float MoveCostOf(const TraversabilityGrid& T, std::size_t k, int b) {
+  const CellIndex c = T.geometry.FromLinear(k);
+  return MoveCostAt(T, c.i, c.j, b);
+}
 
 RobotLimits RobotLimits::P3AT() { return {"p3at", 0.089, std::atan(0.35), 0.497}; }
 RobotLimits RobotLimits::P3DX() { return {"p3dx", 0.025, std::atan(0.25), 0.381}; }

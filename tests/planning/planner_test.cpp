@@ -153,6 +153,48 @@ TEST(Planner, DijkstraAStarAndBglAgreeOnRandomTerrain) {
   }
 }
 
+TEST(Planner, ManyStartGoalPairsGiveBglsCostAndTheirOwnEdgeSums) {
+  // Nearly flat ground (2 mm of noise: A*'s bound is almost exact, so many cells share a bucket
+  // and some are lowered after their expansion, which must be expanded again) and rough ground
+  // with unknown cells penalised; 20 random pairs on each of 8 maps of both: Dijkstra, A* and BGL
+  // agree, and each path's edges, costed again on the map, sum to the path's cost.
+  for (const bool rough : {false, true}) {
+    for (unsigned seed = 1; seed <= 8; ++seed) {
+      std::mt19937 rng(seed);
+      std::uniform_real_distribution<double> u(0, 1);
+      const ElevationLayers L = MakeLayers(40, 40, 0.1, [&](int i, int j) {
+        if (!rough) return 0.002 * u(rng);
+        if (u(rng) < 0.05) return std::nan("");
+        return 0.06 * std::sin(0.35 * i) * std::cos(0.2 * j) + 0.015 * u(rng);
+      });
+      PlannerConfig cfg = PointRobot();
+      cfg.unknown = UnknownPolicy::kPenalise;
+      cfg.unknown_penalty = 0.3;
+      const TraversabilityGrid T = BuildTraversability(L, cfg);
+      std::uniform_int_distribution<std::size_t> cell(0, T.geometry.cell_count() - 1);
+      const auto centre = [&](std::size_t k) {
+        return T.geometry.CenterOf(T.geometry.FromLinear(k));
+      };
+      for (int pair = 0; pair < 20; ++pair) {
+        std::size_t s = cell(rng), t = cell(rng);
+        while (!T.Free(s)) s = cell(rng);
+        while (!T.Free(t)) t = cell(rng);
+        const auto d = PlanPath(T, centre(s), centre(t), Algorithm::kDijkstra);
+        const auto a = PlanPath(T, centre(s), centre(t), Algorithm::kAStar);
+        ASSERT_TRUE(d && a) << "seed " << seed << " pair " << pair;
+        const double peer = BglCost(T, s, t);
+        const std::string where = (rough ? "rough, seed " : "flat, seed ") + std::to_string(seed) +
+                                  ", pair " + std::to_string(pair);
+        EXPECT_NEAR(d->cost, peer, kCostRelTol * peer) << where;
+        EXPECT_NEAR(a->cost, peer, kCostRelTol * peer) << where;
+        EXPECT_NEAR(EvaluatePath(T, *d).cost, d->cost, kCostRelTol * peer) << where;
+        EXPECT_NEAR(EvaluatePath(T, *a).cost, a->cost, kCostRelTol * peer) << where;
+        EXPECT_EQ(EvaluatePath(T, *a).forbidden_cells, 0u) << where;
+      }
+    }
+  }
+}
+
 TEST(Planner, HugeUnknownPenaltyStillGivesTheOptimalCost) {
   // Moves into unknown cells cost 1e6: the bucket ring would be too long, so the search falls
   // back to its radix heap; both searches must still agree with BGL.

@@ -43,7 +43,9 @@ struct Path {
   double length_m = 0;                    ///< 3D length, sum of P [m]
   double max_step_m = 0;                  ///< largest |dz| between consecutive cells [m]
   double max_inclination_rad = 0;         ///< largest plane tilt of a path cell [rad]
-  std::size_t expanded = 0;               ///< nodes settled by the search [1]
+  /// Cells expanded by the search; a cell lowered after its expansion (A*, rarely: its bucket
+  /// queue is label-correcting) counts again [1].
+  std::size_t expanded = 0;
 };
 
 /// Why there is no path.
