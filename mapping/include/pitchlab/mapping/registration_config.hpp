@@ -77,7 +77,11 @@ struct RegistrationConfig {
   bool constant_velocity_fallback = true;  ///< use the previous motion when alignment fails
   double inlier_distance_m = 0.1;  ///< a source point is an inlier within this of the target [m]
   double min_inlier_ratio = 0.3;   ///< fewer inliers: failure (no overlap / misaligned) [1]
-  double max_rmse_m = 0.06;        ///< inlier RMS point-to-plane error above this: failure [m]
+  /// Inlier RMS point-to-plane error above this: failure (the scans do not fit together). In
+  /// registration_eval (1000 runs, 5 and 10 mm range noise) correct alignments measured 4-15 mm;
+  /// 10 wrong poses that passed the inlier test 17-32 mm (the others, 9-16 mm, are left to the
+  /// degeneracy checks) [m].
+  double max_rmse_m = 0.017;
 
   /// Throws std::invalid_argument naming the field and value.
   void Validate() const;
