@@ -600,6 +600,7 @@ int main(int argc, char** argv) {
         const auto [level_m, level_deg] = o.levels[l];
         mapping::RegistrationPrior prior;
         prior.odometry = OffsetGuess(p.truth, level_m, level_deg, rng);
+        prior.odometry_uncertainty = mapping::GuessUncertainty{level_m, level_deg};  // its bound
         if (!o.only_pairs.empty() && !o.only_pairs.count(p.id))
           continue;  // guess drawn all the same
         json entry = PairInfo(p, level_m, level_deg, *prior.odometry);
