@@ -1,14 +1,15 @@
 // registration_eval: Algorithm 1 scored against the simulator's ground truth (issue 3).
 // Simulates scan pairs in the worlds (target at a random free pose, source 0.3-1.2 m / up to 20 deg
 // further on, as stop-scan-go steps), registers them with an odometry guess offset from the truth
-// by each sweep level (Algorithm 1's initial guess), and prints JSON: per pair and level the
-// rotation / translation error, fitness, path and stage times; per world x level x noise the
-// success rate; the same pairs without any prior (global registration);
-// the PCL default pipeline on a subset of the same pairs; Table 1 (NARF vs FPFH); and scan-to-map
-// sequences with their drift. Time per pair is wall clock per stage and this thread's CPU time
-// (one core, whatever else runs), as median / p95 / max over the target pairs, all pairs and the
-// full-size (72k-point) pairs. False successes (success reported, > 5 cm or > 1 deg off the truth)
-// are counted over every pair and level. Progress and a summary go to stderr.
+// by each sweep level (Algorithm 1's initial guess; the prior bounds its error by the level), and
+// prints JSON: per pair and level the rotation / translation error, fitness, path and stage times;
+// per world x level x noise the success rate; the same pairs without any prior (global
+// registration); the PCL default pipeline on a subset of the same pairs; Table 1 (NARF vs FPFH);
+// and scan-to-map sequences with their drift. Time per pair is wall clock per stage and this
+// thread's CPU time (one core, whatever else runs), as median / p95 / max over the target pairs,
+// all pairs and the full-size (72k-point) pairs. False successes (success reported, > 5 cm or
+// > 1 deg off the truth) are counted over every pair and level. Progress and a summary go to
+// stderr.
 
 #include <algorithm>
 #include <chrono>
