@@ -203,6 +203,25 @@ std::string UntrustedGuess(const Weakness& weak, RegistrationPath path,
   return os.str();
 }
 
+// `a` and the directions of `b` not (nearly) within a's, orthonormalized (a frozen set must be).
+Weakness Union(Weakness a, const Weakness& b) {
+  auto add = [](std::vector<Eigen::Vector3d>& to, std::vector<double>& ratios,
+                const Eigen::Vector3d& d, double ratio) {
+    Eigen::Vector3d r = d;
+    for (const Eigen::Vector3d& e : to) r -= r.dot(e) * e;
+    if (r.norm() < 0.5) return;
+    to.push_back(r.normalized());
+    ratios.push_back(ratio);
+  };
+  for (std::size_t k = 0; k < b.translations.size(); ++k) {
+    add(a.translations, a.translation_ratios, b.translations[k], b.translation_ratios[k]);
+  }
+  for (std::size_t k = 0; k < b.rotation_axes.size(); ++k) {
+    add(a.rotation_axes, a.rotation_ratios, b.rotation_axes[k], b.rotation_ratios[k]);
+  }
+  return a;
+}
+
 // ICP from a guess of the prior, and whether it may be merged.
 struct FromGuess {
   IcpResult icp;
@@ -216,7 +235,8 @@ struct FromGuess {
 // nothing constrains is otherwise rejected as undetermined. The directions along which the feature
 // alignment was `ambiguous` stay so whatever ICP from the guess finds: along them the scans fit
 // several poses about equally well (office 26 of registration_eval, 1 cm noise: ICP from a guess
-// 0.5 m off ends 0.27 m from the truth in a pose its own probe finds well constrained).
+// 0.5 m off ends 0.27 m from the truth in a pose its own probe finds well constrained), so they
+// are rejected, or kept at a trusted guess with the weak directions of ICP's own result.
 FromGuess IcpFromGuess(const IcpTarget& target, const PointCloud& source, const Prepared& prep,
                        const Eigen::Isometry3d& guess, RegistrationPath path,
                        const Weakness& ambiguous, const RegistrationPrior& prior,
@@ -243,7 +263,8 @@ FromGuess IcpFromGuess(const IcpTarget& target, const PointCloud& source, const 
       path == RegistrationPath::kFallback ||
       (u && (u->translation_m <= config.carry_max_m || u->rotation_deg <= config.carry_max_deg));
   if (!out.rejection.empty() && !may_carry) return out;  // no probe needed: searched or failed
-  const Weakness weak = GuessDegenerateDirections(target, source, out.icp, config);
+  const Weakness weak =
+      Union(GuessDegenerateDirections(target, source, out.icp, config), ambiguous);
   if (!weak.any()) return out;
   const std::string untrusted = UntrustedGuess(weak, path, prior, config);
   if (untrusted.empty()) {
