@@ -256,11 +256,6 @@ TEST(Register, OnOpenTerrainAnUntrustedOdometryGuessCannotFixTheHeading) {
 // 0.5 deg off, fitting 54 % of the source with an inlier RMS error of 18 mm (correct alignments of
 // these scans: 4-9 mm). With the former max_rmse_m of 0.06 m it was a success.
 TEST(Register, ScansThatFitTogetherOnlyLooselyAreAReportedFailure) {
-  // Known open defect (issue 3): since the robot carries its batteries (f67b8a6) it settles a
-  // little differently, these two scans changed, and the pair now registers 5.9 cm / 0.25 deg off
-  // with an inlier RMS under max_rmse_m: a success by the 3 cm target's standard it is not. The
-  // residual check alone does not catch it; the test stays here, skipped, until one does.
-  GTEST_SKIP() << "pair now 5.9 cm off and reported success: the RMS check misses it (issue 3)";
   const sensors::Scan3D a = SimulatedScan("terrain", 2.9785, 1.6730, -79.139, 1);
   const sensors::Scan3D b = SimulatedScan("terrain", 2.8836, 0.7636, -95.010, 2);
   const Eigen::Isometry3d truth = a.T_world_base.inverse() * b.T_world_base;
