@@ -81,203 +81,55 @@ struct Prepared {
   Normals target_normals;
 };
 
-// Whether a probe that ends `away` from `at` (beyond a quarter of the probe) shows the direction
-// degenerate: below degeneracy_ratio always (in a corridor the best-fitting pose along the axis
-// may be a wrong one, so fits cannot decide there); above it only when the probe's end fits about
-// as well (inliers at most kSameFit fewer): a pose elsewhere that fits clearly worse is another,
-// poorer minimum, not a free direction.
-constexpr double kSameFit = 0.01;
-bool Undetermined(bool away, double direction_ratio, const IcpResult& at, const IcpResult& probe,
-                  const RegistrationConfig& config) {
-  if (!away) return false;
-  return direction_ratio < config.degeneracy_ratio ||
-         probe.inlier_ratio >= at.inlier_ratio - kSameFit;
-}
-
-// The directions along which the solution is not unique: of those the scene constrains weakly at
-// `at` (eigenvalue ratio below `ratio`, at most `max_per_kind` translations and rotation axes), the
-// ones along which ICP restarted degeneracy_probe_m away (degeneracy_probe_deg about the axis) does
-// not come back (a corridor; an open plane; see Undetermined). Empty when well constrained.
+// The directions along which the solution is not unique: ICP restarted degeneracy_probe_m along
+// the weakest translation (degeneracy_probe_deg about the weakest rotation axis) does not come
+// back (a corridor; an open plane). Empty when well constrained.
 Weakness DegenerateDirections(const IcpTarget& target, const PointCloud& source,
-                              const IcpResult& at, const RegistrationConfig& config, double ratio,
-                              int max_per_kind) {
+                              const IcpResult& at, const RegistrationConfig& config) {
   Weakness out;
-  if (at.degeneracy >= ratio) return out;
-  const Weakness weak =
-      WeakDirections(target, source, at.T_target_source, config, ratio, max_per_kind);
-  for (std::size_t k = 0; k < weak.translations.size(); ++k) {
-    const Eigen::Vector3d& d = weak.translations[k];
+  if (at.degeneracy >= config.degeneracy_ratio) return out;
+  const Weakness weak = WeakDirections(target, source, at.T_target_source, config);
+  if (weak.translation) {
     const Eigen::Isometry3d start =
-        Eigen::Translation3d(config.degeneracy_probe_m * d) * at.T_target_source;
+        Eigen::Translation3d(config.degeneracy_probe_m * *weak.translation) * at.T_target_source;
     const IcpResult probe = PointToPlaneLm(target, source, start, config, {});
     const double back_m = ComparePoses(probe.T_target_source, at.T_target_source).translation_m;
-    if (Undetermined(back_m >= 0.25 * config.degeneracy_probe_m, weak.translation_ratios[k], at,
-                     probe, config)) {
-      out.translations.push_back(d);
-      out.translation_ratios.push_back(weak.translation_ratios[k]);
-    }
+    if (back_m >= 0.25 * config.degeneracy_probe_m) out.translation = weak.translation;
   }
-  const Eigen::Vector3d c = at.T_target_source.translation();
-  for (std::size_t k = 0; k < weak.rotation_axes.size(); ++k) {
-    const Eigen::Vector3d& axis = weak.rotation_axes[k];
+  if (weak.rotation_axis) {
+    const Eigen::Vector3d c = at.T_target_source.translation();
     const Eigen::Isometry3d turn =
         Eigen::Translation3d(c) *
-        Eigen::AngleAxisd(config.degeneracy_probe_deg * kPi / 180.0, axis) *
+        Eigen::AngleAxisd(config.degeneracy_probe_deg * kPi / 180.0, *weak.rotation_axis) *
         Eigen::Translation3d(-c);
     const IcpResult probe = PointToPlaneLm(target, source, turn * at.T_target_source, config, {});
     const double back_deg = ComparePoses(probe.T_target_source, at.T_target_source).rotation_deg;
-    if (Undetermined(back_deg >= 0.25 * config.degeneracy_probe_deg, weak.rotation_ratios[k], at,
-                     probe, config)) {
-      out.rotation_axes.push_back(axis);
-      out.rotation_ratios.push_back(weak.rotation_ratios[k]);
-    }
+    if (back_deg >= 0.25 * config.degeneracy_probe_deg) out.rotation_axis = weak.rotation_axis;
   }
   return out;
 }
 
-// The feature alignment's winner is probed along its weakest translation and rotation axis.
-Weakness AmbiguousDirections(const IcpTarget& target, const PointCloud& source, const IcpResult& at,
-                             const RegistrationConfig& config) {
-  return DegenerateDirections(target, source, at, config, config.degeneracy_ratio, 1);
-}
-
-// A pose ICP reached from a guess has no feature consensus behind it, and a few points on the
-// wrong surface can make a free direction look constrained (office 26 of registration_eval, 1 cm
-// noise: facing a wall 0.37 m ahead, ICP slid 0.27 m down until the wall's foot lay on the floor;
-// up was then 13 % of the strongest constraint, and a probe 1 m up ended in a pose fitting 96 %
-// of the source vs 88 %): it is probed along every translation and rotation axis below
-// guess_degeneracy_ratio.
-Weakness GuessDegenerateDirections(const IcpTarget& target, const PointCloud& source,
-                                   const IcpResult& at, const RegistrationConfig& config) {
-  return DegenerateDirections(target, source, at, config, config.guess_degeneracy_ratio, 2);
-}
-
-// PCL's ICP-NL from `init` (backend pcl: the whole voxelized source, no subsampling), scored as
-// ours.
-IcpResult RunPclIcp(const IcpTarget& target, const PointCloud& source, const Prepared& prep,
-                    const Eigen::Isometry3d& init, const RegistrationConfig& config) {
-  const PclIcp pcl = PclIcpNonLinear(prep.target_icp, prep.source_icp, init, config);
-  IcpResult r = Evaluate(target, source, pcl.T_target_source, config);
-  r.iterations = pcl.iterations;
-  return r;
-}
-
-std::string Vector(const Eigen::Vector3d& v) {
-  std::ostringstream os;
-  os.precision(2);
-  os << std::fixed << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
-  return os.str();
-}
-
-// Why the guess on `path` may not supply the `weak` directions, or empty when it may: the
-// constant-velocity motion always may (the paper's corridor assumption); odometry only with an
-// error bound within carry_max_m / carry_max_deg for the kind of direction that is weak.
-std::string UntrustedGuess(const Weakness& weak, RegistrationPath path,
-                           const RegistrationPrior& prior, const RegistrationConfig& config) {
-  if (path == RegistrationPath::kFallback) return {};
-  const std::optional<GuessUncertainty>& u = prior.odometry_uncertainty;
-  if (u && (weak.translations.empty() || u->translation_m <= config.carry_max_m) &&
-      (weak.rotation_axes.empty() || u->rotation_deg <= config.carry_max_deg)) {
-    return {};
-  }
-  std::ostringstream os;
-  os.precision(3);
-  os << "degenerate geometry leaves";
-  const char* sep = " ";
-  for (const Eigen::Vector3d& d : weak.translations) {
-    os << sep << "the translation along " << Vector(d);
-    sep = " and ";
-  }
-  for (const Eigen::Vector3d& a : weak.rotation_axes) {
-    os << sep << "the rotation about " << Vector(a);
-    sep = " and ";
-  }
-  os << " unconstrained, and the odometry guess ";
-  if (u) {
-    os << "may be " << u->translation_m << " m / " << u->rotation_deg << " deg off (carry_max_m "
-       << config.carry_max_m << ", carry_max_deg " << config.carry_max_deg << ")";
-  } else {
-    os << "has no error bound (odometry_uncertainty)";
-  }
-  os << ": the pose is not determined";
-  return os.str();
-}
-
-// `a` and the directions of `b` not (nearly) within a's, orthonormalized (a frozen set must be).
-Weakness Union(Weakness a, const Weakness& b) {
-  auto add = [](std::vector<Eigen::Vector3d>& to, std::vector<double>& ratios,
-                const Eigen::Vector3d& d, double ratio) {
-    Eigen::Vector3d r = d;
-    for (const Eigen::Vector3d& e : to) r -= r.dot(e) * e;
-    if (r.norm() < 0.5) return;
-    to.push_back(r.normalized());
-    ratios.push_back(ratio);
-  };
-  for (std::size_t k = 0; k < b.translations.size(); ++k) {
-    add(a.translations, a.translation_ratios, b.translations[k], b.translation_ratios[k]);
-  }
-  for (std::size_t k = 0; k < b.rotation_axes.size(); ++k) {
-    add(a.rotation_axes, a.rotation_ratios, b.rotation_axes[k], b.rotation_ratios[k]);
-  }
-  return a;
-}
-
-// ICP from a guess of the prior, and whether it may be merged.
-struct FromGuess {
-  IcpResult icp;
-  std::string rejection;      // empty: accepted
-  bool carried = false;       // degenerate: the weak directions were kept from the guess
-  bool undetermined = false;  // degenerate, and the guess may not supply the weak directions
-};
-
-// In degenerate geometry the guess supplies the weak directions (ICP re-run with them kept at the
-// guess) when it may (UntrustedGuess); a fit that passes the acceptance test along directions
-// nothing constrains is otherwise rejected as undetermined. The directions along which the feature
-// alignment was `ambiguous` stay so whatever ICP from the guess finds: along them the scans fit
-// several poses about equally well (office 26 of registration_eval, 1 cm noise: ICP from a guess
-// 0.5 m off ends 0.27 m from the truth in a pose its own probe finds well constrained), so they
-// are rejected, or kept at a trusted guess with the weak directions of ICP's own result.
-FromGuess IcpFromGuess(const IcpTarget& target, const PointCloud& source, const Prepared& prep,
-                       const Eigen::Isometry3d& guess, RegistrationPath path,
-                       const Weakness& ambiguous, const RegistrationPrior& prior,
-                       const RegistrationConfig& config) {
-  FromGuess out;
+// ICP from `init` with the configured backend; in degenerate geometry (`freeze_weak`) the weak
+// translation direction keeps the initial guess (constant velocity / odometry carries it).
+IcpResult RunIcp(const PointCloud& source, const IcpTarget& target, const Prepared& prep,
+                 const Eigen::Isometry3d& init, const RegistrationConfig& config, bool freeze_weak,
+                 bool* degenerate) {
   if (config.backend == RegistrationBackend::kPcl) {
-    out.icp = RunPclIcp(target, source, prep, guess, config);
-    out.rejection = Rejection(out.icp, prior, config);
-    return out;
+    // PCL's pipeline aligns the whole voxelized source (no subsampling).
+    const PclIcp pcl = PclIcpNonLinear(prep.target_icp, prep.source_icp, init, config);
+    IcpResult r = Evaluate(target, source, pcl.T_target_source, config);
+    r.iterations = pcl.iterations;
+    return r;
   }
-  if (ambiguous.any()) {  // decided before any ICP: the guess is scored where it is
-    if (std::string untrusted = UntrustedGuess(ambiguous, path, prior, config);
-        !untrusted.empty()) {
-      out.icp = Evaluate(target, source, guess, config);
-      out.rejection = std::move(untrusted);
-      out.undetermined = true;
-      return out;
-    }
+  IcpResult r = PointToPlaneLm(target, source, init, config, {});
+  const Weakness weak = DegenerateDirections(target, source, r, config);
+  if (degenerate) *degenerate = weak.any();
+  if (freeze_weak && weak.any()) {
+    const int first = r.iterations;
+    r = PointToPlaneLm(target, source, init, config, weak);
+    r.iterations += first;
   }
-  out.icp = PointToPlaneLm(target, source, guess, config, {});
-  out.rejection = Rejection(out.icp, prior, config);
-  const std::optional<GuessUncertainty>& u = prior.odometry_uncertainty;
-  const bool may_carry =
-      path == RegistrationPath::kFallback ||
-      (u && (u->translation_m <= config.carry_max_m || u->rotation_deg <= config.carry_max_deg));
-  if (!out.rejection.empty() && !may_carry) return out;  // no probe needed: searched or failed
-  const Weakness weak =
-      Union(GuessDegenerateDirections(target, source, out.icp, config), ambiguous);
-  if (!weak.any()) return out;
-  const std::string untrusted = UntrustedGuess(weak, path, prior, config);
-  if (untrusted.empty()) {
-    const int first = out.icp.iterations;
-    out.icp = PointToPlaneLm(target, source, guess, config, weak);
-    out.icp.iterations += first;
-    out.rejection = Rejection(out.icp, prior, config);
-    out.carried = true;
-  } else if (out.rejection.empty()) {
-    out.rejection = untrusted;
-    out.undetermined = true;
-  }
-  return out;
+  return r;
 }
 
 // NARF on the dense scans (range images need one return per beam) + the same RANSAC.
@@ -470,16 +322,15 @@ Verified VerifyHypotheses(const PointCloud& source, const IcpTarget& target, con
     verify(GuessGrid(*guess, config), 2);
   }
   if (best.icp.degeneracy < config.degeneracy_ratio && config.degeneracy_search_m > 0) {
-    const Weakness weak = WeakDirections(target, source, best.icp.T_target_source, config,
-                                         config.degeneracy_ratio, 1);
-    if (!weak.translations.empty()) {
+    const Weakness weak = WeakDirections(target, source, best.icp.T_target_source, config);
+    if (weak.translation) {
       const double step = 0.5 * config.icp_max_distance_m;
       const int steps = static_cast<int>(std::ceil(config.degeneracy_search_m / step));
       std::vector<Start> along;
       for (int k = -steps; k <= steps; ++k) {
         if (k == 0) continue;
         along.push_back(
-            {Eigen::Translation3d(k * step * weak.translations.front()) * best.icp.T_target_source,
+            {Eigen::Translation3d(k * step * *weak.translation) * best.icp.T_target_source,
              best.path, "starts along the weakly constrained direction"});
       }
       verify(along, 2);
@@ -599,7 +450,7 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
                          config.constraint_rotation_deg * kPi / 180.0};
   }
   std::vector<std::string> notes;
-  Weakness ambiguous;  // directions the feature alignment left undetermined
+  bool ambiguous = false;
   // 3-4. Features and sample-consensus initial alignment.
   if (config.features != FeatureKind::kNone) {
     SacResult sac;
@@ -627,20 +478,17 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
       RegistrationPath path = RegistrationPath::kFeatures;
       std::string note;
       if (config.backend == RegistrationBackend::kPcl) {
-        icp = RunPclIcp(icp_target, icp_source, prep, sac.T_target_source, config);
+        icp = RunIcp(icp_source, icp_target, prep, sac.T_target_source, config, false, &ambiguous);
       } else {
         const Verified v = VerifyHypotheses(icp_source, icp_target, sac, prior, config);
         icp = v.icp, path = v.path, note = v.note;
         out.iterations += v.iterations - icp.iterations;  // Fill adds the winner's own
-      }
-      const std::string rejection = Rejection(icp, prior, config);
-      // Only a fit that passes the acceptance test says anything about the scene's degeneracy.
-      if (config.backend == RegistrationBackend::kFast && rejection.empty()) {
-        ambiguous = AmbiguousDirections(icp_target, icp_source, icp, config);
+        ambiguous = DegenerateDirections(icp_target, icp_source, icp, config).any();
       }
       out.timings.icp_s += lap.Lap();
       Fill(out, icp, path);
-      if (!ambiguous.any() && rejection.empty()) {
+      const std::string rejection = Rejection(icp, prior, config);
+      if (!ambiguous && rejection.empty()) {
         out.success = true;
         out.reason = note.empty() ? std::string(ToString(path)) : note;
         out.timings.total_s = total.Lap();
@@ -648,7 +496,7 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
       }
       std::ostringstream os;
       os.precision(3);
-      if (ambiguous.any()) {
+      if (ambiguous) {
         os << "feature alignment ambiguous: degenerate geometry (ICP restarted "
            << config.degeneracy_probe_m << " m / " << config.degeneracy_probe_deg
            << " deg along the weakest direction does not come back)";
@@ -670,9 +518,11 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
     guesses.emplace_back(RegistrationPath::kFallback, *prior.previous_motion);
   }
   for (const auto& [path, guess] : guesses) {
-    FromGuess g = IcpFromGuess(icp_target, icp_source, prep, guess, path, ambiguous, prior, config);
+    bool degenerate = false;
+    IcpResult icp = RunIcp(icp_source, icp_target, prep, guess, config, true, &degenerate);
+    std::string rejection = Rejection(icp, prior, config);
     bool searched = false;
-    if (!g.rejection.empty() && !g.undetermined && config.backend == RegistrationBackend::kFast &&
+    if (!rejection.empty() && config.backend == RegistrationBackend::kFast &&
         config.guess_search_m > 0) {
       int iterations = 0;
       const std::optional<IcpResult> found = SearchAroundGuess(
@@ -680,31 +530,27 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
       out.iterations += iterations;
       // Only a pose the scene pins down may replace the guess: in a corridor a grid start fits
       // anywhere along the axis, and nothing says where.
-      if (found && !GuessDegenerateDirections(icp_target, icp_source, *found, config).any()) {
-        notes.push_back(std::string("ICP from the ") + ToString(path) + " guess: " + g.rejection);
-        g.icp = *found, g.rejection.clear(), searched = true, g.carried = false;
-        out.iterations -= g.icp.iterations;  // Fill adds the winner's own
+      if (found && !DegenerateDirections(icp_target, icp_source, *found, config).any()) {
+        notes.push_back(std::string("ICP from the ") + ToString(path) + " guess: " + rejection);
+        icp = *found, rejection.clear(), searched = true, degenerate = false;
+        out.iterations -= icp.iterations;  // Fill adds the winner's own
       } else if (found) {
-        g.rejection +=
+        rejection +=
             " (a grid of starts around the guess fits, but degenerate geometry leaves the "
             "pose undetermined there)";
       }
     }
     out.timings.icp_s += lap.Lap();
-    Fill(out, g.icp, path);
-    if (g.rejection.empty()) {
+    Fill(out, icp, path);
+    if (rejection.empty()) {
       out.success = true;
-      const char* carried =
-          path == RegistrationPath::kFallback
-              ? " (degenerate: constant velocity assumed along the weak directions)"
-              : " (degenerate: the weak directions kept from the odometry guess, "
-                "whose error bound is within carry_max_m / carry_max_deg)";
       notes.push_back(
-          std::string("took the ") + ToString(path) + " path" + (g.carried ? carried : "") +
+          std::string("took the ") + ToString(path) + " path" +
+          (degenerate ? " (degenerate: the weak directions kept from the guess)" : "") +
           (searched ? " (ICP from the best of a grid of starts around the guess)" : ""));
       break;
     }
-    notes.push_back(std::string(ToString(path)) + " path rejected: " + g.rejection);
+    notes.push_back(std::string(ToString(path)) + " path rejected: " + rejection);
   }
   if (!out.success && guesses.empty()) {
     notes.push_back("no odometry prior or previous motion to fall back on");
