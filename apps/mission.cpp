@@ -185,7 +185,7 @@ bool Mission::Stop(int k) {
   if (!scan && scan.error().code == Error::Code::kTimeout && !OverBudget()) {
     // The scan waits for a standstill in vain where the base creeps: the wheel hold on a slope,
     // or a rigid four-wheeler rocking on two diagonal tyres over a bump. Back off the way it came
-    // (marking the ground) and scan once more.
+    // (marking the ground as too steep only when standing on a slope) and scan once more.
     Progress("scan at stop " + std::to_string(k) + " timed out waiting for a standstill (" +
              scan.error().message + "): backing off to scan again");
     Result<sensors::Odometry> odo = base_.ReadOdometry();
@@ -254,12 +254,12 @@ void Mission::UpdateElevation(const StopRecord& stop) {
   const Eigen::Isometry3f T = stop.T_world_base.cast<float>();
   const Eigen::Vector3f laser =
       (stop.T_world_base * config_.mount.BaseToLaser(0.0)).translation().cast<float>();
-  std::vector<sensors::ScanPoint> near;
+  std::vector<Eigen::Vector3f> near;  // map frame, within map_range_m of the laser
   near.reserve(stop.scan.points.size());
   for (const sensors::ScanPoint& p : stop.scan.points) {
-    if (p.range_m <= config_.map_range_m) near.push_back(p);
+    if (p.range_m <= config_.map_range_m) near.push_back(T * Eigen::Vector3f(p.x, p.y, p.z));
   }
-  result_.elevation.Insert(near, T, laser);
+  result_.elevation.InsertScan(near.data(), near.size(), laser);
   // The laser cannot see under the robot, but the robot stands on that ground; only a registered
   // pose knows its height well enough (odometry's z drifts, and a wrong one makes a step around
   // the robot that traps it).
@@ -601,16 +601,16 @@ bool Mission::BackOff(const sensors::Odometry& odo, double tilt_rad, bool obstac
 bool Mission::DriveBack(const sensors::Odometry& odo) {
   const Eigen::Vector2d from(odo.x_m, odo.y_m);
   const double start_s = probes_.now_s();
+  // Reversing blind over a rim or into a hollow can tilt it more than what it backs away from:
+  // stop once it tilts kBackOffTiltRise_rad more, or past caution (from below caution).
   const double start_tilt = Tilt();
+  const double stop_tilt = std::min(start_tilt + kBackOffTiltRise_rad,
+                                    std::max(start_tilt, config_.caution_tilt_deg * kPi / 180));
   sensors::Odometry now = odo;
   while ((Eigen::Vector2d(now.x_m, now.y_m) - from).norm() < kBackOff_m) {
     if (OverBudget()) return false;
     if (probes_.now_s() - start_s > config_.stuck_timeout_s) break;  // as far as it goes
-    // Reversing blind over a rim or into a hollow can tilt it more than what it backs away from.
-    if (Tilt() > std::min(start_tilt + kBackOffTiltRise_rad,
-                          std::max(start_tilt, config_.caution_tilt_deg * kPi / 180))) {
-      break;
-    }
+    if (Tilt() > stop_tilt) break;
     Result<sensors::Odometry> next = base_.Drive(-kBackOffSpeed_mps, 0.0, config_.control_period_s);
     if (!next) {
       result_.reason = "base: " + next.error().message;
