@@ -91,15 +91,24 @@ void InflateHazards(TraversabilityGrid& T) {
       }
       if (edge) border.push_back(k);
     }
+  const auto near = [&](std::size_t k) {
+    Blocked& b = T.blocked[k];
+    if (b == Blocked::kFree || b == Blocked::kUnknown) b = Blocked::kNearHazard;
+  };
   for (std::size_t k : border) {
     const CellIndex c = g.FromLinear(k);
     for (const auto& [di, dj] : disc) {
       const CellIndex nb{c.i + di, c.j + dj};
-      if (!g.Contains(nb)) continue;
-      Blocked& b = T.blocked[g.Linear(nb)];
-      if (b == Blocked::kFree || b == Blocked::kUnknown) b = Blocked::kNearHazard;
+      if (g.Contains(nb)) near(g.Linear(nb));
     }
   }
+  // Off the grid is nothing known to stand on (a DEM's or a world's edge): the footprint may not
+  // hang over it (a terrain run drove off the world's edge along a path hugging the border).
+  for (int j = 0; j < g.size_y; ++j)
+    for (int i = 0; i < g.size_x; ++i) {
+      const int cells_out = std::min({i, j, g.size_x - 1 - i, g.size_y - 1 - j}) + 1;
+      if (cells_out * g.cell_m < reach_m - 1e-9) near(g.Linear({i, j}));
+    }
 }
 
 // The 8-neighbour move mask of every cell (see TraversabilityGrid::moves).

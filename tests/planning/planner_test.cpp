@@ -237,6 +237,31 @@ TEST(Planner, GapNarrowerThanTheRobotIsNotPassed) {
   EXPECT_TRUE(PlanPath(BuildTraversability(wide, at), start, goal, Algorithm::kAStar));
 }
 
+TEST(Planner, FootprintNeverHangsOffTheMapsEdge) {
+  // Flat, all known: the edge is the only hazard. P3-AT: 0.497 m wide, so with 0.1 m cells the
+  // cells whose centre lies within 0.2985 m of an outside cell's (the first 2 rings) are blocked.
+  const ElevationLayers L = MakeLayers(40, 30, 0.1, [](int, int) { return 0.0; });
+  PlannerConfig at;
+  at.robot = RobotLimits::P3AT();
+  const TraversabilityGrid T = BuildTraversability(L, at);
+  const GridGeometry& g = T.geometry;
+  for (int j = 0; j < g.size_y; ++j)
+    for (int i = 0; i < g.size_x; ++i) {
+      const int ring = std::min({i, j, g.size_x - 1 - i, g.size_y - 1 - j});
+      EXPECT_EQ(T.blocked[g.Linear({i, j})] == Blocked::kNearHazard, ring < 2) << i << ", " << j;
+    }
+  // Along the bottom edge: the path keeps half the robot's width on the map.
+  const auto path = PlanPath(T, {0.25, 0.25}, {3.75, 0.25}, Algorithm::kAStar);
+  ASSERT_TRUE(path);
+  for (const CellIndex& c : path->cells) {
+    const Eigen::Vector2d p = g.CenterOf(c);
+    EXPECT_GE(std::min({p.x(), p.y(), 4.0 - p.x(), 3.0 - p.y()}), 0.5 * at.robot.width_m);
+  }
+  const auto off = PlanPath(T, {0.15, 0.15}, {2.0, 1.5}, Algorithm::kAStar);
+  ASSERT_FALSE(off);
+  EXPECT_EQ(off.error().reason, NoPath::Reason::kStartBlocked);
+}
+
 TEST(Planner, StartOrGoalOffTheMapOrInAnObstacleIsAClearError) {
   const ElevationLayers L = MakeLayers(40, 40, 0.1, [](int i, int j) {
     return (i >= 18 && i < 22 && j >= 18 && j < 22) ? 1.0 : 0.0;  // a 0.4 m box, 1 m tall

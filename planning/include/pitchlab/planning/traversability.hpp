@@ -70,7 +70,8 @@ enum class Blocked : std::uint8_t {
   kDrop,        ///< a negative hazard
   kStep,        ///< a step above step_max_m to a neighbour, or within the cell
   kTooSteep,    ///< plane tilt above max_inclination_rad
-  kNearHazard,  ///< within half the robot's width of a step, drop or steep cell (footprint)
+  kNearHazard,  ///< within half the robot's width of a step, drop or steep cell or the grid's
+                ///< edge (footprint)
 };
 const char* ToString(Blocked b);
 
