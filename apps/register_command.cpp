@@ -26,6 +26,10 @@ CliArgs RegisterArgs() {
       .Option("prior", "x,y,z,roll,pitch,yaw",
               "odometry guess of T_target_source: metres and degrees; enables the geometric "
               "constraint around it")
+      .Option("prior-error", "metres,degrees",
+              "how far the --prior may be off at most; only a prior bounded within the "
+              "settings carry_max_m / carry_max_deg may supply what degenerate geometry (a "
+              "corridor's axis) leaves unconstrained, else that is a failure")
       .Option("previous", "x,y,z,roll,pitch,yaw",
               "the previous pair's motion, used when the initial alignment fails (constant "
               "velocity)")
@@ -74,6 +78,10 @@ int RunRegister(int argc, char** argv) {
   if (args.Has("config")) config = mapping::LoadRegistrationConfig(args.Get("config"));
   mapping::RegistrationPrior prior;
   if (args.Has("prior")) prior.odometry = PoseOption(args, "prior");
+  if (args.Has("prior-error")) {
+    const std::vector<double> e = args.GetNumbers("prior-error", 2);
+    prior.odometry_uncertainty = mapping::GuessUncertainty{e[0], e[1]};
+  }
   if (args.Has("previous")) prior.previous_motion = PoseOption(args, "previous");
 
   const sensors::Scan3D source = ReadScan(source_path), target = ReadScan(target_path);

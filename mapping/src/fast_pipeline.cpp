@@ -300,8 +300,8 @@ IcpResult PointToPlaneLm(const IcpTarget& target, const PointCloud& source,
   using Matrix6d = Eigen::Matrix<double, 6, 6>;
   Eigen::Matrix3d keep_t = Eigen::Matrix3d::Identity();  // projectors onto the free directions
   Eigen::Matrix3d keep_r = Eigen::Matrix3d::Identity();
-  if (frozen.translation) keep_t -= *frozen.translation * frozen.translation->transpose();
-  if (frozen.rotation_axis) keep_r -= *frozen.rotation_axis * frozen.rotation_axis->transpose();
+  for (const Eigen::Vector3d& d : frozen.translations) keep_t -= d * d.transpose();
+  for (const Eigen::Vector3d& a : frozen.rotation_axes) keep_r -= a * a.transpose();
   IcpResult result;
   result.T_target_source = init;
   double gate = config.icp_max_distance_m, lambda = 1e-4, prev_mean = -1;
@@ -392,14 +392,25 @@ std::pair<Eigen::Matrix3d, Eigen::Matrix3d> ScorePairs(const IcpTarget& target,
   return {Ct, Cr};
 }
 
-// Weakest eigenvector of C when its eigenvalue is below ratio x the strongest; also the ratio.
-std::optional<Eigen::Vector3d> Weakest(const Eigen::Matrix3d& C, double ratio, double* value) {
+// Weakest / strongest eigenvalue of C.
+double WeakestRatio(const Eigen::Matrix3d& C) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(C);
   const double max_ev = eig.eigenvalues()(2);
-  const double r = max_ev > 0 ? eig.eigenvalues()(0) / max_ev : 0.0;
-  if (value) *value = r;
-  if (r < ratio) return Eigen::Vector3d(eig.eigenvectors().col(0));
-  return std::nullopt;
+  return max_ev > 0 ? eig.eigenvalues()(0) / max_ev : 0.0;
+}
+
+// Eigenvectors of C whose eigenvalue is below ratio x the largest, at most `max`, weakest first,
+// appended to `out` with their ratios.
+void WeakEigenvectors(const Eigen::Matrix3d& C, double ratio, int max,
+                      std::vector<Eigen::Vector3d>& out, std::vector<double>& ratios) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(C);
+  const double max_ev = eig.eigenvalues()(2);
+  for (int k = 0; k < 2 && k < max; ++k) {
+    const double r = max_ev > 0 ? eig.eigenvalues()(k) / max_ev : 0.0;
+    if (r >= ratio) break;
+    out.push_back(eig.eigenvectors().col(k));
+    ratios.push_back(r);
+  }
 }
 }  // namespace
 
@@ -407,19 +418,19 @@ IcpResult Evaluate(const IcpTarget& target, const PointCloud& source, const Eige
                    const RegistrationConfig& config) {
   IcpResult out;
   const auto [Ct, Cr] = ScorePairs(target, source, T, config, out);
-  double t_ratio = 0, r_ratio = 0;
-  Weakest(Ct, 0.0, &t_ratio);
-  Weakest(Cr, 0.0, &r_ratio);
-  out.degeneracy = std::min(t_ratio, r_ratio);
+  out.degeneracy = std::min(WeakestRatio(Ct), WeakestRatio(Cr));
   return out;
 }
 
 Weakness WeakDirections(const IcpTarget& target, const PointCloud& source,
-                        const Eigen::Isometry3d& T, const RegistrationConfig& config) {
+                        const Eigen::Isometry3d& T, const RegistrationConfig& config, double ratio,
+                        int max_per_kind) {
   IcpResult unused;
   const auto [Ct, Cr] = ScorePairs(target, source, T, config, unused);
-  return {Weakest(Ct, config.degeneracy_ratio, nullptr),
-          Weakest(Cr, config.degeneracy_ratio, nullptr)};
+  Weakness out;
+  WeakEigenvectors(Ct, ratio, max_per_kind, out.translations, out.translation_ratios);
+  WeakEigenvectors(Cr, ratio, max_per_kind, out.rotation_axes, out.rotation_ratios);
+  return out;
 }
 
 std::vector<int> EvenIndices(std::size_t size, int max_points) {

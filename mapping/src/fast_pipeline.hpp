@@ -78,11 +78,14 @@ struct IcpResult {
   double rmse_m = 0, fitness_m2 = 0, inlier_ratio = 0, degeneracy = 0;
 };
 
-/// Directions the scene constrains weakly (unit vectors in the target frame).
+/// Directions the scene constrains weakly (orthonormal unit vectors in the target frame, weakest
+/// first).
 struct Weakness {
-  std::optional<Eigen::Vector3d> translation;    ///< e.g. along a corridor
-  std::optional<Eigen::Vector3d> rotation_axis;  ///< e.g. yaw on an open plane
-  bool any() const { return translation || rotation_axis; }
+  std::vector<Eigen::Vector3d> translations;   ///< e.g. along a corridor; along and up a wall
+  std::vector<Eigen::Vector3d> rotation_axes;  ///< e.g. yaw on an open plane
+  /// Of each direction, its eigenvalue / the strongest of its kind [1].
+  std::vector<double> translation_ratios, rotation_ratios;
+  bool any() const { return !translations.empty() || !rotation_axes.empty(); }
 };
 
 /// Point-to-plane ICP, each iteration a Levenberg-Marquardt step on fixed correspondences; stops
@@ -97,10 +100,12 @@ IcpResult PointToPlaneLm(const IcpTarget& target, const PointCloud& source,
 IcpResult Evaluate(const IcpTarget& target, const PointCloud& source, const Eigen::Isometry3d& T,
                    const RegistrationConfig& config);
 
-/// The translation direction and rotation axis the target constrains most weakly at `T`, each
-/// when its eigenvalue ratio (weakest / strongest of its 3x3 block) is below degeneracy_ratio.
+/// The translation directions and rotation axes the target constrains weakly at `T`: the
+/// eigenvectors of each 3x3 constraint block whose eigenvalue is below `ratio` x the block's
+/// largest, at most `max_per_kind` of each, weakest first.
 Weakness WeakDirections(const IcpTarget& target, const PointCloud& source,
-                        const Eigen::Isometry3d& T, const RegistrationConfig& config);
+                        const Eigen::Isometry3d& T, const RegistrationConfig& config, double ratio,
+                        int max_per_kind);
 
 /// Evenly spaced indices into a cloud of `size` points, at most `max_points` of them.
 std::vector<int> EvenIndices(std::size_t size, int max_points);

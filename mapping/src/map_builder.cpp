@@ -50,7 +50,8 @@ PointCloud MapBuilder::LocalTarget(const Eigen::Isometry3d& T_map_last) const {
 }
 
 Result<MergeStep> MapBuilder::Add(const PointCloud& cloud_base,
-                                  const std::optional<Eigen::Isometry3d>& odometry_T_map_base) {
+                                  const std::optional<Eigen::Isometry3d>& odometry_T_map_base,
+                                  const std::optional<GuessUncertainty>& odometry_uncertainty) {
   MergeStep step;
   step.scan_index = scans_seen_++;
   if (trajectory_.empty()) {  // the first scan defines the map frame
@@ -71,6 +72,7 @@ Result<MergeStep> MapBuilder::Add(const PointCloud& cloud_base,
   const Eigen::Isometry3d T_map_last = trajectory_.back().T_map_base;
   RegistrationPrior prior;
   if (odometry_T_map_base) prior.odometry = T_map_last.inverse() * *odometry_T_map_base;
+  prior.odometry_uncertainty = odometry_uncertainty;
   prior.previous_motion = last_motion_ ? *last_motion_ : Eigen::Isometry3d::Identity();
   Result<RegistrationResult> r =
       Register(LocalTarget(T_map_last), cloud_base, prior, config_.registration);

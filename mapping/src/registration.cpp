@@ -50,6 +50,25 @@ std::string Percent(double ratio) {
   return os.str();
 }
 
+// The geometric constraint's limits around the prior: the config's, narrowed to the odometry
+// guess's error bound when the prior gives one (the true pose lies within it, so a pose beyond it
+// is wrong however well it fits: a grid start in the office mission fitted 58 % of the scan
+// 0.53 m from the truth, where odometry was 0.11 m off).
+struct Limits {
+  double translation_m, rotation_deg;
+  bool from_bound;  // narrowed by odometry_uncertainty
+};
+Limits ConstraintLimits(const RegistrationPrior& prior, const RegistrationConfig& config) {
+  Limits l{config.constraint_translation_m, config.constraint_rotation_deg, false};
+  if (prior.odometry && prior.odometry_uncertainty) {
+    const GuessUncertainty& u = *prior.odometry_uncertainty;
+    l.from_bound = u.translation_m < l.translation_m || u.rotation_deg < l.rotation_deg;
+    l.translation_m = std::min(l.translation_m, u.translation_m);
+    l.rotation_deg = std::min(l.rotation_deg, u.rotation_deg);
+  }
+  return l;
+}
+
 // Why `icp` may not be merged, or empty when it may.
 std::string Rejection(const IcpResult& icp, const RegistrationPrior& prior,
                       const RegistrationConfig& config) {
@@ -64,12 +83,12 @@ std::string Rejection(const IcpResult& icp, const RegistrationPrior& prior,
   } else if (prior.odometry || prior.previous_motion) {
     const PoseError d = ComparePoses(icp.T_target_source,
                                      prior.odometry ? *prior.odometry : *prior.previous_motion);
-    if (d.translation_m > config.constraint_translation_m ||
-        d.rotation_deg > config.constraint_rotation_deg) {
+    const Limits limits = ConstraintLimits(prior, config);
+    if (d.translation_m > limits.translation_m || d.rotation_deg > limits.rotation_deg) {
       os << "geometric constraint: result is " << d.translation_m << " m / " << d.rotation_deg
          << " deg from the " << (prior.odometry ? "odometry prior" : "constant-velocity motion")
-         << " (limit " << config.constraint_translation_m << " m / "
-         << config.constraint_rotation_deg << " deg)";
+         << " (limit " << limits.translation_m << " m / " << limits.rotation_deg << " deg"
+         << (limits.from_bound ? ", the odometry's error bound" : "") << ")";
     }
   }
   return os.str();
@@ -81,55 +100,213 @@ struct Prepared {
   Normals target_normals;
 };
 
-// The directions along which the solution is not unique: ICP restarted degeneracy_probe_m along
-// the weakest translation (degeneracy_probe_deg about the weakest rotation axis) does not come
-// back (a corridor; an open plane). Empty when well constrained.
+// Whether a probe that ends `away` from `at` (beyond a quarter of the probe) shows the direction
+// degenerate: below degeneracy_ratio always (in a corridor the best-fitting pose along the axis
+// may be a wrong one, so fits cannot decide there); above it only when the probe's end fits about
+// as well (inliers at most kSameFit fewer): a pose elsewhere that fits clearly worse is another,
+// poorer minimum, not a free direction.
+constexpr double kSameFit = 0.01;
+bool Undetermined(bool away, double direction_ratio, const IcpResult& at, const IcpResult& probe,
+                  const RegistrationConfig& config) {
+  if (!away) return false;
+  return direction_ratio < config.degeneracy_ratio ||
+         probe.inlier_ratio >= at.inlier_ratio - kSameFit;
+}
+
+// The directions along which the solution is not unique: of those the scene constrains weakly at
+// `at` (eigenvalue ratio below `ratio`, at most `max_per_kind` translations and rotation axes), the
+// ones along which ICP restarted degeneracy_probe_m away (degeneracy_probe_deg about the axis) does
+// not come back (a corridor; an open plane; see Undetermined). Empty when well constrained.
 Weakness DegenerateDirections(const IcpTarget& target, const PointCloud& source,
-                              const IcpResult& at, const RegistrationConfig& config) {
+                              const IcpResult& at, const RegistrationConfig& config, double ratio,
+                              int max_per_kind) {
   Weakness out;
-  if (at.degeneracy >= config.degeneracy_ratio) return out;
-  const Weakness weak = WeakDirections(target, source, at.T_target_source, config);
-  if (weak.translation) {
+  if (at.degeneracy >= ratio) return out;
+  const Weakness weak =
+      WeakDirections(target, source, at.T_target_source, config, ratio, max_per_kind);
+  for (std::size_t k = 0; k < weak.translations.size(); ++k) {
+    const Eigen::Vector3d& d = weak.translations[k];
+    if (weak.translation_ratios[k] < config.free_ratio) {  // no probe can vouch for it
+      out.translations.push_back(d);
+      out.translation_ratios.push_back(weak.translation_ratios[k]);
+      continue;
+    }
     const Eigen::Isometry3d start =
-        Eigen::Translation3d(config.degeneracy_probe_m * *weak.translation) * at.T_target_source;
+        Eigen::Translation3d(config.degeneracy_probe_m * d) * at.T_target_source;
     const IcpResult probe = PointToPlaneLm(target, source, start, config, {});
     const double back_m = ComparePoses(probe.T_target_source, at.T_target_source).translation_m;
-    if (back_m >= 0.25 * config.degeneracy_probe_m) out.translation = weak.translation;
+    if (Undetermined(back_m >= 0.25 * config.degeneracy_probe_m, weak.translation_ratios[k], at,
+                     probe, config)) {
+      out.translations.push_back(d);
+      out.translation_ratios.push_back(weak.translation_ratios[k]);
+    }
   }
-  if (weak.rotation_axis) {
-    const Eigen::Vector3d c = at.T_target_source.translation();
+  const Eigen::Vector3d c = at.T_target_source.translation();
+  for (std::size_t k = 0; k < weak.rotation_axes.size(); ++k) {
+    const Eigen::Vector3d& axis = weak.rotation_axes[k];
+    if (weak.rotation_ratios[k] < config.free_ratio) {
+      out.rotation_axes.push_back(axis);
+      out.rotation_ratios.push_back(weak.rotation_ratios[k]);
+      continue;
+    }
     const Eigen::Isometry3d turn =
         Eigen::Translation3d(c) *
-        Eigen::AngleAxisd(config.degeneracy_probe_deg * kPi / 180.0, *weak.rotation_axis) *
+        Eigen::AngleAxisd(config.degeneracy_probe_deg * kPi / 180.0, axis) *
         Eigen::Translation3d(-c);
     const IcpResult probe = PointToPlaneLm(target, source, turn * at.T_target_source, config, {});
     const double back_deg = ComparePoses(probe.T_target_source, at.T_target_source).rotation_deg;
-    if (back_deg >= 0.25 * config.degeneracy_probe_deg) out.rotation_axis = weak.rotation_axis;
+    if (Undetermined(back_deg >= 0.25 * config.degeneracy_probe_deg, weak.rotation_ratios[k], at,
+                     probe, config)) {
+      out.rotation_axes.push_back(axis);
+      out.rotation_ratios.push_back(weak.rotation_ratios[k]);
+    }
   }
   return out;
 }
 
-// ICP from `init` with the configured backend; in degenerate geometry (`freeze_weak`) the weak
-// translation direction keeps the initial guess (constant velocity / odometry carries it).
-IcpResult RunIcp(const PointCloud& source, const IcpTarget& target, const Prepared& prep,
-                 const Eigen::Isometry3d& init, const RegistrationConfig& config, bool freeze_weak,
-                 bool* degenerate) {
-  if (config.backend == RegistrationBackend::kPcl) {
-    // PCL's pipeline aligns the whole voxelized source (no subsampling).
-    const PclIcp pcl = PclIcpNonLinear(prep.target_icp, prep.source_icp, init, config);
-    IcpResult r = Evaluate(target, source, pcl.T_target_source, config);
-    r.iterations = pcl.iterations;
-    return r;
-  }
-  IcpResult r = PointToPlaneLm(target, source, init, config, {});
-  const Weakness weak = DegenerateDirections(target, source, r, config);
-  if (degenerate) *degenerate = weak.any();
-  if (freeze_weak && weak.any()) {
-    const int first = r.iterations;
-    r = PointToPlaneLm(target, source, init, config, weak);
-    r.iterations += first;
-  }
+// The feature alignment's winner is probed along its weakest translation and rotation axis.
+Weakness AmbiguousDirections(const IcpTarget& target, const PointCloud& source, const IcpResult& at,
+                             const RegistrationConfig& config) {
+  return DegenerateDirections(target, source, at, config, config.degeneracy_ratio, 1);
+}
+
+// A pose ICP reached from a guess has no feature consensus behind it, and a few points on the
+// wrong surface can make a free direction look constrained (office 26 of registration_eval, 1 cm
+// noise: facing a wall 0.37 m ahead, ICP slid 0.27 m down until the wall's foot lay on the floor;
+// up was then 13 % of the strongest constraint, and a probe 1 m up ended in a pose fitting 96 %
+// of the source vs 88 %): it is probed along every translation and rotation axis below
+// guess_degeneracy_ratio.
+Weakness GuessDegenerateDirections(const IcpTarget& target, const PointCloud& source,
+                                   const IcpResult& at, const RegistrationConfig& config) {
+  return DegenerateDirections(target, source, at, config, config.guess_degeneracy_ratio, 2);
+}
+
+// PCL's ICP-NL from `init` (backend pcl: the whole voxelized source, no subsampling), scored as
+// ours.
+IcpResult RunPclIcp(const IcpTarget& target, const PointCloud& source, const Prepared& prep,
+                    const Eigen::Isometry3d& init, const RegistrationConfig& config) {
+  const PclIcp pcl = PclIcpNonLinear(prep.target_icp, prep.source_icp, init, config);
+  IcpResult r = Evaluate(target, source, pcl.T_target_source, config);
+  r.iterations = pcl.iterations;
   return r;
+}
+
+std::string Vector(const Eigen::Vector3d& v) {
+  std::ostringstream os;
+  os.precision(2);
+  os << std::fixed << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
+  return os.str();
+}
+
+// Why the guess on `path` may not supply the `weak` directions, or empty when it may: the
+// constant-velocity motion always may (the paper's corridor assumption); odometry only with an
+// error bound within carry_max_m / carry_max_deg for the kind of direction that is weak.
+std::string UntrustedGuess(const Weakness& weak, RegistrationPath path,
+                           const RegistrationPrior& prior, const RegistrationConfig& config) {
+  if (path == RegistrationPath::kFallback) return {};
+  const std::optional<GuessUncertainty>& u = prior.odometry_uncertainty;
+  if (u && (weak.translations.empty() || u->translation_m <= config.carry_max_m) &&
+      (weak.rotation_axes.empty() || u->rotation_deg <= config.carry_max_deg)) {
+    return {};
+  }
+  std::ostringstream os;
+  os.precision(3);
+  os << "degenerate geometry leaves";
+  const char* sep = " ";
+  for (const Eigen::Vector3d& d : weak.translations) {
+    os << sep << "the translation along " << Vector(d);
+    sep = " and ";
+  }
+  for (const Eigen::Vector3d& a : weak.rotation_axes) {
+    os << sep << "the rotation about " << Vector(a);
+    sep = " and ";
+  }
+  os << " unconstrained, and the odometry guess ";
+  if (u) {
+    os << "may be " << u->translation_m << " m / " << u->rotation_deg << " deg off (carry_max_m "
+       << config.carry_max_m << ", carry_max_deg " << config.carry_max_deg << ")";
+  } else {
+    os << "has no error bound (odometry_uncertainty)";
+  }
+  os << ": the pose is not determined";
+  return os.str();
+}
+
+// `a` and the directions of `b` not (nearly) within a's, orthonormalized (a frozen set must be).
+Weakness Union(Weakness a, const Weakness& b) {
+  auto add = [](std::vector<Eigen::Vector3d>& to, std::vector<double>& ratios,
+                const Eigen::Vector3d& d, double ratio) {
+    Eigen::Vector3d r = d;
+    for (const Eigen::Vector3d& e : to) r -= r.dot(e) * e;
+    if (r.norm() < 0.5) return;
+    to.push_back(r.normalized());
+    ratios.push_back(ratio);
+  };
+  for (std::size_t k = 0; k < b.translations.size(); ++k) {
+    add(a.translations, a.translation_ratios, b.translations[k], b.translation_ratios[k]);
+  }
+  for (std::size_t k = 0; k < b.rotation_axes.size(); ++k) {
+    add(a.rotation_axes, a.rotation_ratios, b.rotation_axes[k], b.rotation_ratios[k]);
+  }
+  return a;
+}
+
+// ICP from a guess of the prior, and whether it may be merged.
+struct FromGuess {
+  IcpResult icp;
+  std::string rejection;      // empty: accepted
+  bool carried = false;       // degenerate: the weak directions were kept from the guess
+  bool undetermined = false;  // degenerate, and the guess may not supply the weak directions
+};
+
+// In degenerate geometry the guess supplies the weak directions (ICP re-run with them kept at the
+// guess) when it may (UntrustedGuess); a fit that passes the acceptance test along directions
+// nothing constrains is otherwise rejected as undetermined. The directions along which the feature
+// alignment was `ambiguous` stay so whatever ICP from the guess finds: along them the scans fit
+// several poses about equally well (office 26 of registration_eval, 1 cm noise: ICP from a guess
+// 0.5 m off ends 0.27 m from the truth in a pose its own probe finds well constrained), so they
+// are rejected, or kept at a trusted guess with the weak directions of ICP's own result.
+FromGuess IcpFromGuess(const IcpTarget& target, const PointCloud& source, const Prepared& prep,
+                       const Eigen::Isometry3d& guess, RegistrationPath path,
+                       const Weakness& ambiguous, const RegistrationPrior& prior,
+                       const RegistrationConfig& config) {
+  FromGuess out;
+  if (config.backend == RegistrationBackend::kPcl) {
+    out.icp = RunPclIcp(target, source, prep, guess, config);
+    out.rejection = Rejection(out.icp, prior, config);
+    return out;
+  }
+  if (ambiguous.any()) {  // decided before any ICP: the guess is scored where it is
+    if (std::string untrusted = UntrustedGuess(ambiguous, path, prior, config);
+        !untrusted.empty()) {
+      out.icp = Evaluate(target, source, guess, config);
+      out.rejection = std::move(untrusted);
+      out.undetermined = true;
+      return out;
+    }
+  }
+  out.icp = PointToPlaneLm(target, source, guess, config, {});
+  out.rejection = Rejection(out.icp, prior, config);
+  const std::optional<GuessUncertainty>& u = prior.odometry_uncertainty;
+  const bool may_carry =
+      path == RegistrationPath::kFallback ||
+      (u && (u->translation_m <= config.carry_max_m || u->rotation_deg <= config.carry_max_deg));
+  if (!out.rejection.empty() && !may_carry) return out;  // no probe needed: searched or failed
+  const Weakness weak =
+      Union(GuessDegenerateDirections(target, source, out.icp, config), ambiguous);
+  if (!weak.any()) return out;
+  const std::string untrusted = UntrustedGuess(weak, path, prior, config);
+  if (untrusted.empty()) {
+    const int first = out.icp.iterations;
+    out.icp = PointToPlaneLm(target, source, guess, config, weak);
+    out.icp.iterations += first;
+    out.rejection = Rejection(out.icp, prior, config);
+    out.carried = true;
+  } else if (out.rejection.empty()) {
+    out.rejection = untrusted;
+    out.undetermined = true;
+  }
+  return out;
 }
 
 // NARF on the dense scans (range images need one return per beam) + the same RANSAC.
@@ -225,17 +402,21 @@ struct Start {
 };
 
 // The 3 x 3 x 3 grid over the guess's uncertainty (guess_search_m, guess_search_deg about the
-// vertical): neighbours lie guess_search_m apart, so every pose of the region is within ICP's
-// capture range of one (0.6 m spacing, 0.5 m gate; a 12 deg turn moves a point 5 m out 0.5 m).
-std::vector<Start> GuessGrid(const Start& guess, const RegistrationConfig& config) {
+// vertical, or the odometry's error bound where that is tighter): neighbours lie guess_search_m
+// apart, so every pose of the region is within ICP's capture range of one (0.6 m spacing, 0.5 m
+// gate; a 12 deg turn moves a point 5 m out 0.5 m).
+std::vector<Start> GuessGrid(const Start& guess, const RegistrationPrior& prior,
+                             const RegistrationConfig& config) {
+  const Limits limits = ConstraintLimits(prior, config);
+  const double step_m = std::min(config.guess_search_m, limits.translation_m);
+  const double step_deg = std::min(config.guess_search_deg, limits.rotation_deg);
   std::vector<Start> out;
   for (int ix = -1; ix <= 1; ++ix) {
     for (int iy = -1; iy <= 1; ++iy) {
       for (int iyaw = -1; iyaw <= 1; ++iyaw) {
         if (ix == 0 && iy == 0 && iyaw == 0) continue;  // the guess itself
         out.push_back(
-            {guess.T * PoseFromXyzRpyDeg(ix * config.guess_search_m, iy * config.guess_search_m, 0,
-                                         0, 0, iyaw * config.guess_search_deg),
+            {guess.T * PoseFromXyzRpyDeg(ix * step_m, iy * step_m, 0, 0, 0, iyaw * step_deg),
              guess.path, "a grid of starts around " + guess.name});
       }
     }
@@ -319,18 +500,19 @@ Verified VerifyHypotheses(const PointCloud& source, const IcpTarget& target, con
   const std::vector<IcpResult> screened = verify(starts, 2);
   if (guess && config.guess_search_m > 0 && sac.inliers < 2 * config.sac_min_inliers &&
       !SamePose(screened.back().T_target_source, best.icp.T_target_source, config)) {
-    verify(GuessGrid(*guess, config), 2);
+    verify(GuessGrid(*guess, prior, config), 2);
   }
   if (best.icp.degeneracy < config.degeneracy_ratio && config.degeneracy_search_m > 0) {
-    const Weakness weak = WeakDirections(target, source, best.icp.T_target_source, config);
-    if (weak.translation) {
+    const Weakness weak = WeakDirections(target, source, best.icp.T_target_source, config,
+                                         config.degeneracy_ratio, 1);
+    if (!weak.translations.empty()) {
       const double step = 0.5 * config.icp_max_distance_m;
       const int steps = static_cast<int>(std::ceil(config.degeneracy_search_m / step));
       std::vector<Start> along;
       for (int k = -steps; k <= steps; ++k) {
         if (k == 0) continue;
         along.push_back(
-            {Eigen::Translation3d(k * step * *weak.translation) * best.icp.T_target_source,
+            {Eigen::Translation3d(k * step * weak.translations.front()) * best.icp.T_target_source,
              best.path, "starts along the weakly constrained direction"});
       }
       verify(along, 2);
@@ -346,7 +528,7 @@ std::optional<IcpResult> SearchAroundGuess(const IcpTarget& target, const PointC
                                            const Start& guess, const RegistrationPrior& prior,
                                            const RegistrationConfig& config, int& iterations) {
   std::vector<Eigen::Isometry3d> poses;
-  for (const Start& s : GuessGrid(guess, config)) poses.push_back(s.T);
+  for (const Start& s : GuessGrid(guess, prior, config)) poses.push_back(s.T);
   std::vector<IcpResult> screened = Screen(target, source, poses, config, iterations);
   std::stable_sort(screened.begin(), screened.end(),
                    [](const auto& a, const auto& b) { return a.inlier_ratio > b.inlier_ratio; });
@@ -412,6 +594,14 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
   }
   if (auto ok = CheckCloud(target, "target"); !ok) return tl::make_unexpected(ok.error());
   if (auto ok = CheckCloud(source, "source"); !ok) return tl::make_unexpected(ok.error());
+  if (const auto& u = prior.odometry_uncertainty;
+      u && !(u->translation_m >= 0 && std::isfinite(u->translation_m) && u->rotation_deg >= 0 &&
+             std::isfinite(u->rotation_deg))) {
+    std::ostringstream os;
+    os << "odometry_uncertainty must be finite and >= 0, got " << u->translation_m << " m / "
+       << u->rotation_deg << " deg";
+    return Fail(Error::Code::kInvalidArgument, os.str());
+  }
 
   RegistrationResult out;
   Stopwatch total, lap;
@@ -446,11 +636,11 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
   // Geometric constraint: around the odometry prior, else around the constant-velocity motion.
   std::optional<PriorRegion> region;
   if (const auto& centre = prior.odometry ? prior.odometry : prior.previous_motion; centre) {
-    region = PriorRegion{*centre, config.constraint_translation_m,
-                         config.constraint_rotation_deg * kPi / 180.0};
+    const Limits limits = ConstraintLimits(prior, config);
+    region = PriorRegion{*centre, limits.translation_m, limits.rotation_deg * kPi / 180.0};
   }
   std::vector<std::string> notes;
-  bool ambiguous = false;
+  Weakness ambiguous;  // directions the feature alignment left undetermined
   // 3-4. Features and sample-consensus initial alignment.
   if (config.features != FeatureKind::kNone) {
     SacResult sac;
@@ -478,17 +668,20 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
       RegistrationPath path = RegistrationPath::kFeatures;
       std::string note;
       if (config.backend == RegistrationBackend::kPcl) {
-        icp = RunIcp(icp_source, icp_target, prep, sac.T_target_source, config, false, &ambiguous);
+        icp = RunPclIcp(icp_target, icp_source, prep, sac.T_target_source, config);
       } else {
         const Verified v = VerifyHypotheses(icp_source, icp_target, sac, prior, config);
         icp = v.icp, path = v.path, note = v.note;
         out.iterations += v.iterations - icp.iterations;  // Fill adds the winner's own
-        ambiguous = DegenerateDirections(icp_target, icp_source, icp, config).any();
+      }
+      const std::string rejection = Rejection(icp, prior, config);
+      // Only a fit that passes the acceptance test says anything about the scene's degeneracy.
+      if (config.backend == RegistrationBackend::kFast && rejection.empty()) {
+        ambiguous = AmbiguousDirections(icp_target, icp_source, icp, config);
       }
       out.timings.icp_s += lap.Lap();
       Fill(out, icp, path);
-      const std::string rejection = Rejection(icp, prior, config);
-      if (!ambiguous && rejection.empty()) {
+      if (!ambiguous.any() && rejection.empty()) {
         out.success = true;
         out.reason = note.empty() ? std::string(ToString(path)) : note;
         out.timings.total_s = total.Lap();
@@ -496,7 +689,7 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
       }
       std::ostringstream os;
       os.precision(3);
-      if (ambiguous) {
+      if (ambiguous.any()) {
         os << "feature alignment ambiguous: degenerate geometry (ICP restarted "
            << config.degeneracy_probe_m << " m / " << config.degeneracy_probe_deg
            << " deg along the weakest direction does not come back)";
@@ -518,11 +711,9 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
     guesses.emplace_back(RegistrationPath::kFallback, *prior.previous_motion);
   }
   for (const auto& [path, guess] : guesses) {
-    bool degenerate = false;
-    IcpResult icp = RunIcp(icp_source, icp_target, prep, guess, config, true, &degenerate);
-    std::string rejection = Rejection(icp, prior, config);
+    FromGuess g = IcpFromGuess(icp_target, icp_source, prep, guess, path, ambiguous, prior, config);
     bool searched = false;
-    if (!rejection.empty() && config.backend == RegistrationBackend::kFast &&
+    if (!g.rejection.empty() && !g.undetermined && config.backend == RegistrationBackend::kFast &&
         config.guess_search_m > 0) {
       int iterations = 0;
       const std::optional<IcpResult> found = SearchAroundGuess(
@@ -530,27 +721,31 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
       out.iterations += iterations;
       // Only a pose the scene pins down may replace the guess: in a corridor a grid start fits
       // anywhere along the axis, and nothing says where.
-      if (found && !DegenerateDirections(icp_target, icp_source, *found, config).any()) {
-        notes.push_back(std::string("ICP from the ") + ToString(path) + " guess: " + rejection);
-        icp = *found, rejection.clear(), searched = true, degenerate = false;
-        out.iterations -= icp.iterations;  // Fill adds the winner's own
+      if (found && !GuessDegenerateDirections(icp_target, icp_source, *found, config).any()) {
+        notes.push_back(std::string("ICP from the ") + ToString(path) + " guess: " + g.rejection);
+        g.icp = *found, g.rejection.clear(), searched = true, g.carried = false;
+        out.iterations -= g.icp.iterations;  // Fill adds the winner's own
       } else if (found) {
-        rejection +=
+        g.rejection +=
             " (a grid of starts around the guess fits, but degenerate geometry leaves the "
             "pose undetermined there)";
       }
     }
     out.timings.icp_s += lap.Lap();
-    Fill(out, icp, path);
-    if (rejection.empty()) {
+    Fill(out, g.icp, path);
+    if (g.rejection.empty()) {
       out.success = true;
+      const char* carried =
+          path == RegistrationPath::kFallback
+              ? " (degenerate: constant velocity assumed along the weak directions)"
+              : " (degenerate: the weak directions kept from the odometry guess, "
+                "whose error bound is within carry_max_m / carry_max_deg)";
       notes.push_back(
-          std::string("took the ") + ToString(path) + " path" +
-          (degenerate ? " (degenerate: the weak directions kept from the guess)" : "") +
+          std::string("took the ") + ToString(path) + " path" + (g.carried ? carried : "") +
           (searched ? " (ICP from the best of a grid of starts around the guess)" : ""));
       break;
     }
-    notes.push_back(std::string(ToString(path)) + " path rejected: " + rejection);
+    notes.push_back(std::string(ToString(path)) + " path rejected: " + g.rejection);
   }
   if (!out.success && guesses.empty()) {
     notes.push_back("no odometry prior or previous motion to fall back on");

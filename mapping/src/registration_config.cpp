@@ -53,11 +53,15 @@ void VisitFields(RegistrationConfig& c, Visitor&& v) {
   v("sac_min_inliers", c.sac_min_inliers);
   v("sac_hypotheses", c.sac_hypotheses);
   v("degeneracy_ratio", c.degeneracy_ratio);
+  v("guess_degeneracy_ratio", c.guess_degeneracy_ratio);
+  v("free_ratio", c.free_ratio);
   v("degeneracy_probe_m", c.degeneracy_probe_m);
   v("degeneracy_probe_deg", c.degeneracy_probe_deg);
   v("degeneracy_search_m", c.degeneracy_search_m);
   v("guess_search_m", c.guess_search_m);
   v("guess_search_deg", c.guess_search_deg);
+  v("carry_max_m", c.carry_max_m);
+  v("carry_max_deg", c.carry_max_deg);
   v("icp_max_iterations", c.icp_max_iterations);
   v("icp_epsilon", c.icp_epsilon);
   v("icp_max_distance_m", c.icp_max_distance_m);
@@ -124,6 +128,10 @@ void RegistrationConfig::Validate() const {
           "must be in [1, 16]");
   require(degeneracy_ratio >= 0 && degeneracy_ratio < 1, "degeneracy_ratio", degeneracy_ratio,
           "must be in [0, 1)");
+  require(guess_degeneracy_ratio >= 0 && guess_degeneracy_ratio < 1, "guess_degeneracy_ratio",
+          guess_degeneracy_ratio, "must be in [0, 1)");
+  require(free_ratio >= 0 && free_ratio <= degeneracy_ratio, "free_ratio", free_ratio,
+          "must be in [0, degeneracy_ratio]");
   require(degeneracy_probe_m > 0, "degeneracy_probe_m", degeneracy_probe_m, "must be > 0");
   require(degeneracy_probe_deg > 0 && degeneracy_probe_deg < 90, "degeneracy_probe_deg",
           degeneracy_probe_deg, "must be in (0, 90)");
@@ -131,6 +139,8 @@ void RegistrationConfig::Validate() const {
   require(guess_search_m >= 0, "guess_search_m", guess_search_m, "must be >= 0");
   require(guess_search_deg >= 0 && guess_search_deg < 90, "guess_search_deg", guess_search_deg,
           "must be in [0, 90)");
+  require(carry_max_m >= 0, "carry_max_m", carry_max_m, "must be >= 0");
+  require(carry_max_deg >= 0, "carry_max_deg", carry_max_deg, "must be >= 0");
   require(icp_max_iterations >= 1, "icp_max_iterations", icp_max_iterations, "must be >= 1");
   require(icp_epsilon > 0, "icp_epsilon", icp_epsilon, "must be > 0");
   require(icp_max_distance_m > 0, "icp_max_distance_m", icp_max_distance_m, "must be > 0");

@@ -1,45 +1,61 @@
 #pragma once
 // A spatial hash of points in cubic cells: fixed-radius and nearest-neighbour queries that look at
-// the 27 cells around the query. Faster than a k-d tree when the radius is known up front.
+// the cells (at most 27) the query ball reaches. Faster than a k-d tree when the radius is known up
+// front. ICP asks it millions of times per pair, so the cells live in a flat open-addressing table
+// and the points are copied in cell order (one contiguous run per cell).
 
 #include <cmath>
 #include <cstdint>
-#include <unordered_map>
-#include <utility>
 #include <vector>
 
 #include "pitchlab/mapping/point_cloud.hpp"
 
 namespace pitchlab::mapping {
 
-/// Key of the cell holding `p` for cells of edge 1 / `inv_cell`.
-inline std::uint64_t CellKey(const Eigen::Vector3f& p, float inv_cell) {
-  const auto q = [inv_cell](float v) {
-    return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v * inv_cell)) +
-                                      (1 << 20)) &
-           0x1FFFFF;
+/// Key of the integer cell (x, y, z), each coordinate within +-2^20.
+inline std::uint64_t CellKey(std::int64_t x, std::int64_t y, std::int64_t z) {
+  const auto q = [](std::int64_t v) {
+    return static_cast<std::uint64_t>(v + (1 << 20)) & 0x1FFFFF;
   };
-  return (q(p.x()) << 42) | (q(p.y()) << 21) | q(p.z());
+  return (q(x) << 42) | (q(y) << 21) | q(z);
 }
 
-/// Points of a cloud (held by reference: it must outlive the index) bucketed by cell.
+/// Key of the cell holding `p` for cells of edge 1 / `inv_cell`.
+inline std::uint64_t CellKey(const Eigen::Vector3f& p, float inv_cell) {
+  const auto c = [inv_cell](float v) {
+    return static_cast<std::int64_t>(std::floor(v * inv_cell));
+  };
+  return CellKey(c(p.x()), c(p.y()), c(p.z()));
+}
+
+/// Points of a cloud bucketed by cell (a copy: the cloud need not outlive the index).
 class VoxelHashIndex {
  public:
   VoxelHashIndex(const PointCloud& cloud, double cell_m);
 
-  /// Indices of points within `radius_m` (<= the cell edge) of `q`, appended to `out`.
+  /// Indices of points within `radius_m` (<= the cell edge) of `q`, appended to `out` in the order
+  /// of their cells (x, then y, then z ascending) and, within a cell, of their indices.
   void Radius(const Eigen::Vector3f& q, float radius_m, std::vector<int>& out) const;
   /// Nearest point within `max_m` (<= the cell edge), or -1; its squared distance in `d2`.
   int Nearest(const Eigen::Vector3f& q, float max_m, float& d2) const;
 
  private:
-  template <typename F>
-  void ForCells(const Eigen::Vector3f& q, F&& f) const;
+  struct Slot {
+    std::uint64_t key;
+    int begin, end;  // [begin, end) in points_ / order_
+  };
+  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // no CellKey has all 64 bits set
 
-  const PointCloud& cloud_;
-  float cell_m_, inv_cell_;
-  std::vector<int> order_;                                        // point indices sorted by cell
-  std::unordered_map<std::uint64_t, std::pair<int, int>> cells_;  // key -> [begin, end) in order_
+  const Slot* Find(std::uint64_t key) const;
+  // Calls f(begin, end) for every occupied cell the ball (q, radius_m) reaches.
+  template <typename F>
+  void ForCells(const Eigen::Vector3f& q, float radius_m, F&& f) const;
+
+  float inv_cell_;
+  std::vector<Eigen::Vector3f> points_;  // the cloud's points sorted by cell
+  std::vector<int> order_;               // index into the cloud of each of points_
+  std::vector<Slot> slots_;              // open addressing, linear probing; size a power of two
+  std::uint64_t mask_ = 0;
 };
 
 }  // namespace pitchlab::mapping

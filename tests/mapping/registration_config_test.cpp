@@ -53,6 +53,10 @@ TEST(RegistrationConfig, AWrongTypeOrValueIsAnErrorNamingFieldAndValue) {
             std::string::npos);
   EXPECT_NE(ErrorOf("registration: {guess_search_deg: 90}").find("must be in [0, 90)"),
             std::string::npos);
+  EXPECT_NE(ErrorOf("registration: {carry_max_m: -0.1}").find("registration.carry_max_m = -0.1"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("registration: {guess_degeneracy_ratio: 1}").find("must be in [0, 1)"),
+            std::string::npos);
 }
 
 TEST(RegistrationConfig, YamlRoundTripGivesTheSameConfig) {

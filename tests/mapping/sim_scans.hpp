@@ -15,11 +15,14 @@
 
 namespace pitchlab::mapping::testing {
 
-/// A full seed-pattern scan (361 x 200, 5 mm noise) of `world` from (x, y, yaw); throws on failure.
+/// A full seed-pattern scan (361 x 200, `noise_sigma_m` range noise) of `world` from (x, y, yaw);
+/// throws on failure.
 inline sensors::Scan3D SimulatedScan(const std::string& world, double x_m, double y_m,
-                                     double yaw_deg, std::uint64_t seed = 1) {
+                                     double yaw_deg, std::uint64_t seed = 1,
+                                     double noise_sigma_m = 0.005) {
   std::ostringstream name;
-  name << world << "_" << x_m << "_" << y_m << "_" << yaw_deg << "_s" << seed << ".pcd";
+  name << world << "_" << x_m << "_" << y_m << "_" << yaw_deg << "_s" << seed << "_n"
+       << noise_sigma_m << ".pcd";
   // Keyed by this test binary's build time: it relinks whenever the simulator or a world
   // library changes, so a cached scan never outlives the code that made it.
   const auto built = std::filesystem::last_write_time("/proc/self/exe").time_since_epoch().count();
@@ -33,6 +36,7 @@ inline sensors::Scan3D SimulatedScan(const std::string& world, double x_m, doubl
   }
   sim::SimRigConfig config;
   config.lms200.seed = seed;
+  config.lms200.noise_sigma_m = noise_sigma_m;
   sim::SimRig rig(std::string(PITCHLAB_WORLDS_DIR) + "/" + world + ".xml", config);
   Result<Eigen::Isometry3d> pose = rig.PlaceRobot(x_m, y_m, yaw_deg * M_PI / 180.0);
   if (!pose) throw std::runtime_error(world + ": " + pose.error().message);

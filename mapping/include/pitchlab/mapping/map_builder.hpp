@@ -46,11 +46,14 @@ class MapBuilder {
   explicit MapBuilder(const MapConfig& config);  ///< validates; throws std::invalid_argument
 
   /// Registers `cloud_base` (points in its base_link [m]) against the map and merges it when the
-  /// registration succeeds. `odometry_T_map_base`: odometry's guess of its pose, when known.
-  /// Errors: bad input (see Register). A failed registration is a step with merged == false.
+  /// registration succeeds. `odometry_T_map_base`: odometry's guess of its pose, when known;
+  /// `odometry_uncertainty`: how far that guess may be off the motion since the last merged scan
+  /// (see RegistrationPrior). Errors: bad input (see Register). A failed registration is a step
+  /// with merged == false.
   [[nodiscard]] Result<MergeStep> Add(
       const PointCloud& cloud_base,
-      const std::optional<Eigen::Isometry3d>& odometry_T_map_base = {});
+      const std::optional<Eigen::Isometry3d>& odometry_T_map_base = {},
+      const std::optional<GuessUncertainty>& odometry_uncertainty = {});
 
   /// The merged map in `map` [m], one centroid per voxel.
   PointCloud MapCloud() const;

@@ -24,10 +24,22 @@ enum class RegistrationPath {
 /// "features", "odometry", "fallback".
 const char* ToString(RegistrationPath path);
 
+/// How far a guess may be off the true motion at most (e.g. odometry's drift over the step).
+struct GuessUncertainty {
+  double translation_m = 0;  ///< [m]
+  double rotation_deg = 0;   ///< [deg]
+};
+
 /// What the caller knows before aligning. Both transforms are T_target_source.
 struct RegistrationPrior {
   std::optional<Eigen::Isometry3d> odometry;         ///< odometry's guess; enables the constraint
   std::optional<Eigen::Isometry3d> previous_motion;  ///< last pair's estimate (constant velocity)
+  /// How far `odometry` may be off; unset: unknown. Where the scans leave a direction unconstrained
+  /// (a corridor's axis, yaw on an open plane) only an odometry guess bounded within the config's
+  /// carry_max_m / carry_max_deg may supply it; else the odometry path reports a failure. The
+  /// bound also narrows the geometric constraint (constraint_translation_m / _rotation_deg) and
+  /// the grid searched around the guess (guess_search_m / _deg) to itself. Finite, >= 0.
+  std::optional<GuessUncertainty> odometry_uncertainty;
 };
 
 /// Wall time per stage [s] (for both clouds together).
