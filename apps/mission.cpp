@@ -140,6 +140,9 @@ class Mission {
   Eigen::Isometry3d T_world_map_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_world_base_ = Eigen::Isometry3d::Identity();  // estimate at odo_ref_
   sensors::Odometry odo_ref_;
+  // Odometry distance [m] and clock [s] at the last merged scan: the prior's error bound grows
+  // from there.
+  double merged_distance_m_ = 0, merged_stamp_s_ = 0;
   bool last_stop_turned_only_ = false;  // the previous stop only turned to look ahead
   bool backed_off_ = false;             // the last drive ended backing off from a tilt
   std::vector<FeltHazard> felt_;
@@ -209,8 +212,16 @@ bool Mission::Stop(int k) {
   const std::optional<Eigen::Isometry3d> prior =
       k == 0 ? std::nullopt
              : std::optional<Eigen::Isometry3d>(T_world_map_.inverse() * stop.T_world_base_odom);
-  Result<mapping::MergeStep> merge = builder_.Add(mapping::CloudFromScan(stop.scan), prior);
+  const mapping::GuessUncertainty bound{
+      config_.odometry_error_m +
+          config_.odometry_error_per_m * (result_.odometry_distance_m - merged_distance_m_),
+      config_.odometry_error_deg + config_.odometry_error_dps * (stop.stamp_s - merged_stamp_s_)};
+  Result<mapping::MergeStep> merge = builder_.Add(mapping::CloudFromScan(stop.scan), prior, bound);
   if (merge) stop.merge = *merge;
+  if (stop.merge.merged) {
+    merged_distance_m_ = result_.odometry_distance_m;
+    merged_stamp_s_ = stop.stamp_s;
+  }
   if (!merge) stop.merge.registration.reason = merge.error().message;
   // A failed registration is never merged: the pose comes from odometry and the map keeps
   // what it had.

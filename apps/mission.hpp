@@ -45,6 +45,19 @@ struct MissionConfig {
   /// centimetres a cell: overlapping far views of two scans read as steps and slopes that cut
   /// every way (terrain). The robot rescans every drive_per_stop_m, well inside this [m].
   double map_range_m = 10.0;
+  /// How far odometry may be off the motion since the last merged scan (plus that scan's own
+  /// registration error), the registration prior's error bound (mapping::GuessUncertainty): it
+  /// narrows the geometric constraint and the search around the guess to itself, and lets
+  /// odometry supply what the scene leaves free. odometry_error_m + odometry_error_per_m x the
+  /// distance driven [m] ... (terrain runs, the worst ground: 0.16 m median, 0.56 m p95 over ~3 m;
+  /// office: 0.12 m at most)
+  double odometry_error_m = 0.3;
+  double odometry_error_per_m = 0.3;  ///< ... [m/m]
+  /// ... and odometry_error_deg + odometry_error_dps x the time elapsed [deg]: the gyro's drift
+  /// (0.017 deg/s p95) and the roll/pitch errors of the attitude sensor and the last registration
+  /// (terrain: 0.6 deg median, 4.5 deg p99 between stops).
+  double odometry_error_deg = 5.0;
+  double odometry_error_dps = 0.03;  ///< ... [deg/s]
   /// Clearance kept beyond the robot's half width when planning, for tracking error [m].
   double safety_margin_m = 0.08;
   /// The robot stops this far before the first unobserved cell of its plan, turns to face it and
@@ -85,15 +98,15 @@ struct StopRecord {
   Eigen::Isometry3d T_world_base_odom = Eigen::Isometry3d::Identity();  ///< odometry's pose
   Eigen::Isometry3d T_world_base = Eigen::Isometry3d::Identity();       ///< the estimate used
   std::optional<Eigen::Isometry3d> T_world_base_true;                   ///< simulation only
-  std::optional<planning::Path> plan;    ///< to the goal, world frame
-  std::string plan_error;                ///< why there was no plan
-  std::string plan_note;                 ///< how the plan was found, when not the plain way
+  std::optional<planning::Path> plan;  ///< to the goal, world frame
+  std::string plan_error;              ///< why there was no plan
+  std::string plan_note;               ///< how the plan was found, when not the plain way
   /// Recovery: planned through cells taken for hazards (inferred drops, hazards around a goal
   /// seen from afar) as unknown, to look from closer (plan_note says which).
   bool look_closer = false;
   double plan_to_doubt_m = 0;  ///< with look_closer: plan length before the first such cell [m]
-  double plan_known_m = 0;               ///< length of the plan over observed cells [m]
-  int felt_hazards = 0;                  ///< places marked too steep by the tilt so far
+  double plan_known_m = 0;     ///< length of the plan over observed cells [m]
+  int felt_hazards = 0;        ///< places marked too steep by the tilt so far
   bool elevation_from_odometry = false;  ///< registration failed: the scan entered the elevation
                                          ///< map at the odometry pose
   double distance_to_goal_m = 0;         ///< from the estimate [m]

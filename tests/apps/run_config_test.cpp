@@ -41,16 +41,16 @@ TEST(RunSettings, TheLoadedP3AtPlansToSixteenDegrees) {
   const RunSettings footprint =
       ParseRunSettings("run: {inclination_radius_m: 0.25}\n", "test", sim::P3Model::kP3AT);
   EXPECT_EQ(footprint.mission.layers.inclination_radius_cells, 2);
-  const RunSettings coarse = ParseRunSettings(
-      "run: {cell_m: 0.25, inclination_radius_m: 0.25}\n", "test", sim::P3Model::kP3AT);
+  const RunSettings coarse = ParseRunSettings("run: {cell_m: 0.25, inclination_radius_m: 0.25}\n",
+                                              "test", sim::P3Model::kP3AT);
   EXPECT_EQ(coarse.mission.layers.inclination_radius_cells, 1);
   EXPECT_THROW(ParseRunSettings("run: {scan_tilt_deg: 25}\n", "t", sim::P3Model::kP3AT),
                std::invalid_argument);  // above caution_tilt_deg
   EXPECT_THROW(ParseRunSettings("run: {map_range_m: 0.5}\n", "t", sim::P3Model::kP3AT),
                std::invalid_argument);  // inside the robot's own footprint
-  EXPECT_NEAR(ParseRunSettings("run: {map_range_m: 25}\n", "t", sim::P3Model::kP3AT)
-                  .mission.map_range_m,
-              25.0, 1e-12);
+  EXPECT_NEAR(
+      ParseRunSettings("run: {map_range_m: 25}\n", "t", sim::P3Model::kP3AT).mission.map_range_m,
+      25.0, 1e-12);
 }
 
 TEST(RunSettings, RunKeysAreReadAndBadOnesNamed) {
@@ -64,16 +64,58 @@ TEST(RunSettings, RunKeysAreReadAndBadOnesNamed) {
     ParseRunSettings("run: {drive_per_stop: 2}\n", "f.yaml", sim::P3Model::kP3AT);
     FAIL() << "an unknown key was accepted";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("f.yaml: run.drive_per_stop"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("f.yaml: run.drive_per_stop"), std::string::npos)
+        << e.what();
   }
   EXPECT_THROW(ParseRunSettings("run: {cell_m: 5}\n", "f.yaml", sim::P3Model::kP3AT),
                std::invalid_argument);
 }
 
+// Scan-to-map registration keeps its own acceptance (registration_eval's pairwise defaults
+// reject the low-overlap stops of a run), unless the config's registration section says otherwise
+// key by key.
+TEST(RunSettings, TheRunRegistersWithScanToMapDefaultsAKeyGivenWins) {
+  const mapping::RegistrationConfig pairwise;
+  const RunSettings s = ParseRunSettings("", "t", sim::P3Model::kP3AT);
+  const mapping::RegistrationConfig& r = s.mission.registration.registration;
+  EXPECT_EQ(r.max_rmse_m, 0.06);
+  EXPECT_EQ(r.min_inlier_ratio, 0.15);
+  EXPECT_EQ(r.constraint_translation_m, 1.0);
+  EXPECT_GT(r.carry_max_m, s.mission.odometry_error_m + 4 * s.mission.odometry_error_per_m)
+      << "a 4 m drive's bound must let odometry supply a corridor's axis";
+  EXPECT_LT(pairwise.max_rmse_m, r.max_rmse_m);
+  const RunSettings given = ParseRunSettings(
+      "registration: {max_rmse_m: 0.02, icp_max_iterations: 30}\n", "t", sim::P3Model::kP3AT);
+  const mapping::RegistrationConfig& g = given.mission.registration.registration;
+  EXPECT_EQ(g.max_rmse_m, 0.02);
+  EXPECT_EQ(g.icp_max_iterations, 30);
+  EXPECT_EQ(g.min_inlier_ratio, 0.15);  // not given: the run's
+  EXPECT_EQ(g.carry_max_m, r.carry_max_m);
+}
+
+TEST(RunSettings, TheOdometryErrorBoundIsReadAndANegativeOneNamed) {
+  const RunSettings s = ParseRunSettings(
+      "run: {odometry_error_m: 0.1, odometry_error_per_m: 0.05, odometry_error_deg: 1, "
+      "odometry_error_dps: 0.02}\n",
+      "f.yaml", sim::P3Model::kP3DX);
+  EXPECT_EQ(s.mission.odometry_error_m, 0.1);
+  EXPECT_EQ(s.mission.odometry_error_per_m, 0.05);
+  EXPECT_EQ(s.mission.odometry_error_deg, 1.0);
+  EXPECT_EQ(s.mission.odometry_error_dps, 0.02);
+  try {
+    ParseRunSettings("run: {odometry_error_deg: -1}\n", "f.yaml", sim::P3Model::kP3DX);
+    FAIL() << "a negative bound was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("f.yaml: run.odometry_error_deg"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(RunSettings, WrittenYamlReadsBackTheSame) {
   const RunSettings s = ParseRunSettings(
-      "run: {goal_tolerance_m: 0.3}\nplanner: {weights: {roughness: 5}}\n", "t",
-      sim::P3Model::kP3AT);
+      "run: {goal_tolerance_m: 0.3, odometry_error_m: 0.2}\nplanner: {weights: {roughness: 5}}\n"
+      "registration: {max_rmse_m: 0.03}\n",
+      "t", sim::P3Model::kP3AT);
   const RunSettings back = ParseRunSettings(RunSettingsToYaml(s), "back", sim::P3Model::kP3AT);
   EXPECT_EQ(RunSettingsToYaml(back), RunSettingsToYaml(s));
 }
