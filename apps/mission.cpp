@@ -99,6 +99,8 @@ class Mission {
 
  private:
   bool Stop(int k);  // false: the mission ends (result_.reason says why)
+  // Registration failed: the odometry pose's height from the map's ground (FitHeightOffset).
+  void LevelOnMap(StopRecord& stop) const;
   void UpdateElevation(const StopRecord& stop);
   void Plan(StopRecord& stop) const;
   tl::expected<planning::Path, planning::NoPath> PlanOn(const planning::TraversabilityGrid& grid,
@@ -227,12 +229,14 @@ bool Mission::Stop(int k) {
   // what it had.
   stop.T_world_base =
       stop.merge.merged ? T_world_map_ * stop.merge.T_map_base : stop.T_world_base_odom;
-  T_world_base_ = stop.T_world_base;
-  odo_ref_ = *odo;
   // A scan whose registration failed is never merged into the map cloud; the elevation map
   // still takes it at the odometry pose (said in the stop record), or an unregistrable stretch
-  // of terrain would stay unknown and the robot could never plan across it.
+  // of terrain would stay unknown and the robot could never plan across it. That pose's height
+  // comes from the map's ground where the scan overlaps it.
   stop.elevation_from_odometry = !stop.merge.merged;
+  if (stop.elevation_from_odometry) LevelOnMap(stop);
+  T_world_base_ = stop.T_world_base;
+  odo_ref_ = *odo;
   UpdateElevation(stop);
   stop.distance_to_goal_m = (config_.goal_m - stop.T_world_base.translation().head<2>()).norm();
   const bool arrived = stop.distance_to_goal_m <= config_.goal_tolerance_m;
@@ -259,6 +263,19 @@ bool Mission::Stop(int k) {
     return false;
   }
   return Drive(s);
+}
+
+void Mission::LevelOnMap(StopRecord& stop) const {
+  const Eigen::Isometry3f T = stop.T_world_base.cast<float>();
+  std::vector<Eigen::Vector3f> near;
+  for (const sensors::ScanPoint& p : stop.scan.points) {
+    if (p.range_m <= config_.map_range_m) near.push_back(T * Eigen::Vector3f(p.x, p.y, p.z));
+  }
+  const std::optional<HeightOffset> fit = FitHeightOffset(result_.elevation, near);
+  constexpr double kMaxShift_m = 2.0;  // beyond: the map or the scan gone wrong, not drift
+  if (!fit || std::abs(fit->dz_m) > kMaxShift_m) return;
+  stop.T_world_base.translation().z() -= fit->dz_m;
+  stop.height_fit = fit;
 }
 
 void Mission::UpdateElevation(const StopRecord& stop) {

@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 
+#include "height_fit.hpp"
 #include "path_follower.hpp"
 #include "pitchlab/mapping/elevation_map.hpp"
 #include "pitchlab/mapping/map_builder.hpp"
@@ -109,7 +110,10 @@ struct StopRecord {
   int felt_hazards = 0;        ///< places marked too steep by the tilt so far
   bool elevation_from_odometry = false;  ///< registration failed: the scan entered the elevation
                                          ///< map at the odometry pose
-  double distance_to_goal_m = 0;         ///< from the estimate [m]
+  /// With elevation_from_odometry: the height that pose took from the map's ground
+  /// (FitHeightOffset), when the scan overlapped enough of it.
+  std::optional<HeightOffset> height_fit;
+  double distance_to_goal_m = 0;  ///< from the estimate [m]
 };
 
 /// A pose of the robot while driving (sampled every control period).

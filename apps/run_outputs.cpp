@@ -122,21 +122,25 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
   nlohmann::json matrix = nlohmann::json::array();
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j) matrix.push_back(stop.merge.T_map_base.matrix()(i, j));
-  nlohmann::json j = {{"stop", stop.index},
-                      {"stamp_s", stop.stamp_s},
-                      {"merged", stop.merge.merged},
-                      {"elevation_from_odometry", stop.elevation_from_odometry},
-                      {"success", reg.success},
-                      {"reason", reg.reason},
-                      {"path", mapping::ToString(reg.path)},
-                      {"fitness_m2", reg.fitness_m2},
-                      {"rmse_m", reg.rmse_m},
-                      {"inlier_ratio", reg.inlier_ratio},
-                      {"iterations", reg.iterations},
-                      {"timings_s", StageTimingsJson(reg.timings)},
-                      {"T_map_base", matrix},
-                      {"estimate", PoseJson(stop.T_world_base)},
-                      {"odometry", PoseJson(stop.T_world_base_odom)}};
+  nlohmann::json j = {
+      {"stop", stop.index},
+      {"stamp_s", stop.stamp_s},
+      {"merged", stop.merge.merged},
+      {"elevation_from_odometry", stop.elevation_from_odometry},
+      {"height_fit", stop.height_fit ? nlohmann::json{{"dz_m", stop.height_fit->dz_m},
+                                                      {"cells", stop.height_fit->cells}}
+                                     : nlohmann::json()},
+      {"success", reg.success},
+      {"reason", reg.reason},
+      {"path", mapping::ToString(reg.path)},
+      {"fitness_m2", reg.fitness_m2},
+      {"rmse_m", reg.rmse_m},
+      {"inlier_ratio", reg.inlier_ratio},
+      {"iterations", reg.iterations},
+      {"timings_s", StageTimingsJson(reg.timings)},
+      {"T_map_base", matrix},
+      {"estimate", PoseJson(stop.T_world_base)},
+      {"odometry", PoseJson(stop.T_world_base_odom)}};
   if (stop.T_world_base_true) {
     const Eigen::Isometry3d d = stop.T_world_base_true->inverse() * stop.T_world_base;
     j["truth"] = PoseJson(*stop.T_world_base_true);
