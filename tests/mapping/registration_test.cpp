@@ -40,6 +40,23 @@ PointCloud EveryOther(const PointCloud& cloud) {
   return out;
 }
 
+// Two simulated scans and the true motion between them (the source's pose in the target's frame).
+struct ScanPair {
+  PointCloud target, source;
+  Eigen::Isometry3d truth;
+};
+ScanPair Pair(const sensors::Scan3D& a, const sensors::Scan3D& b) {
+  return {CloudFromScan(a), CloudFromScan(b), a.T_world_base.inverse() * b.T_world_base};
+}
+// 1 m apart along the corridor: nothing but the far ends fixes the axis.
+ScanPair CorridorPair() {
+  return Pair(SimulatedScan("corridor", -10, 0, 0, 1), SimulatedScan("corridor", -9, 0, 0, 2));
+}
+// 0.85 m and 12 deg apart in the office's first room.
+ScanPair OfficePair() {
+  return Pair(SimulatedScan("office", -8, 0, 0, 1), SimulatedScan("office", -7.2, 0.3, 12, 2));
+}
+
 void ExpectNear(const RegistrationResult& r, const Eigen::Isometry3d& truth) {
   const PoseError e = ComparePoses(r.T_target_source, truth);
   EXPECT_LT(e.rotation_deg, kMaxRotationError_deg) << r.reason;
@@ -87,35 +104,33 @@ TEST(Register, TwoRealScansFromDifferentPosesMatchGroundTruth) {
 }
 
 TEST(Register, WithAnOdometryPriorTheResultStaysInsideItsRegion) {
-  const sensors::Scan3D a = SimulatedScan("office", -8, 0, 0, 1);
-  const sensors::Scan3D b = SimulatedScan("office", -7.2, 0.3, 12, 2);
-  const Eigen::Isometry3d truth = a.T_world_base.inverse() * b.T_world_base;
+  const ScanPair office = OfficePair();
+  const Eigen::Isometry3d& truth = office.truth;
   RegistrationPrior prior;
   prior.odometry = truth * PoseFromXyzRpyDeg(0.3, 0.2, 0, 0, 0, 5);  // odometry drifted
-  Result<RegistrationResult> r = Register(CloudFromScan(a), CloudFromScan(b), prior, {});
+  Result<RegistrationResult> r = Register(office.target, office.source, prior, {});
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_TRUE(r->success) << r->reason;
   ExpectNear(*r, truth);
 }
 
 TEST(Register, AnOdometryErrorBoundNarrowsTheConstraintToItself) {
-  const sensors::Scan3D a = SimulatedScan("office", -8, 0, 0, 1);
-  const sensors::Scan3D b = SimulatedScan("office", -7.2, 0.3, 12, 2);
-  const Eigen::Isometry3d truth = a.T_world_base.inverse() * b.T_world_base;
+  const ScanPair office = OfficePair();
+  const Eigen::Isometry3d& truth = office.truth;
   RegistrationPrior prior;
   prior.odometry = truth * PoseFromXyzRpyDeg(0.3, 0.2, 0, 0, 0, 5);  // 0.36 m / 5 deg off
   prior.odometry_uncertainty = GuessUncertainty{0.1, 2.0};           // claims better
-  Result<RegistrationResult> tight = Register(CloudFromScan(a), CloudFromScan(b), prior, {});
+  Result<RegistrationResult> tight = Register(office.target, office.source, prior, {});
   ASSERT_TRUE(tight) << tight.error().message;
   EXPECT_FALSE(tight->success) << "the truth lies outside the bound: " << tight->reason;
   EXPECT_NE(tight->reason.find("the odometry's error bound"), std::string::npos) << tight->reason;
   prior.odometry_uncertainty = GuessUncertainty{0.5, 8.0};  // honest
-  Result<RegistrationResult> r = Register(CloudFromScan(a), CloudFromScan(b), prior, {});
+  Result<RegistrationResult> r = Register(office.target, office.source, prior, {});
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_TRUE(r->success) << r->reason;
   ExpectNear(*r, truth);
   prior.odometry_uncertainty = GuessUncertainty{-0.1, 2.0};
-  Result<RegistrationResult> bad = Register(CloudFromScan(a), CloudFromScan(b), prior, {});
+  Result<RegistrationResult> bad = Register(office.target, office.source, prior, {});
   ASSERT_FALSE(bad);
   EXPECT_NE(bad.error().message.find("odometry_uncertainty"), std::string::npos);
 }
@@ -180,12 +195,11 @@ TEST(Register, ScansWithNoOverlapAreAReportedFailureNotASuccess) {
 }
 
 TEST(Register, TheCorridorTakesTheConstantVelocityFallback) {
-  const sensors::Scan3D a = SimulatedScan("corridor", -10, 0, 0, 1);
-  const sensors::Scan3D b = SimulatedScan("corridor", -9, 0, 0, 2);
-  const Eigen::Isometry3d truth = a.T_world_base.inverse() * b.T_world_base;
+  const ScanPair corridor = CorridorPair();
+  const Eigen::Isometry3d& truth = corridor.truth;
   RegistrationPrior prior;
   prior.previous_motion = PoseFromXyzRpyDeg(1.0, 0, 0, 0, 0, 0);  // the last pair's motion
-  Result<RegistrationResult> r = Register(CloudFromScan(a), CloudFromScan(b), prior, {});
+  Result<RegistrationResult> r = Register(corridor.target, corridor.source, prior, {});
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_TRUE(r->success) << r->reason;
   EXPECT_EQ(r->path, RegistrationPath::kFallback) << r->reason;
@@ -197,12 +211,11 @@ TEST(Register, TheCorridorDoesNotTakeItsAxisFromAnOdometryGuessOfUnknownError) {
   // Formerly a false success: ICP kept the along-corridor position of a guess 0.4 m off and the
   // result, 0.4 m off, was reported as a success. Nothing in the scans fixes that position and
   // nothing says how good the guess is: the pose is not determined, and says so.
-  const sensors::Scan3D a = SimulatedScan("corridor", -10, 0, 0, 1);
-  const sensors::Scan3D b = SimulatedScan("corridor", -9, 0, 0, 2);
-  const Eigen::Isometry3d truth = a.T_world_base.inverse() * b.T_world_base;
+  const ScanPair corridor = CorridorPair();
+  const Eigen::Isometry3d& truth = corridor.truth;
   RegistrationPrior prior;
   prior.odometry = Eigen::Translation3d(0.4, 0, 0) * truth;
-  Result<RegistrationResult> r = Register(CloudFromScan(a), CloudFromScan(b), prior, {});
+  Result<RegistrationResult> r = Register(corridor.target, corridor.source, prior, {});
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_FALSE(r->success) << r->reason;
   EXPECT_NE(r->reason.find("not determined"), std::string::npos) << r->reason;
@@ -211,14 +224,13 @@ TEST(Register, TheCorridorDoesNotTakeItsAxisFromAnOdometryGuessOfUnknownError) {
 TEST(Register, TheCorridorTakesItsAxisFromAnOdometryGuessTrustedToAFewCentimetres) {
   // The same corridor with odometry that says it is good to 3 cm: the along-corridor position is
   // the guess's (2 cm off), the rest comes from the scans, and the result says so.
-  const sensors::Scan3D a = SimulatedScan("corridor", -10, 0, 0, 1);
-  const sensors::Scan3D b = SimulatedScan("corridor", -9, 0, 0, 2);
-  const Eigen::Isometry3d truth = a.T_world_base.inverse() * b.T_world_base;
+  const ScanPair corridor = CorridorPair();
+  const Eigen::Isometry3d& truth = corridor.truth;
   constexpr double kGuessOffAlong_m = 0.02;
   RegistrationPrior prior;
   prior.odometry = Eigen::Translation3d(kGuessOffAlong_m, 0, 0) * truth;
   prior.odometry_uncertainty = GuessUncertainty{0.03, 0.3};
-  Result<RegistrationResult> r = Register(CloudFromScan(a), CloudFromScan(b), prior, {});
+  Result<RegistrationResult> r = Register(corridor.target, corridor.source, prior, {});
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_TRUE(r->success) << r->reason;
   EXPECT_EQ(r->path, RegistrationPath::kOdometry) << r->reason;
@@ -229,13 +241,12 @@ TEST(Register, TheCorridorTakesItsAxisFromAnOdometryGuessTrustedToAFewCentimetre
 TEST(Register, TheCorridorWithAnOdometryGuessOfUnknownErrorTakesTheConstantVelocityFallback) {
   // Odometry that cannot be trusted along the axis is rejected there; the previous pair's motion
   // (the paper's constant-velocity assumption) carries it instead, and the path says so.
-  const sensors::Scan3D a = SimulatedScan("corridor", -10, 0, 0, 1);
-  const sensors::Scan3D b = SimulatedScan("corridor", -9, 0, 0, 2);
-  const Eigen::Isometry3d truth = a.T_world_base.inverse() * b.T_world_base;
+  const ScanPair corridor = CorridorPair();
+  const Eigen::Isometry3d& truth = corridor.truth;
   RegistrationPrior prior;
   prior.odometry = Eigen::Translation3d(0.4, 0, 0) * truth;
   prior.previous_motion = PoseFromXyzRpyDeg(1.0, 0, 0, 0, 0, 0);  // the last pair's motion
-  Result<RegistrationResult> r = Register(CloudFromScan(a), CloudFromScan(b), prior, {});
+  Result<RegistrationResult> r = Register(corridor.target, corridor.source, prior, {});
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_TRUE(r->success) << r->reason;
   EXPECT_EQ(r->path, RegistrationPath::kFallback) << r->reason;
@@ -281,18 +292,17 @@ TEST(Register, OnOpenTerrainAnUntrustedOdometryGuessCannotFixTheHeading) {
 // A source no rigid motion fits (ranges 6 % long: a range-scale error; 30 cm at 5 m) is a
 // reported failure naming the residual, never a success. The same pair unscaled is the control.
 TEST(Register, ScansThatFitTogetherOnlyLooselyAreAReportedFailure) {
-  const sensors::Scan3D a = SimulatedScan("office", -8, 0, 0, 1);
-  const sensors::Scan3D b = SimulatedScan("office", -7.2, 0.3, 12, 2);
-  const Eigen::Isometry3d truth = a.T_world_base.inverse() * b.T_world_base;
-  const PointCloud source = CloudFromScan(b);
+  const ScanPair office = OfficePair();
+  const Eigen::Isometry3d& truth = office.truth;
+  const PointCloud& source = office.source;
   const Eigen::Vector3f laser = sensors::MountConfig{}.BaseToLaser(0.0).translation().cast<float>();
   PointCloud scaled;
   for (const Eigen::Vector3f& p : source) scaled.push_back(laser + 1.06f * (p - laser));
-  Result<RegistrationResult> r = Register(CloudFromScan(a), scaled, {}, {});
+  Result<RegistrationResult> r = Register(office.target, scaled, {}, {});
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_FALSE(r->success) << r->reason << " (RMS " << r->rmse_m << " m)";
   EXPECT_NE(r->reason.find("inlier RMS error"), std::string::npos) << r->reason;
-  Result<RegistrationResult> control = Register(CloudFromScan(a), source, {}, {});
+  Result<RegistrationResult> control = Register(office.target, source, {}, {});
   ASSERT_TRUE(control) << control.error().message;
   EXPECT_TRUE(control->success) << control->reason;
   ExpectNear(*control, truth);
@@ -337,9 +347,8 @@ TEST(Register, NarfFeaturesAlignAKnownTransformOnRealScans) {
 }
 
 TEST(Register, TheCorridorWithoutAFallbackIsAReportedFailure) {
-  const sensors::Scan3D a = SimulatedScan("corridor", -10, 0, 0, 1);
-  const sensors::Scan3D b = SimulatedScan("corridor", -9, 0, 0, 2);
-  Result<RegistrationResult> r = Register(CloudFromScan(a), CloudFromScan(b), {}, {});
+  const ScanPair corridor = CorridorPair();
+  Result<RegistrationResult> r = Register(corridor.target, corridor.source, {}, {});
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_FALSE(r->success) << r->reason;
   EXPECT_NE(r->reason.find("ambiguous"), std::string::npos) << r->reason;
