@@ -215,6 +215,11 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
     m["final_true_distance_to_goal_m"] = score->final_distance_to_goal_m;
     m["max_registration_error"] = {{"translation_m", score->max_registration_translation_error_m},
                                    {"rotation_deg", score->max_registration_rotation_error_deg}};
+    m["registration_step_error"] = {{"steps", score->registration_steps},
+                                    {"p95_m", score->registration_step_p95_m},
+                                    {"max_m", score->registration_step_max_m},
+                                    {"p95_deg", score->registration_step_p95_deg},
+                                    {"max_deg", score->registration_step_max_deg}};
     m["max_tilt_deg"] = score->max_true_tilt_deg;
     m["path_cost_on_true_map"] = score->driven_cost_on_true_map;
     m["true_optimal_cost"] =

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
+#include <utility>
 
 namespace pitchlab::apps {
 namespace {
@@ -36,7 +38,8 @@ planning::Path CellChain(const std::vector<Eigen::Vector2d>& xy, const mapping::
     if (!g.Contains(c)) continue;
     while (!path.cells.empty() && !(path.cells.back() == c)) {
       const mapping::CellIndex b = path.cells.back();
-      const mapping::CellIndex step{b.i + (c.i > b.i) - (c.i < b.i), b.j + (c.j > b.j) - (c.j < b.j)};
+      const mapping::CellIndex step{b.i + (c.i > b.i) - (c.i < b.i),
+                                    b.j + (c.j > b.j) - (c.j < b.j)};
       path.cells.push_back(step);
     }
     if (path.cells.empty()) path.cells.push_back(c);
@@ -73,9 +76,19 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
   std::vector<Eigen::Vector2d> xy{start_m};
   Eigen::Isometry3d last_true = Eigen::Isometry3d::Identity();
   bool have_true = false;
+  std::vector<double> step_m, step_deg;
+  const StopRecord* last_merged = nullptr;
   for (const StopRecord& stop : result.stops) {
     if (!stop.T_world_base_true) continue;
     const PoseDelta e = Compare(stop.T_world_base, *stop.T_world_base_true);
+    if (stop.merge.merged && last_merged) {
+      const PoseDelta step =
+          Compare(last_merged->T_world_base.inverse() * stop.T_world_base,
+                  last_merged->T_world_base_true->inverse() * *stop.T_world_base_true);
+      step_m.push_back(step.translation_m);
+      step_deg.push_back(step.rotation_deg);
+    }
+    if (stop.merge.merged) last_merged = &stop;
     if (stop.merge.merged) {
       s.max_registration_translation_error_m =
           std::max(s.max_registration_translation_error_m, e.translation_m);
@@ -87,6 +100,16 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
     s.max_true_tilt_deg = std::max(s.max_true_tilt_deg, Tilt(*stop.T_world_base_true) * kRadToDeg);
     last_true = *stop.T_world_base_true;
     have_true = true;
+  }
+  s.registration_steps = static_cast<int>(step_m.size());
+  if (!step_m.empty()) {
+    const auto p95_max = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      const std::size_t k = static_cast<std::size_t>(std::ceil(0.95 * v.size())) - 1;
+      return std::pair{v[k], v.back()};
+    };
+    std::tie(s.registration_step_p95_m, s.registration_step_max_m) = p95_max(step_m);
+    std::tie(s.registration_step_p95_deg, s.registration_step_max_deg) = p95_max(step_deg);
   }
   for (const TrajectorySample& sample : result.trajectory) {
     if (!sample.T_world_base_true) continue;

@@ -12,13 +12,19 @@
 namespace pitchlab::apps {
 
 struct RunScore {
-  double final_translation_error_m = 0;  ///< last estimate vs truth [m]
-  double final_rotation_error_deg = 0;   ///< [deg]
+  double final_translation_error_m = 0;             ///< last estimate vs truth [m]
+  double final_rotation_error_deg = 0;              ///< [deg]
   double max_registration_translation_error_m = 0;  ///< over stops merged by registration [m]
   double max_registration_rotation_error_deg = 0;   ///< [deg]
-  double true_distance_m = 0;            ///< driven, by ground truth [m]
-  double final_distance_to_goal_m = 0;   ///< true position to goal [m]
-  double max_true_tilt_deg = 0;          ///< [deg]
+  /// Registration's own error, without the drift it inherits: each merged stop's motion since the
+  /// previous merged stop, estimated vs true. Largest and 95th percentile over the run's steps
+  /// (0 when fewer than one step) [m] / [deg].
+  int registration_steps = 0;
+  double registration_step_max_m = 0, registration_step_p95_m = 0;
+  double registration_step_max_deg = 0, registration_step_p95_deg = 0;
+  double true_distance_m = 0;               ///< driven, by ground truth [m]
+  double final_distance_to_goal_m = 0;      ///< true position to goal [m]
+  double max_true_tilt_deg = 0;             ///< [deg]
   std::optional<double> true_optimal_cost;  ///< start to goal on the true map (none: no path)
   std::string true_optimum_note;            ///< why there is none
   double driven_cost_on_true_map = 0;       ///< the true trajectory's cells, costed by Eq. 5

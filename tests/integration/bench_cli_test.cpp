@@ -87,6 +87,7 @@ TEST_F(BenchCli, ShardsCoverEveryRunOnceAndMergeToTheUnshardedSummary) {
     EXPECT_GT(r["distance_m"].get<double>(), 11.0);
     EXPECT_TRUE(r["final_pose_error_m"].is_number());
     EXPECT_TRUE(r["max_registration_error_m"].is_number());
+    EXPECT_TRUE(r["registration_step_max_m"].is_number());
     EXPECT_TRUE(r["cost_ratio"].is_number());
     EXPECT_TRUE(fs::exists(dir_ / "whole" / r["run_dir"].get<std::string>() / "metrics.json"));
   }

@@ -8,8 +8,8 @@
 #include <string>
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>
+#include <nlohmann/json.hpp>
 
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/sensors/scan_pcd.hpp"
@@ -34,9 +34,7 @@ class RunCli : public ::testing::Test {
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }
 
-  static CliResult Exec(const std::string& args) {
-    return cli_test::RunPitchlab(args, dir_);
-  }
+  static CliResult Exec(const std::string& args) { return cli_test::RunPitchlab(args, dir_); }
   // Folders in the scratch folder other than the successful run's: a failed run leaves none,
   // not even its hidden staging folder.
   static int Leftovers() {
@@ -52,16 +50,23 @@ fs::path RunCli::dir_;
 
 TEST_F(RunCli, AMissionAroundABlockReachesTheGoalAndWritesEveryOutput) {
   const fs::path run = dir_ / "ok_yard";
-  const CliResult r = Exec("run --world " + kYard.string() + " --seed 3 --json --quiet --out " +
-                     run.string());
+  const CliResult r =
+      Exec("run --world " + kYard.string() + " --seed 3 --json --quiet --out " + run.string());
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   const nlohmann::json metrics = nlohmann::json::parse(Slurp(run / "metrics.json"));
   EXPECT_EQ(metrics, nlohmann::json::parse(r.out));
   EXPECT_TRUE(metrics["success"].get<bool>()) << metrics["reason"];
   constexpr double kGoalTolerance_m = 0.5, kPoseBound_m = 0.15;
-  EXPECT_LT(metrics["final_true_distance_to_goal_m"].get<double>(), kGoalTolerance_m + kPoseBound_m);
+  EXPECT_LT(metrics["final_true_distance_to_goal_m"].get<double>(),
+            kGoalTolerance_m + kPoseBound_m);
   EXPECT_LT(metrics["final_pose_error"]["translation_m"].get<double>(), kPoseBound_m);
   EXPECT_LT(metrics["max_registration_error"]["translation_m"].get<double>(), kPoseBound_m);
+  // Each registration on its own: the motion since the last merged stop, against the truth.
+  const nlohmann::json& step = metrics["registration_step_error"];
+  EXPECT_GE(step["steps"].get<int>(), 1);
+  EXPECT_LE(step["p95_m"].get<double>(), step["max_m"].get<double>());
+  EXPECT_LT(step["max_m"].get<double>(), kPoseBound_m);
+  EXPECT_LT(step["max_deg"].get<double>(), 1.0);
   EXPECT_GT(metrics["closest_approach_to_forbidden_m"].get<double>(), 0.0);  // never on a hazard
   EXPECT_GT(metrics["distance_m"].get<double>(), 11.0);  // around the block, not through it
   EXPECT_GE(metrics["cost_ratio"].get<double>(), 0.95);
@@ -85,8 +90,8 @@ TEST_F(RunCli, AMissionAroundABlockReachesTheGoalAndWritesEveryOutput) {
   EXPECT_TRUE(mapping::LoadElevationMap((run / "elevation.plem").string()));
   EXPECT_NE(Slurp(run / "elevation.asc").find("ncols"), std::string::npos);
   EXPECT_NE(Slurp(run / "elevation.prj").find("PROJCS"), std::string::npos);
-  for (const char* png : {"elevation.png", "truth_elevation.png", "traversability.png",
-                          "truth_traversability.png"}) {
+  for (const char* png :
+       {"elevation.png", "truth_elevation.png", "traversability.png", "truth_traversability.png"}) {
     EXPECT_EQ(Slurp(run / png).substr(1, 3), "PNG") << png;
   }
   for (const char* csv : {"trajectory_estimated.csv", "trajectory_true.csv"}) {
