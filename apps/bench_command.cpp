@@ -416,6 +416,7 @@ json MakeRecord(const SweepSettings& s, const BenchRun& run, std::optional<int> 
   r["cost_ratio"] = Field(metrics, "/cost_ratio");
   r["closest_approach_to_forbidden_m"] = Field(metrics, "/closest_approach_to_forbidden_m");
   r["forbidden_cells_crossed"] = Field(metrics, "/forbidden_cells_crossed");
+  r["hazard_cells_crossed"] = Field(metrics, "/hazard_cells_crossed");
   r["max_tilt_deg"] = Field(metrics, "/max_tilt_deg");
   return r;
 }

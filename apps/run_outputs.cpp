@@ -228,6 +228,7 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
     m["cost_ratio"] =
         score->cost_ratio && r.success ? nlohmann::json(*score->cost_ratio) : nlohmann::json();
     m["forbidden_cells_crossed"] = score->forbidden_cells_crossed;
+    m["hazard_cells_crossed"] = score->hazard_cells_crossed;
     if (std::isfinite(score->closest_hazard_m)) {
       m["closest_approach_to_forbidden_m"] = score->closest_hazard_m;
       m["closest_approach_at"] = {{"x_m", score->closest_hazard_at.x()},

@@ -124,6 +124,11 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
   const planning::PathOnMap on_truth = planning::EvaluatePath(truth, driven);
   s.driven_cost_on_true_map = on_truth.cost;
   s.forbidden_cells_crossed = on_truth.forbidden_cells;
+  for (std::size_t i = 1; i < driven.cells.size(); ++i) {  // the start excluded, as above
+    const planning::Blocked b = truth.blocked[truth.geometry.Linear(driven.cells[i])];
+    s.hazard_cells_crossed += b == planning::Blocked::kStep || b == planning::Blocked::kDrop ||
+                              b == planning::Blocked::kTooSteep;
+  }
   auto optimum = planning::PlanPath(truth, start_m, goal_m, algorithm);
   if (optimum) {
     s.true_optimal_cost = optimum->cost;

@@ -30,6 +30,9 @@ struct RunScore {
   double driven_cost_on_true_map = 0;       ///< the true trajectory's cells, costed by Eq. 5
   std::optional<double> cost_ratio;         ///< driven / optimal (>= 1 up to discretisation)
   std::size_t forbidden_cells_crossed = 0;  ///< truly forbidden cells under the true trajectory
+  /// Of those, cells that are a true step, drop or too steep themselves (the rest are within half
+  /// the robot's width of one, or unknown in the truth) [1].
+  std::size_t hazard_cells_crossed = 0;
   /// Smallest distance from the robot's centre to a truly hazardous cell (step, steep, drop) [m];
   /// infinity when none is within 5 m of the trajectory.
   double closest_hazard_m = 0;

@@ -68,6 +68,9 @@ TEST_F(RunCli, AMissionAroundABlockReachesTheGoalAndWritesEveryOutput) {
   EXPECT_LT(step["max_m"].get<double>(), kPoseBound_m);
   EXPECT_LT(step["max_deg"].get<double>(), 1.0);
   EXPECT_GT(metrics["closest_approach_to_forbidden_m"].get<double>(), 0.0);  // never on a hazard
+  EXPECT_EQ(metrics["hazard_cells_crossed"].get<int>(), 0);
+  EXPECT_LE(metrics["hazard_cells_crossed"].get<int>(),
+            metrics["forbidden_cells_crossed"].get<int>());
   EXPECT_GT(metrics["distance_m"].get<double>(), 11.0);  // around the block, not through it
   EXPECT_GE(metrics["cost_ratio"].get<double>(), 0.95);
   EXPECT_LT(metrics["cost_ratio"].get<double>(), 1.5);
