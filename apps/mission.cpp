@@ -103,9 +103,9 @@ class Mission {
 
  private:
   bool Stop(int k);  // false: the mission ends (result_.reason says why)
-  // Registration failed: the odometry pose's height from the map's ground (FitHeightOffset).
-  void LevelOnMap(StopRecord& stop) const;
-  void UpdateElevation(const StopRecord& stop);
+  // Inserts the scan (within map_range_m) at stop.T_world_base; at an odometry pose (registration
+  // failed) the pose's height is first taken from the map's ground (FitHeightOffset).
+  void UpdateElevation(StopRecord& stop);
   void Plan(StopRecord& stop) const;
   tl::expected<planning::Path, planning::NoPath> PlanOn(const planning::TraversabilityGrid& grid,
                                                         const Eigen::Vector2d& here) const;
@@ -238,10 +238,9 @@ bool Mission::Stop(int k) {
   // of terrain would stay unknown and the robot could never plan across it. That pose's height
   // comes from the map's ground where the scan overlaps it.
   stop.elevation_from_odometry = !stop.merge.merged;
-  if (stop.elevation_from_odometry) LevelOnMap(stop);
+  UpdateElevation(stop);
   T_world_base_ = stop.T_world_base;
   odo_ref_ = *odo;
-  UpdateElevation(stop);
   stop.distance_to_goal_m = (config_.goal_m - stop.T_world_base.translation().head<2>()).norm();
   const bool arrived = stop.distance_to_goal_m <= config_.goal_tolerance_m;
   if (!arrived) Plan(stop);
@@ -269,28 +268,25 @@ bool Mission::Stop(int k) {
   return Drive(s);
 }
 
-void Mission::LevelOnMap(StopRecord& stop) const {
+void Mission::UpdateElevation(StopRecord& stop) {
   const Eigen::Isometry3f T = stop.T_world_base.cast<float>();
-  std::vector<Eigen::Vector3f> near;
-  for (const sensors::ScanPoint& p : stop.scan.points) {
-    if (p.range_m <= config_.map_range_m) near.push_back(T * Eigen::Vector3f(p.x, p.y, p.z));
-  }
-  const std::optional<HeightOffset> fit = FitHeightOffset(result_.elevation, near);
-  constexpr double kMaxShift_m = 2.0;  // beyond: the map or the scan gone wrong, not drift
-  if (!fit || std::abs(fit->dz_m) > kMaxShift_m) return;
-  stop.T_world_base.translation().z() -= fit->dz_m;
-  stop.height_fit = fit;
-}
-
-void Mission::UpdateElevation(const StopRecord& stop) {
-  const Eigen::Isometry3f T = stop.T_world_base.cast<float>();
-  const Eigen::Vector3f laser =
-      (stop.T_world_base * config_.mount.BaseToLaser(0.0)).translation().cast<float>();
   std::vector<Eigen::Vector3f> near;  // map frame, within map_range_m of the laser
   near.reserve(stop.scan.points.size());
   for (const sensors::ScanPoint& p : stop.scan.points) {
     if (p.range_m <= config_.map_range_m) near.push_back(T * Eigen::Vector3f(p.x, p.y, p.z));
   }
+  // At the odometry pose, the height comes from the map's ground where the scan overlaps it.
+  if (stop.elevation_from_odometry) {
+    constexpr double kMaxShift_m = 2.0;  // beyond: the map or the scan gone wrong, not drift
+    const std::optional<HeightOffset> fit = FitHeightOffset(result_.elevation, near);
+    if (fit && std::abs(fit->dz_m) <= kMaxShift_m) {
+      stop.T_world_base.translation().z() -= fit->dz_m;
+      for (Eigen::Vector3f& p : near) p.z() -= static_cast<float>(fit->dz_m);
+      stop.height_fit = fit;
+    }
+  }
+  const Eigen::Vector3f laser =
+      (stop.T_world_base * config_.mount.BaseToLaser(0.0)).translation().cast<float>();
   result_.elevation.InsertScan(near.data(), near.size(), laser);
   // The laser cannot see under the robot, but the robot stands on that ground; only a registered
   // pose knows its height well enough (odometry's z drifts, and a wrong one makes a step around
