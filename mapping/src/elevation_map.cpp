@@ -252,7 +252,7 @@ InsertStats ElevationMap::InsertScan(const Eigen::Vector3f* points_m, std::size_
   return InsertScanImpl(geometry_, cells_, points_m, count, sensor_origin_m, config);
 }
 
-Result<std::size_t> ElevationMap::Merge(const ElevationMap& other) {
+Result<std::size_t> ElevationMap::Merge(const ElevationMap& other, MergeCells cells) {
   const GridGeometry& a = geometry_;
   const GridGeometry& b = other.geometry_;
   if (std::abs(a.cell_m - b.cell_m) > 1e-9 * a.cell_m) {
@@ -277,7 +277,9 @@ Result<std::size_t> ElevationMap::Merge(const ElevationMap& other) {
         dropped += src.count > 0;
         continue;
       }
-      CombineInto(cells_[a.Linear(dst)], src, 0.0f, 0.0f);
+      CellStats& into = cells_[a.Linear(dst)];
+      if (cells == MergeCells::kUnknown && into.known()) continue;
+      CombineInto(into, src, 0.0f, 0.0f);
     }
   }
   return dropped;

@@ -212,6 +212,42 @@ TEST(ElevationMap, MergeEqualsInsertingBothClouds) {
   EXPECT_FALSE(ma.Merge(misaligned));
 }
 
+TEST(ElevationMap, MergeOfUnknownCellsLeavesSeenGroundAsItWas) {
+  // The map has seen x in [0, 2) at z = 0; a view shifted 0.3 m up covers x in [1, 3): only its
+  // part over x in [2, 3) enters, and a cell the map has seen keeps its points and clearance.
+  const GridGeometry g = GridGeometry::FromArea(0, 0, 3, 1, 0.25);
+  std::vector<Eigen::Vector3f> seen, view;
+  for (float x = 0.05f; x < 2.0f; x += 0.1f) {
+    for (float y = 0.05f; y < 1.0f; y += 0.1f) seen.emplace_back(x, y, 0.0f);
+  }
+  for (float x = 1.05f; x < 3.0f; x += 0.1f) {
+    for (float y = 0.05f; y < 1.0f; y += 0.1f) view.emplace_back(x, y, 0.3f);
+  }
+  ElevationMap map(g), shifted(g);
+  (void)map.InsertPoints(seen.data(), seen.size());
+  (void)shifted.InsertScan(view.data(), view.size(), Eigen::Vector3f(1.0f, 0.5f, 0.0f));
+  const ElevationMap before = map;
+  const auto merged = map.Merge(shifted, ElevationMap::MergeCells::kUnknown);
+  ASSERT_TRUE(merged) << merged.error().message;
+  EXPECT_EQ(*merged, 0u);
+  for (std::size_t k = 0; k < g.cell_count(); ++k) {
+    const double x = g.CenterOf(g.FromLinear(k)).x();
+    const CellStats &now = map.at(k), &was = before.at(k);
+    if (x < 2.0) {
+      EXPECT_EQ(now.count, was.count) << "x " << x;
+      EXPECT_EQ(now.max_z, 0.0f) << "x " << x;
+      EXPECT_EQ(now.clearance_z, was.clearance_z) << "x " << x;
+    } else {
+      EXPECT_EQ(now.count, shifted.at(k).count) << "x " << x;
+      EXPECT_NEAR(now.mean_z, 0.3f, 1e-6) << "x " << x;
+    }
+  }
+  // Merging everything blends the two heights where they overlap.
+  ElevationMap blended = before;
+  ASSERT_TRUE(blended.Merge(shifted));
+  EXPECT_NEAR(blended.at(g.Linear(g.IndexOf(1.5, 0.5))).max_z, 0.3f, 1e-6);
+}
+
 TEST(ElevationMap, DitchShowsAsDropNotAsUnknown) {
   // Flat ground z = 0 except a ditch 1 m wide and 0.6 m deep at x in [4, 5); the laser at
   // (0, 0, 0.55) sees the near ground, the far wall and the far ground, never the ditch floor.

@@ -168,11 +168,19 @@ class ElevationMap {
                      const std::optional<Eigen::Vector3f>& sensor_origin_m = std::nullopt,
                      const InsertConfig& config = {});
 
+  /// Which cells of this map Merge adds to.
+  enum class MergeCells {
+    kAll,      ///< every cell, as if `other`'s points had been inserted here
+    kUnknown,  ///< only cells without a point: a view from an uncertain pose fills the map's
+               ///< gaps and never blends into (and contradicts) ground the map has seen
+  };
   /// Adds every cell of `other` into this map as if its points had been inserted here (Chan's
-  /// parallel update of the moments). Fails (kInvalidArgument) when the cell sizes differ or the
-  /// grids are not aligned to a whole number of cells; cells of `other` off this grid are counted
-  /// in the returned number and dropped.
-  [[nodiscard]] Result<std::size_t> Merge(const ElevationMap& other);
+  /// parallel update of the moments), or with MergeCells::kUnknown only those this map has no
+  /// point in (the others are left as they are, clearance included). Fails (kInvalidArgument) when
+  /// the cell sizes differ or the grids are not aligned to a whole number of cells; cells of
+  /// `other` off this grid are counted in the returned number and dropped.
+  [[nodiscard]] Result<std::size_t> Merge(const ElevationMap& other,
+                                          MergeCells cells = MergeCells::kAll);
 
   /// Replaces the statistics of every cell (for the loader); throws std::invalid_argument when
   /// the size does not match the geometry.
