@@ -417,6 +417,9 @@ json MakeRecord(const SweepSettings& s, const BenchRun& run, std::optional<int> 
   r["closest_approach_to_forbidden_m"] = Field(metrics, "/closest_approach_to_forbidden_m");
   r["forbidden_cells_crossed"] = Field(metrics, "/forbidden_cells_crossed");
   r["hazard_cells_crossed"] = Field(metrics, "/hazard_cells_crossed");
+  r["map_cells_compared"] = Field(metrics, "/map_hazards/cells_compared");
+  r["false_hazard_cells"] = Field(metrics, "/map_hazards/false_hazard_cells");
+  r["missed_hazard_cells"] = Field(metrics, "/map_hazards/missed_hazard_cells");
   r["max_tilt_deg"] = Field(metrics, "/max_tilt_deg");
   return r;
 }

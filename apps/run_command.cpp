@@ -175,8 +175,10 @@ int RunRun(int argc, char** argv) {
   };
   const MissionResult result =
       RunMission(rig, rig.base(), *placed, mission, probes, observer);
+  const planning::TraversabilityGrid final_grid = planning::BuildTraversability(
+      mapping::ComputeLayers(result.elevation, mission.layers), mission.planner);
   const RunScore score =
-      ScoreRun(result, truth_grid, start.head<2>(), goal, mission.algorithm);
+      ScoreRun(result, truth_grid, final_grid, start.head<2>(), goal, mission.algorithm);
 
   RunContext context;
   context.world = world;

@@ -229,6 +229,9 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
         score->cost_ratio && r.success ? nlohmann::json(*score->cost_ratio) : nlohmann::json();
     m["forbidden_cells_crossed"] = score->forbidden_cells_crossed;
     m["hazard_cells_crossed"] = score->hazard_cells_crossed;
+    m["map_hazards"] = {{"cells_compared", score->map_cells_compared},
+                        {"false_hazard_cells", score->false_hazard_cells},
+                        {"missed_hazard_cells", score->missed_hazard_cells}};
     if (std::isfinite(score->closest_hazard_m)) {
       m["closest_approach_to_forbidden_m"] = score->closest_hazard_m;
       m["closest_approach_at"] = {{"x_m", score->closest_hazard_at.x()},

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <tuple>
 #include <utility>
 
@@ -70,6 +71,7 @@ double ClosestHazard(const std::vector<Eigen::Vector2d>& xy, const planning::Tra
 }  // namespace
 
 RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGrid& truth,
+                  const planning::TraversabilityGrid& estimated,
                   const Eigen::Vector2d& start_m, const Eigen::Vector2d& goal_m,
                   planning::Algorithm algorithm) {
   RunScore s;
@@ -137,6 +139,21 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
     s.true_optimum_note = optimum.error().message;
   }
   s.closest_hazard_m = ClosestHazard(xy, truth, &s.closest_hazard_at);
+  if (!estimated.geometry.SameAs(truth.geometry)) {
+    throw std::invalid_argument("score: the estimated and the true map are on different grids");
+  }
+  // Unknown: no height and no hazard inferred (a drop may have no points, only rays over it).
+  const auto known = [](const planning::TraversabilityGrid& g, std::size_t k) {
+    return g.blocked[k] != planning::Blocked::kUnknown &&
+           (std::isfinite(g.z_m[k]) || IsHazard(g.blocked[k]));
+  };
+  for (std::size_t k = 0; k < truth.blocked.size(); ++k) {
+    if (!known(truth, k) || !known(estimated, k)) continue;
+    const planning::Blocked t = truth.blocked[k], e = estimated.blocked[k];
+    ++s.map_cells_compared;
+    s.false_hazard_cells += IsHazard(e) && t == planning::Blocked::kFree;
+    s.missed_hazard_cells += IsHazard(t) && e == planning::Blocked::kFree;
+  }
   return s;
 }
 

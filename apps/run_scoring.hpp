@@ -37,10 +37,18 @@ struct RunScore {
   /// infinity when none is within 5 m of the trajectory.
   double closest_hazard_m = 0;
   Eigen::Vector2d closest_hazard_at{0, 0};  ///< where the robot was then [m]
+  /// The final map's hazards (step, drop, too steep) against the true ones, cell by cell over the
+  /// cells both know: a run that ends with no path was most often walled in by false hazards, and
+  /// unlike success these counts change smoothly with the map's quality [1].
+  std::size_t map_cells_compared = 0;
+  std::size_t false_hazard_cells = 0;   ///< hazard in the map, truly free (not even near one)
+  std::size_t missed_hazard_cells = 0;  ///< free in the map, truly a hazard
 };
 
-/// `truth` is the true traversability over the mission's map area; `start_m`/`goal_m` world [m].
+/// `truth` is the true traversability over the mission's map area, `estimated` the final map's on
+/// the same grid; `start_m`/`goal_m` world [m].
 RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGrid& truth,
+                  const planning::TraversabilityGrid& estimated,
                   const Eigen::Vector2d& start_m, const Eigen::Vector2d& goal_m,
                   planning::Algorithm algorithm);
 
