@@ -1,5 +1,6 @@
 #include "mission.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -88,6 +89,40 @@ std::vector<Eigen::Vector2d> PathPrefix(const planning::Path& path, double lengt
   return out;
 }
 
+// Inserts the scan (map frame, rays from `laser`) into the cells of `map` that have no point yet;
+// the others stay as they are, clearance included. Returns the cells it filled.
+std::size_t FillUnknown(mapping::ElevationMap& map, const std::vector<Eigen::Vector3f>& points,
+                        const Eigen::Vector3f& laser) {
+  // A scratch grid over the scan's extent (rays included), aligned to the map's cells.
+  const mapping::GridGeometry& g = map.geometry();
+  Eigen::Vector2f lo = laser.head<2>(), hi = laser.head<2>();
+  for (const Eigen::Vector3f& p : points) {
+    lo = lo.cwiseMin(p.head<2>());
+    hi = hi.cwiseMax(p.head<2>());
+  }
+  const mapping::CellIndex a = g.IndexOf(lo.x(), lo.y()), b = g.IndexOf(hi.x(), hi.y());
+  const int i0 = std::clamp(a.i, 0, g.size_x - 1), j0 = std::clamp(a.j, 0, g.size_y - 1);
+  const int i1 = std::clamp(b.i, 0, g.size_x - 1), j1 = std::clamp(b.j, 0, g.size_y - 1);
+  mapping::GridGeometry local = g;
+  local.x_min_m = g.x_min_m + i0 * g.cell_m;
+  local.y_min_m = g.y_min_m + j0 * g.cell_m;
+  local.size_x = i1 - i0 + 1;
+  local.size_y = j1 - j0 + 1;
+  mapping::ElevationMap view(local);
+  view.InsertScan(points.data(), points.size(), laser);
+  std::size_t unknown_before = 0;
+  for (int j = j0; j <= j1; ++j) {
+    for (int i = i0; i <= i1; ++i) unknown_before += !map.at({i, j}).known();
+  }
+  const auto merged = map.Merge(view, mapping::ElevationMap::MergeCells::kUnknown);
+  if (!merged) throw std::logic_error("mission: " + merged.error().message);  // same alignment
+  std::size_t unknown_after = 0;
+  for (int j = j0; j <= j1; ++j) {
+    for (int i = i0; i <= i1; ++i) unknown_after += !map.at({i, j}).known();
+  }
+  return unknown_before - unknown_after;
+}
+
 class Mission {
  public:
   Mission(sensors::ScanSource& source, sensors::MobileBase& base, const MissionConfig& config,
@@ -104,7 +139,8 @@ class Mission {
  private:
   bool Stop(int k);  // false: the mission ends (result_.reason says why)
   // Inserts the scan (within map_range_m) at stop.T_world_base; at an odometry pose (registration
-  // failed) the pose's height is first taken from the map's ground (FitHeightOffset).
+  // failed) the pose's height is first taken from the map's ground (FitHeightOffset), and the scan
+  // fills only the cells the map has not seen (FillUnknown).
   void UpdateElevation(StopRecord& stop);
   void Plan(StopRecord& stop) const;
   tl::expected<planning::Path, planning::NoPath> PlanOn(const planning::TraversabilityGrid& grid,
@@ -287,11 +323,17 @@ void Mission::UpdateElevation(StopRecord& stop) {
   }
   const Eigen::Vector3f laser =
       (stop.T_world_base * config_.mount.BaseToLaser(0.0)).translation().cast<float>();
+  if (stop.elevation_from_odometry) {
+    // Odometry slips by up to a metre on rugged ground: the scan only fills the map's unknown
+    // cells. Blended into the ground the map has seen, a shifted view of it makes steps and
+    // drops all over the overlap (the fake hazards that sealed the terrain runs' way).
+    stop.elevation_cells_filled = FillUnknown(result_.elevation, near, laser);
+    return;
+  }
   result_.elevation.InsertScan(near.data(), near.size(), laser);
   // The laser cannot see under the robot, but the robot stands on that ground; only a registered
   // pose knows its height well enough (odometry's z drifts, and a wrong one makes a step around
   // the robot that traps it).
-  if (stop.elevation_from_odometry) return;
   std::vector<Eigen::Vector3f> ground;
   for (double x = -kFootprintHalf_m; x <= kFootprintHalf_m + 1e-9; x += 0.1) {
     for (double y = -kFootprintHalf_m; y <= kFootprintHalf_m + 1e-9; y += 0.1) {

@@ -113,6 +113,9 @@ struct StopRecord {
   /// With elevation_from_odometry: the height that pose took from the map's ground
   /// (FitHeightOffset), when the scan overlapped enough of it.
   std::optional<HeightOffset> height_fit;
+  /// With elevation_from_odometry: the map's unknown cells the scan filled; it leaves the cells
+  /// the map has already seen as they are [1].
+  std::size_t elevation_cells_filled = 0;
   double distance_to_goal_m = 0;  ///< from the estimate [m]
 };
 

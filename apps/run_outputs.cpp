@@ -130,6 +130,7 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
       {"height_fit", stop.height_fit ? nlohmann::json{{"dz_m", stop.height_fit->dz_m},
                                                       {"cells", stop.height_fit->cells}}
                                      : nlohmann::json()},
+      {"elevation_cells_filled", stop.elevation_cells_filled},
       {"success", reg.success},
       {"reason", reg.reason},
       {"path", mapping::ToString(reg.path)},
@@ -231,6 +232,10 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
     m["hazard_cells_crossed"] = score->hazard_cells_crossed;
     m["map_hazards"] = {{"cells_compared", score->map_cells_compared},
                         {"false_hazard_cells", score->false_hazard_cells},
+                        {"false_as",
+                         {{"step", score->false_steps},
+                          {"drop", score->false_drops},
+                          {"too_steep", score->false_too_steep}}},
                         {"missed_hazard_cells", score->missed_hazard_cells}};
     if (std::isfinite(score->closest_hazard_m)) {
       m["closest_approach_to_forbidden_m"] = score->closest_hazard_m;

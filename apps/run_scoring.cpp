@@ -151,7 +151,12 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
     if (!known(truth, k) || !known(estimated, k)) continue;
     const planning::Blocked t = truth.blocked[k], e = estimated.blocked[k];
     ++s.map_cells_compared;
-    s.false_hazard_cells += IsHazard(e) && t == planning::Blocked::kFree;
+    if (IsHazard(e) && t == planning::Blocked::kFree) {
+      ++s.false_hazard_cells;
+      s.false_steps += e == planning::Blocked::kStep;
+      s.false_drops += e == planning::Blocked::kDrop;
+      s.false_too_steep += e == planning::Blocked::kTooSteep;
+    }
     s.missed_hazard_cells += IsHazard(t) && e == planning::Blocked::kFree;
   }
   return s;

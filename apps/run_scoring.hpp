@@ -42,6 +42,8 @@ struct RunScore {
   /// unlike success these counts change smoothly with the map's quality [1].
   std::size_t map_cells_compared = 0;
   std::size_t false_hazard_cells = 0;   ///< hazard in the map, truly free (not even near one)
+  /// Of those, what the map took them for: a step, a drop, too steep [1].
+  std::size_t false_steps = 0, false_drops = 0, false_too_steep = 0;
   std::size_t missed_hazard_cells = 0;  ///< free in the map, truly a hazard
 };
 
