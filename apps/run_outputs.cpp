@@ -147,6 +147,15 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
     j["truth"] = PoseJson(*stop.T_world_base_true);
     j["error"] = {{"translation_m", d.translation().norm()},
                   {"rotation_deg", Eigen::AngleAxisd(d.linear()).angle() * kRadToDeg}};
+    // The truth is the pose after the scan. On rough ground the robot rocks while the laser nods
+    // (terrain: 0.2 deg median, 2.2 deg p95, 12 deg at most), its lines come from different poses
+    // and no single pose is the scan's: this says how far from one this stop's truth is.
+    if (stop.scan.has_truth) {
+      const Eigen::Isometry3d m = stop.scan.T_world_base.inverse() * *stop.T_world_base_true;
+      j["truth_moved_during_scan"] = {
+          {"translation_m", m.translation().norm()},
+          {"rotation_deg", Eigen::AngleAxisd(m.linear()).angle() * kRadToDeg}};
+    }
   }
   // The plan of this stop: how it was found, or why there was none.
   j["plan"] = {{"found", stop.plan.has_value()},

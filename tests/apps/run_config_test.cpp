@@ -80,7 +80,8 @@ TEST(RunSettings, TheRunRegistersWithScanToMapDefaultsAKeyGivenWins) {
   const mapping::RegistrationConfig& r = s.mission.registration.registration;
   EXPECT_EQ(r.max_rmse_m, 0.06);
   EXPECT_EQ(r.min_inlier_ratio, 0.15);
-  EXPECT_EQ(r.constraint_translation_m, 1.0);
+  EXPECT_EQ(r.constraint_translation_m, 2.0)
+      << "odometry slips up to 2.5 m on rugged ground; the office repeats every 2 m";
   EXPECT_GT(r.carry_max_m, s.mission.odometry_error_m + 4 * s.mission.odometry_error_per_m)
       << "a 4 m drive's bound must let odometry supply a corridor's axis";
   EXPECT_LT(pairwise.max_rmse_m, r.max_rmse_m);
