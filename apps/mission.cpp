@@ -110,17 +110,15 @@ std::size_t FillUnknown(mapping::ElevationMap& map, const std::vector<Eigen::Vec
   local.size_y = j1 - j0 + 1;
   mapping::ElevationMap view(local);
   view.InsertScan(points.data(), points.size(), laser);
-  std::size_t unknown_before = 0;
-  for (int j = j0; j <= j1; ++j) {
-    for (int i = i0; i <= i1; ++i) unknown_before += !map.at({i, j}).known();
+  std::size_t filled = 0;
+  for (int j = 0; j < local.size_y; ++j) {
+    for (int i = 0; i < local.size_x; ++i) {
+      filled += view.at({i, j}).known() && !map.at({i + i0, j + j0}).known();
+    }
   }
   const auto merged = map.Merge(view, mapping::ElevationMap::MergeCells::kUnknown);
   if (!merged) throw std::logic_error("mission: " + merged.error().message);  // same alignment
-  std::size_t unknown_after = 0;
-  for (int j = j0; j <= j1; ++j) {
-    for (int i = i0; i <= i1; ++i) unknown_after += !map.at({i, j}).known();
-  }
-  return unknown_before - unknown_after;
+  return filled;
 }
 
 class Mission {
