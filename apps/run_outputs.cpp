@@ -287,13 +287,15 @@ void WriteFinalOutputs(RunFolder& folder, const RunContext& c, const MissionResu
   DrawPolyline(image, r.elevation.geometry(), EstimatedXy(r), 255, 140, 0);
   DrawPolyline(image, r.elevation.geometry(), TrueXy(r), 30, 80, 255);
   Check(mapping::WritePng(image, folder.File("elevation.png").string()));
-  Check(mapping::WritePng(
-      RenderTraversability(planning::BuildTraversability(layers, c.planner), options),
-      folder.File("traversability.png").string()));
+  const planning::TraversabilityGrid estimated = planning::BuildTraversability(layers, c.planner);
+  Check(mapping::WritePng(RenderTraversability(estimated, options),
+                          folder.File("traversability.png").string()));
   if (truth) {
-    Check(mapping::WritePng(
-        RenderTraversability(planning::BuildTraversability(*truth, c.planner), options),
-        folder.File("truth_traversability.png").string()));
+    const planning::TraversabilityGrid true_grid = planning::BuildTraversability(*truth, c.planner);
+    Check(mapping::WritePng(RenderTraversability(true_grid, options),
+                            folder.File("truth_traversability.png").string()));
+    Check(mapping::WritePng(RenderHazardErrors(estimated, true_grid, options),
+                            folder.File("hazard_errors.png").string()));
     mapping::RgbImage truth_image = mapping::RenderElevationImage(*truth, options);
     if (truth_optimum) planning::DrawPath(*truth_optimum, truth->geometry, truth_image);
     DrawPolyline(truth_image, truth->geometry, TrueXy(r), 30, 80, 255);
@@ -325,6 +327,10 @@ void WriteFinalOutputs(RunFolder& folder, const RunContext& c, const MissionResu
              900);
   if (truth) {
     report.Png(ReadBinaryFile(folder.File("truth_traversability.png")), "traversability, true map",
+               900);
+    report.Paragraph("Where the final map's hazards are wrong (map_hazards in the metrics). " +
+                     HazardErrorsLegend());
+    report.Png(ReadBinaryFile(folder.File("hazard_errors.png")), "hazard errors of the final map",
                900);
   }
   report.Plot(

@@ -70,6 +70,19 @@ double ClosestHazard(const std::vector<Eigen::Vector2d>& xy, const planning::Tra
 
 }  // namespace
 
+HazardVerdict CompareHazard(const planning::TraversabilityGrid& estimated,
+                            const planning::TraversabilityGrid& truth, std::size_t k) {
+  const auto known = [k](const planning::TraversabilityGrid& g) {
+    return g.blocked[k] != planning::Blocked::kUnknown &&
+           (std::isfinite(g.z_m[k]) || IsHazard(g.blocked[k]));
+  };
+  if (!known(truth) || !known(estimated)) return HazardVerdict::kNotCompared;
+  const planning::Blocked t = truth.blocked[k], e = estimated.blocked[k];
+  if (IsHazard(e) && t == planning::Blocked::kFree) return HazardVerdict::kFalseHazard;
+  if (IsHazard(t) && e == planning::Blocked::kFree) return HazardVerdict::kMissedHazard;
+  return HazardVerdict::kAgree;
+}
+
 RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGrid& truth,
                   const planning::TraversabilityGrid& estimated,
                   const Eigen::Vector2d& start_m, const Eigen::Vector2d& goal_m,
@@ -142,22 +155,17 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
   if (!estimated.geometry.SameAs(truth.geometry)) {
     throw std::invalid_argument("score: the estimated and the true map are on different grids");
   }
-  // Unknown: no height and no hazard inferred (a drop may have no points, only rays over it).
-  const auto known = [](const planning::TraversabilityGrid& g, std::size_t k) {
-    return g.blocked[k] != planning::Blocked::kUnknown &&
-           (std::isfinite(g.z_m[k]) || IsHazard(g.blocked[k]));
-  };
   for (std::size_t k = 0; k < truth.blocked.size(); ++k) {
-    if (!known(truth, k) || !known(estimated, k)) continue;
-    const planning::Blocked t = truth.blocked[k], e = estimated.blocked[k];
-    ++s.map_cells_compared;
-    if (IsHazard(e) && t == planning::Blocked::kFree) {
+    const HazardVerdict v = CompareHazard(estimated, truth, k);
+    s.map_cells_compared += v != HazardVerdict::kNotCompared;
+    s.missed_hazard_cells += v == HazardVerdict::kMissedHazard;
+    if (v == HazardVerdict::kFalseHazard) {
+      const planning::Blocked e = estimated.blocked[k];
       ++s.false_hazard_cells;
       s.false_steps += e == planning::Blocked::kStep;
       s.false_drops += e == planning::Blocked::kDrop;
       s.false_too_steep += e == planning::Blocked::kTooSteep;
     }
-    s.missed_hazard_cells += IsHazard(t) && e == planning::Blocked::kFree;
   }
   return s;
 }

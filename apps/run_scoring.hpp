@@ -47,6 +47,14 @@ struct RunScore {
   std::size_t missed_hazard_cells = 0;  ///< free in the map, truly a hazard
 };
 
+/// How a map's cell compares with the truth's (both on one grid): kNotCompared where either does
+/// not know the cell (no height and no hazard inferred: a drop may have no points, only rays).
+enum class HazardVerdict { kNotCompared, kAgree, kFalseHazard, kMissedHazard };
+/// kFalseHazard: a step, drop or too steep cell of `estimated` that `truth` calls free (not even
+/// near a hazard); kMissedHazard: a true hazard `estimated` calls free.
+HazardVerdict CompareHazard(const planning::TraversabilityGrid& estimated,
+                            const planning::TraversabilityGrid& truth, std::size_t k);
+
 /// `truth` is the true traversability over the mission's map area, `estimated` the final map's on
 /// the same grid; `start_m`/`goal_m` world [m].
 RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGrid& truth,

@@ -1,15 +1,17 @@
 #include "traversability_image.hpp"
 
+#include "run_scoring.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 
 namespace pitchlab::apps {
 
-mapping::RgbImage RenderTraversability(const planning::TraversabilityGrid& T,
-                                       const mapping::ImageOptions& o) {
-  using planning::Blocked;
-  const mapping::GridGeometry& g = T.geometry;
+namespace {
+
+// A black image of `g`'s cells at the options' scale.
+mapping::RgbImage BlankImage(const mapping::GridGeometry& g, const mapping::ImageOptions& o) {
   int ppc = o.pixels_per_cell;
   if (ppc <= 0) ppc = std::max(1, o.max_side_px / std::max(1, std::max(g.size_x, g.size_y)));
   mapping::RgbImage img;
@@ -17,6 +19,33 @@ mapping::RgbImage RenderTraversability(const planning::TraversabilityGrid& T,
   img.width = g.size_x * ppc;
   img.height = g.size_y * ppc;
   img.rgb.assign(static_cast<std::size_t>(img.width) * img.height * 3, 0);
+  return img;
+}
+
+// Paints cell (i, j) of an image of `g`, north up.
+void PaintCell(mapping::RgbImage& img, const mapping::GridGeometry& g, int i, int j,
+               const std::array<int, 3>& c) {
+  const int ppc = img.pixels_per_cell;
+  const int y0 = (g.size_y - 1 - j) * ppc, x0 = i * ppc;
+  for (int dy = 0; dy < ppc; ++dy)
+    for (int dx = 0; dx < ppc; ++dx)
+      img.Set(x0 + dx, y0 + dy, static_cast<std::uint8_t>(c[0]), static_cast<std::uint8_t>(c[1]),
+              static_cast<std::uint8_t>(c[2]));
+}
+
+// The elevation picture's checkerboard for unknown cells.
+std::array<int, 3> Checker(int i, int j) {
+  return ((i / 4) + (j / 4)) % 2 ? std::array<int, 3>{150, 150, 150}
+                                 : std::array<int, 3>{200, 200, 200};
+}
+
+}  // namespace
+
+mapping::RgbImage RenderTraversability(const planning::TraversabilityGrid& T,
+                                       const mapping::ImageOptions& o) {
+  using planning::Blocked;
+  const mapping::GridGeometry& g = T.geometry;
+  mapping::RgbImage img = BlankImage(g, o);
   // Entering costs span min..max over the free cells; shade by where a cell sits in that span.
   float lo = INFINITY, hi = -INFINITY;
   for (std::size_t k = 0; k < g.cell_count(); ++k) {
@@ -32,8 +61,7 @@ mapping::RgbImage RenderTraversability(const planning::TraversabilityGrid& T,
       const bool unknown = T.blocked[k] == Blocked::kUnknown ||
                            (T.blocked[k] == Blocked::kFree && !std::isfinite(T.z_m[k]));
       if (unknown) {
-        const bool dark = ((i / 4) + (j / 4)) % 2;  // as the elevation picture
-        c = dark ? std::array<int, 3>{150, 150, 150} : std::array<int, 3>{200, 200, 200};
+        c = Checker(i, j);
       } else {
         switch (T.blocked[k]) {
           case Blocked::kFree: {
@@ -58,14 +86,46 @@ mapping::RgbImage RenderTraversability(const planning::TraversabilityGrid& T,
             break;
         }
       }
-      const int y0 = (g.size_y - 1 - j) * ppc, x0 = i * ppc;  // north up
-      for (int dy = 0; dy < ppc; ++dy)
-        for (int dx = 0; dx < ppc; ++dx)
-          img.Set(x0 + dx, y0 + dy, static_cast<std::uint8_t>(c[0]),
-                  static_cast<std::uint8_t>(c[1]), static_cast<std::uint8_t>(c[2]));
+      PaintCell(img, g, i, j, c);
     }
   }
   return img;
+}
+
+mapping::RgbImage RenderHazardErrors(const planning::TraversabilityGrid& estimated,
+                                     const planning::TraversabilityGrid& truth,
+                                     const mapping::ImageOptions& o) {
+  const mapping::GridGeometry& g = estimated.geometry;
+  mapping::RgbImage img = BlankImage(g, o);
+  for (int j = 0; j < g.size_y; ++j) {
+    for (int i = 0; i < g.size_x; ++i) {
+      const std::size_t k = g.Linear({i, j});
+      std::array<int, 3> c{};
+      switch (CompareHazard(estimated, truth, k)) {
+        case HazardVerdict::kNotCompared:
+          c = Checker(i, j);
+          break;
+        case HazardVerdict::kAgree:
+          c = estimated.Free(k) ? std::array<int, 3>{235, 235, 235}
+                                : std::array<int, 3>{120, 120, 120};
+          break;
+        case HazardVerdict::kFalseHazard:
+          c = {220, 20, 20};
+          break;
+        case HazardVerdict::kMissedHazard:
+          c = {20, 60, 230};
+          break;
+      }
+      PaintCell(img, g, i, j, c);
+    }
+  }
+  return img;
+}
+
+std::string HazardErrorsLegend() {
+  return "Red: a hazard (step, drop, too steep) in the map where the truth is free; blue: a true "
+         "hazard the map calls free; light grey: both free; dark grey: both see a hazard or its "
+         "margin; checkered: not compared (unknown in either).";
 }
 
 std::string TraversabilityLegend() {

@@ -19,4 +19,14 @@ mapping::RgbImage RenderTraversability(const planning::TraversabilityGrid& grid,
 /// The legend of RenderTraversability's colours, one sentence.
 std::string TraversabilityLegend();
 
+/// Where the map's hazards are wrong (CompareHazard): false hazards red, missed hazards blue,
+/// agreeing cells grey (darker where both see a hazard), cells not compared checkered. Same pixel
+/// grid as RenderTraversability.
+mapping::RgbImage RenderHazardErrors(const planning::TraversabilityGrid& estimated,
+                                     const planning::TraversabilityGrid& truth,
+                                     const mapping::ImageOptions& options = {});
+
+/// The legend of RenderHazardErrors' colours, one sentence.
+std::string HazardErrorsLegend();
+
 }  // namespace pitchlab::apps

@@ -71,6 +71,12 @@ TEST_F(RunCli, AMissionAroundABlockReachesTheGoalAndWritesEveryOutput) {
   EXPECT_EQ(metrics["hazard_cells_crossed"].get<int>(), 0);
   EXPECT_LE(metrics["hazard_cells_crossed"].get<int>(),
             metrics["forbidden_cells_crossed"].get<int>());
+  // The final map's hazards against the true ones: the block's walls seen, few false ones.
+  const nlohmann::json& hazards = metrics["map_hazards"];
+  const double compared = hazards["cells_compared"].get<double>();
+  EXPECT_GT(compared, 2000);
+  EXPECT_LT(hazards["false_hazard_cells"].get<double>(), 0.01 * compared);
+  EXPECT_LT(hazards["missed_hazard_cells"].get<double>(), 0.01 * compared);
   EXPECT_GT(metrics["distance_m"].get<double>(), 11.0);  // around the block, not through it
   EXPECT_GE(metrics["cost_ratio"].get<double>(), 0.95);
   EXPECT_LT(metrics["cost_ratio"].get<double>(), 1.5);
@@ -93,8 +99,8 @@ TEST_F(RunCli, AMissionAroundABlockReachesTheGoalAndWritesEveryOutput) {
   EXPECT_TRUE(mapping::LoadElevationMap((run / "elevation.plem").string()));
   EXPECT_NE(Slurp(run / "elevation.asc").find("ncols"), std::string::npos);
   EXPECT_NE(Slurp(run / "elevation.prj").find("PROJCS"), std::string::npos);
-  for (const char* png :
-       {"elevation.png", "truth_elevation.png", "traversability.png", "truth_traversability.png"}) {
+  for (const char* png : {"elevation.png", "truth_elevation.png", "traversability.png",
+                          "truth_traversability.png", "hazard_errors.png"}) {
     EXPECT_EQ(Slurp(run / png).substr(1, 3), "PNG") << png;
   }
   for (const char* csv : {"trajectory_estimated.csv", "trajectory_true.csv"}) {
