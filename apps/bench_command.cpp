@@ -528,6 +528,19 @@ json Median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+// Each run's false hazard cells per cell compared [%], where the run reported them.
+std::vector<double> FalseHazardPercent(const std::vector<const json*>& records) {
+  std::vector<double> v;
+  for (const json* r : records) {
+    const json& f = r->value("false_hazard_cells", json());
+    const json& n = r->value("map_cells_compared", json());
+    if (f.is_number() && n.is_number() && n.get<double>() > 0) {
+      v.push_back(100.0 * f.get<double>() / n.get<double>());
+    }
+  }
+  return v;
+}
+
 json Max(const std::vector<double>& v) {
   if (v.empty()) return json();
   return *std::max_element(v.begin(), v.end());
@@ -558,6 +571,7 @@ json SummaryRow(const std::string& world, const std::vector<const json*>& record
           {"max_registration_step_m", Max(Numbers(records, "registration_step_max_m"))},
           {"max_registration_step_deg", Max(Numbers(records, "registration_step_max_deg"))},
           {"median_cost_ratio", Median(Numbers(records, "cost_ratio"))},
+          {"median_false_hazard_percent", Median(FalseHazardPercent(records))},
           {"failure_reasons", reasons}};
 }
 
@@ -593,10 +607,11 @@ std::string Cell(const json& v, const char* format) {
 
 void PrintTable(const json& summary, std::FILE* out) {
   // "reg max": the worst pose error of a registered stop (with the drift it inherits); "reg step
-  // max": the worst error of one registration, the motion since the last merged stop.
-  std::fprintf(out, "%-14s %5s %5s %8s %18s %8s %14s %13s %20s\n", "world", "runs", "ok", "success",
-               "wall med/max [s]", "RTF med", "pose err [m]", "reg max [m]",
-               "reg step max [m/deg]");
+  // max": the worst error of one registration, the motion since the last merged stop; "false
+  // haz": the final map's false hazard cells per cell compared with the truth, median over runs.
+  std::fprintf(out, "%-14s %5s %5s %8s %18s %8s %14s %13s %20s %13s\n", "world", "runs", "ok",
+               "success", "wall med/max [s]", "RTF med", "pose err [m]", "reg max [m]",
+               "reg step max [m/deg]", "false haz [%]");
   std::vector<json> rows(summary["worlds"].begin(), summary["worlds"].end());
   rows.push_back(summary["total"]);
   for (const json& r : rows) {
@@ -604,12 +619,13 @@ void PrintTable(const json& summary, std::FILE* out) {
         Cell(r["median_wall_time_s"], "%.1f") + " / " + Cell(r["max_wall_time_s"], "%.1f");
     const std::string step = Cell(r["max_registration_step_m"], "%.3f") + " / " +
                              Cell(r["max_registration_step_deg"], "%.2f");
-    std::fprintf(out, "%-14s %5zu %5zu %7.1f%% %18s %8s %14s %13s %20s\n",
+    std::fprintf(out, "%-14s %5zu %5zu %7.1f%% %18s %8s %14s %13s %20s %13s\n",
                  r["world"].get<std::string>().c_str(), r["runs"].get<std::size_t>(),
                  r["successes"].get<std::size_t>(), 100.0 * r["success_rate"].get<double>(),
                  wall.c_str(), Cell(r["median_real_time_factor"], "%.1fx").c_str(),
                  Cell(r["median_final_pose_error_m"], "%.3f").c_str(),
-                 Cell(r["max_registration_error_m"], "%.3f").c_str(), step.c_str());
+                 Cell(r["max_registration_error_m"], "%.3f").c_str(), step.c_str(),
+                 Cell(r["median_false_hazard_percent"], "%.2f").c_str());
   }
   for (const auto& [reason, count] : summary["total"]["failure_reasons"].items()) {
     std::fprintf(out, "  failed %dx: %s\n", count.get<int>(), reason.c_str());
