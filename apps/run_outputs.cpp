@@ -3,6 +3,7 @@
 #include "traversability_image.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <cstdio>
 #include <sstream>
 #include <stdexcept>
@@ -279,7 +280,7 @@ void WriteFinalOutputs(RunFolder& folder, const RunContext& c, const MissionResu
   }
   // The picture: estimated map, last plan (red), estimated (orange) and true (blue) trajectory.
   mapping::ImageOptions options;
-  options.max_side_px = 1400;
+  options.max_side_px = kRunPictureMaxSide_px;
   mapping::RgbImage image = mapping::RenderElevationImage(layers, options);
   for (const StopRecord& s : r.stops) {
     if (s.plan) planning::DrawPath(*s.plan, r.elevation.geometry(), image);
@@ -294,8 +295,6 @@ void WriteFinalOutputs(RunFolder& folder, const RunContext& c, const MissionResu
     const planning::TraversabilityGrid true_grid = planning::BuildTraversability(*truth, c.planner);
     Check(mapping::WritePng(RenderTraversability(true_grid, options),
                             folder.File("truth_traversability.png").string()));
-    Check(mapping::WritePng(RenderHazardErrors(estimated, true_grid, options),
-                            folder.File("hazard_errors.png").string()));
     mapping::RgbImage truth_image = mapping::RenderElevationImage(*truth, options);
     if (truth_optimum) planning::DrawPath(*truth_optimum, truth->geometry, truth_image);
     DrawPolyline(truth_image, truth->geometry, TrueXy(r), 30, 80, 255);
@@ -328,6 +327,8 @@ void WriteFinalOutputs(RunFolder& folder, const RunContext& c, const MissionResu
   if (truth) {
     report.Png(ReadBinaryFile(folder.File("truth_traversability.png")), "traversability, true map",
                900);
+  }
+  if (std::filesystem::exists(folder.File("hazard_errors.png"))) {
     report.Paragraph("Where the final map's hazards are wrong (map_hazards in the metrics). " +
                      HazardErrorsLegend());
     report.Png(ReadBinaryFile(folder.File("hazard_errors.png")), "hazard errors of the final map",
