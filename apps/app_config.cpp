@@ -11,7 +11,7 @@ namespace pitchlab::apps {
 namespace {
 
 // Top-level sections any pitchlab module reads; anything else is a typo worth an error.
-const std::set<std::string> kSections = {"seed",     "robot",      "odometry",     "lms200",
+const std::set<std::string> kSections = {"seed",     "robot",      "odometry",     "imu", "lms200",
                                          "pitch_unit", "scan",     "mount",        "registration",
                                          "elevation", "planner",   "run",          "backend",   "hw"};
 
@@ -65,6 +65,30 @@ void ReadOdometry(const YAML::Node& node, const std::string& source, sim::Odomet
   }
 }
 
+void ReadImu(const YAML::Node& node, const std::string& source, sim::ImuConfig& imu) {
+  if (!node) return;
+  if (!node.IsMap()) throw std::invalid_argument(source + ": 'imu' must be a map");
+  for (const auto& kv : node) {
+    const std::string key = kv.first.as<std::string>();
+    try {
+      if (key == "deskew") {
+        imu.deskew = kv.second.as<bool>();
+      } else if (key == "gyro_bias_dps") {
+        imu.gyro_bias_dps = kv.second.as<double>();
+      } else if (key == "gyro_noise_dps_rthz") {
+        imu.gyro_noise_dps_rthz = kv.second.as<double>();
+      } else {
+        throw std::invalid_argument(source + ": imu." + key +
+                                    " is not a known setting (deskew, gyro_bias_dps, "
+                                    "gyro_noise_dps_rthz)");
+      }
+    } catch (const YAML::Exception&) {
+      throw std::invalid_argument(source + ": imu." + key +
+                                  (key == "deskew" ? " must be true or false" : " must be a number"));
+    }
+  }
+}
+
 }  // namespace
 
 AppConfig LoadAppConfig(const std::optional<std::string>& path) {
@@ -95,9 +119,11 @@ AppConfig LoadAppConfig(const std::optional<std::string>& path) {
   sim::SimRigConfig& rig = config.rig;
   ReadRobot(root["robot"], source, rig.robot);
   ReadOdometry(root["odometry"], source, rig.odometry);
+  ReadImu(root["imu"], source, rig.imu);
   // One seed drives every random source unless a section sets its own.
   if (!(root["lms200"] && root["lms200"]["seed"])) config.sensors.lms200.seed = config.seed;
   rig.odometry.seed = config.seed;
+  rig.imu.seed = config.seed;
   rig.lms200 = config.sensors.lms200;
   rig.pitch_unit = config.sensors.pitch_unit;
   rig.pattern = config.sensors.scan;
@@ -105,6 +131,7 @@ AppConfig LoadAppConfig(const std::optional<std::string>& path) {
   try {
     rig.robot.Validate();
     rig.odometry.Validate();
+    rig.imu.Validate();
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(source + ": " + e.what());
   }
@@ -122,6 +149,10 @@ std::string AppConfigToYaml(const AppConfig& config) {
      << "  scale_sigma: " << rig.odometry.scale_sigma << "\n"
      << "  increment_sigma: " << rig.odometry.increment_sigma << "\n"
      << "  track_error: " << rig.odometry.track_error << "\n"
+     << "imu:\n"
+     << "  deskew: " << (rig.imu.deskew ? "true" : "false") << "\n"
+     << "  gyro_bias_dps: " << rig.imu.gyro_bias_dps << "\n"
+     << "  gyro_noise_dps_rthz: " << rig.imu.gyro_noise_dps_rthz << "\n"
      << sensors::SensorConfigToYaml(config.sensors);
   return os.str();
 }

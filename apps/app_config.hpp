@@ -1,6 +1,6 @@
 #pragma once
 // The run configuration a user gives with --config FILE: one YAML document whose sections belong
-// to the modules (lms200, pitch_unit, scan, mount: sensors; robot, odometry: sim), plus the seed.
+// to the modules (lms200, pitch_unit, scan, mount: sensors; robot, odometry, imu: sim), plus the seed.
 
 #include <cstdint>
 #include <optional>

@@ -90,7 +90,8 @@ int RunRun(int argc, char** argv) {
     const std::vector<double> seed = args.GetNumbers("seed", 1);
     if (seed[0] < 0 || seed[0] != std::floor(seed[0])) throw CliError("--seed must be an integer >= 0");
     config.seed = static_cast<std::uint64_t>(seed[0]);
-    config.sensors.lms200.seed = config.rig.lms200.seed = config.rig.odometry.seed = config.seed;
+    config.sensors.lms200.seed = config.rig.lms200.seed = config.rig.odometry.seed =
+        config.rig.imu.seed = config.seed;
   }
   if (args.Has("robot")) config.rig.robot.model = ParseRobotModel(args.Get("robot"));
   const std::string config_text =

@@ -132,6 +132,8 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
                                                       {"cells", stop.height_fit->cells}}
                                      : nlohmann::json()},
       {"elevation_cells_filled", stop.elevation_cells_filled},
+      {"deskewed", stop.scan.deskewed},
+      {"deskew_deg", stop.scan.deskew_max_rad * kRadToDeg},
       {"success", reg.success},
       {"reason", reg.reason},
       {"path", mapping::ToString(reg.path)},
@@ -150,8 +152,9 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
                   {"rotation_deg", Eigen::AngleAxisd(d.linear()).angle() * kRadToDeg}};
     // The truth is the pose after the scan. On rough ground the robot rocks while the laser nods
     // (terrain: 0.2 deg median, 2.2 deg p95, 12 deg at most), its lines come from different poses
-    // and no single pose is the scan's: this says how far from one this stop's truth is.
-    if (stop.scan.has_truth) {
+    // and no single pose is the scan's: this says how far from one this stop's truth is (a
+    // deskewed scan's truth is already the pose after it; deskew_deg says how much it turned).
+    if (stop.scan.has_truth && !stop.scan.deskewed) {
       const Eigen::Isometry3d m = stop.scan.T_world_base.inverse() * *stop.T_world_base_true;
       j["truth_moved_during_scan"] = {
           {"translation_m", m.translation().norm()},

@@ -39,6 +39,8 @@ Result<Scan3D> PitchingScanSource::Acquire() {
   const double step_deg = n > 1 ? (pattern_.pitch_end_deg - pattern_.pitch_start_deg) / (n - 1) : 0;
   std::vector<LaserLine> lines;
   lines.reserve(static_cast<std::size_t>(n));
+  std::vector<Eigen::Quaterniond> attitudes;
+  bool attitude_known = static_cast<bool>(attitude_);
   for (int k = 0; k < n; ++k) {
     const double target_rad = (pattern_.pitch_start_deg + k * step_deg) * kDegToRad;
     Result<double> encoder_rad = axis_.MoveTo(target_rad, timeout);
@@ -54,9 +56,15 @@ Result<Scan3D> PitchingScanSource::Acquire() {
     // Eq. 1 uses the angle the encoder read, not the one commanded.
     line->pitch_rad = *encoder_rad;
     lines.push_back(std::move(*line));
+    if (attitude_known) {
+      const std::optional<Eigen::Quaterniond> q = attitude_();
+      attitude_known = q.has_value();
+      if (q) attitudes.push_back(*q);
+    }
     if (progress_) progress_(k + 1, n);
   }
-  return AssembleScan(std::move(lines), mount_);
+  if (!attitude_known) attitudes.clear();  // a line without one: the scan stays as swept
+  return AssembleScan(std::move(lines), mount_, attitudes);
 }
 
 }  // namespace pitchlab::sensors

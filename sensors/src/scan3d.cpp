@@ -1,6 +1,9 @@
 #include "pitchlab/sensors/scan3d.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace pitchlab::sensors {
 
@@ -29,8 +32,15 @@ Eigen::Vector3d BeamPointInBase(double rho_m, double theta_rad, double gamma_rad
   return mount.BaseToLaser(gamma_rad) * in_plane;
 }
 
-Scan3D AssembleScan(std::vector<LaserLine> lines, const MountConfig& mount) {
+Scan3D AssembleScan(std::vector<LaserLine> lines, const MountConfig& mount,
+                    const std::vector<Eigen::Quaterniond>& attitudes) {
+  if (!attitudes.empty() && attitudes.size() != lines.size()) {
+    throw std::invalid_argument("AssembleScan: " + std::to_string(attitudes.size()) +
+                                " attitudes for " + std::to_string(lines.size()) +
+                                " lines (one per line, or none)");
+  }
   Scan3D scan;
+  scan.deskewed = !attitudes.empty();
   if (!lines.empty()) {
     scan.stamp_s = lines.front().stamp_s;
     const LaserLine& last = lines.back();
@@ -41,7 +51,15 @@ Scan3D AssembleScan(std::vector<LaserLine> lines, const MountConfig& mount) {
   scan.points.reserve(readings);
   for (std::size_t l = 0; l < lines.size(); ++l) {
     const LaserLine& line = lines[l];
-    const Eigen::Isometry3d T_base_laser = mount.BaseToLaser(line.pitch_rad);
+    Eigen::Isometry3d T_base_laser = mount.BaseToLaser(line.pitch_rad);
+    if (scan.deskewed) {
+      // Rotation only, about base_link's origin: the base rocks about a tyre's contact a few
+      // decimetres away, which moves the laser by millimetres per degree; the turn itself moves
+      // far returns by centimetres per degree.
+      const Eigen::Quaterniond to_last = attitudes.back().conjugate() * attitudes[l];
+      scan.deskew_max_rad = std::max(scan.deskew_max_rad, Eigen::AngleAxisd(to_last).angle());
+      T_base_laser.prerotate(to_last.normalized().toRotationMatrix());
+    }
     for (std::size_t i = 0; i < line.ranges_m.size(); ++i) {
       switch (line.status[i]) {
         case ReadingStatus::kValid: break;

@@ -24,6 +24,11 @@ SimRig::SimRig(std::unique_ptr<Simulation> sim, const SimRigConfig& config)
   scanner_ = std::make_unique<SimLineScanner>(*sim_, *caster_, config_.lms200);
   source_ = std::make_unique<sensors::PitchingScanSource>(*scanner_, *axis_, config_.pattern,
                                                           config_.robot.mount);
+  if (config_.imu.deskew) {
+    imu_ = std::make_unique<SimImu>(*sim_, config_.imu);
+    source_->set_attitude_probe(
+        [this]() -> std::optional<Eigen::Quaterniond> { return imu_->Orientation(); });
+  }
 }
 
 SimRig::~SimRig() = default;
@@ -47,7 +52,7 @@ Result<sensors::Scan3D> SimRig::Acquire() {
   Result<sensors::Scan3D> scan = source_->Acquire();
   if (!scan) return scan;
   scan->has_truth = true;
-  scan->T_world_base = T_world_base;
+  scan->T_world_base = scan->deskewed ? sim_->T_world_base() : T_world_base;
   return scan;
 }
 

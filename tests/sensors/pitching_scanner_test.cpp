@@ -80,6 +80,41 @@ TEST(PitchingScanSource, ADeviceErrorNamesTheLineAndStopsTheScan) {
   EXPECT_NE(scan.error().message.find("line 17"), std::string::npos) << scan.error().message;
 }
 
+TEST(PitchingScanSource, AnAttitudeProbeDeskewsOnlyWhenItAnswersEveryLine) {
+  FakeAxis axis;
+  FakeScanner scanner;
+  ScanPatternConfig pattern;
+  pattern.lines = 10;
+  PitchingScanSource source(scanner, axis, pattern, MountConfig{});
+  // The base yaws 1 deg per line: the first line's wall points turn by 9 deg into the last frame.
+  int reads = 0;
+  source.set_attitude_probe([&]() -> std::optional<Eigen::Quaterniond> {
+    return Eigen::Quaterniond(Eigen::AngleAxisd(reads++ * kDeg, Eigen::Vector3d::UnitZ()));
+  });
+  Result<Scan3D> scan = source.Acquire();
+  ASSERT_TRUE(scan) << scan.error().message;
+  EXPECT_EQ(reads, 10);
+  EXPECT_TRUE(scan->deskewed);
+  EXPECT_NEAR(scan->deskew_max_rad, 9 * kDeg, 1e-9);
+  const Scan3D plain = AssembleScan(scan->lines, MountConfig{});
+  const ScanPoint& p = scan->points.front();  // line 0
+  const ScanPoint& q = plain.points.front();
+  ASSERT_EQ(p.line, 0);
+  const double turned = std::atan2(p.y, p.x) - std::atan2(q.y, q.x);
+  EXPECT_NEAR(turned, -9 * kDeg, 1e-6);
+
+  // No answer for one line: the scan stays as swept, never half corrected.
+  reads = 0;
+  source.set_attitude_probe([&]() -> std::optional<Eigen::Quaterniond> {
+    if (reads++ == 4) return std::nullopt;
+    return Eigen::Quaterniond::Identity();
+  });
+  scan = source.Acquire();
+  ASSERT_TRUE(scan) << scan.error().message;
+  EXPECT_FALSE(scan->deskewed);
+  EXPECT_EQ(reads, 5);  // not asked again after it had none
+}
+
 TEST(PitchingScanSource, RejectsAPatternWithoutLines) {
   FakeAxis axis;
   FakeScanner scanner;

@@ -1,7 +1,9 @@
 #include "pitchlab/sensors/scan3d.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include <gtest/gtest.h>
 
@@ -81,6 +83,66 @@ TEST(AssembleScan, KeepsValidReadingsCountsTheRestAndStampsByLine) {
   EXPECT_NEAR(last.y, expected.y(), 1e-6);
   EXPECT_NEAR(last.z, expected.z(), 1e-6);
   EXPECT_EQ(scan.lines.size(), 2u);
+}
+
+// Lines of flat ground 0.3 m below base_link's origin (z = -0.3 in the frame the base stands in at
+// the last line), swept while the base rocks about its origin: line k's frame is turned by
+// `rock(k)`, the last line's is not. Ranges are the exact ray-plane distances.
+struct RockedSweep {
+  std::vector<LaserLine> lines;
+  std::vector<Eigen::Quaterniond> attitudes;  // base_link per line, in the last line's frame
+};
+
+RockedSweep SweepFlatGroundWhileRocking(const MountConfig& mount) {
+  constexpr int kLines = 40;
+  constexpr double kGround_m = -0.3;
+  RockedSweep sweep;
+  for (int k = 0; k < kLines; ++k) {
+    // Up to 3 deg of roll and 2 deg of pitch, back to level at the last line.
+    const double phase = 1.0 - double(k) / (kLines - 1);
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(3 * kDeg * phase, Eigen::Vector3d::UnitX()) *
+                               Eigen::AngleAxisd(-2 * kDeg * phase, Eigen::Vector3d::UnitY()));
+    LaserLine line;
+    line.stamp_s = 0.1 * k;
+    line.pitch_rad = (10 + k) * kDeg;  // looking down at the ground ahead
+    line.angle_min_rad = -60 * kDeg;
+    line.angle_increment_rad = 5 * kDeg;
+    const Eigen::Isometry3d T = Eigen::Isometry3d(q) * mount.BaseToLaser(line.pitch_rad);
+    for (int i = 0; i <= 24; ++i) {
+      const double theta = line.Angle(i);
+      const Eigen::Vector3d dir = T.linear() * Eigen::Vector3d(std::cos(theta), std::sin(theta), 0);
+      line.ranges_m.push_back(static_cast<float>((kGround_m - T.translation().z()) / dir.z()));
+      line.status.push_back(ReadingStatus::kValid);
+    }
+    sweep.lines.push_back(std::move(line));
+    sweep.attitudes.push_back(q);
+  }
+  return sweep;
+}
+
+TEST(AssembleScan, DeskewedByTheSensedAttitudeFlatGroundIsFlat) {
+  const MountConfig mount = SeedMount();
+  const RockedSweep sweep = SweepFlatGroundWhileRocking(mount);
+  const Scan3D bent = AssembleScan(sweep.lines, mount);
+  const Scan3D deskewed = AssembleScan(sweep.lines, mount, sweep.attitudes);
+  ASSERT_EQ(deskewed.points.size(), bent.points.size());
+  EXPECT_FALSE(bent.deskewed);
+  EXPECT_TRUE(deskewed.deskewed);
+  EXPECT_NEAR(deskewed.deskew_max_rad, std::hypot(3.0, 2.0) * kDeg, 0.01 * kDeg);
+  double bent_worst_m = 0, deskewed_worst_m = 0;
+  for (std::size_t k = 0; k < bent.points.size(); ++k) {
+    bent_worst_m = std::max(bent_worst_m, std::abs(bent.points[k].z + 0.3));
+    deskewed_worst_m = std::max(deskewed_worst_m, std::abs(deskewed.points[k].z + 0.3));
+  }
+  EXPECT_GT(bent_worst_m, 0.05);      // the rock bends the uncorrected ground by centimetres
+  EXPECT_LT(deskewed_worst_m, 1e-5);  // float ranges and points
+}
+
+TEST(AssembleScan, RejectsAttitudesThatAreNotOnePerLine) {
+  const MountConfig mount = SeedMount();
+  RockedSweep sweep = SweepFlatGroundWhileRocking(mount);
+  sweep.attitudes.pop_back();
+  EXPECT_THROW((void)AssembleScan(sweep.lines, mount, sweep.attitudes), std::invalid_argument);
 }
 
 }  // namespace

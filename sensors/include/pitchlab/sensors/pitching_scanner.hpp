@@ -3,6 +3,9 @@
 // Written once against the seam interfaces, so simulation and hardware share it.
 
 #include <functional>
+#include <optional>
+
+#include <Eigen/Geometry>
 
 #include "pitchlab/sensors/result.hpp"
 #include "pitchlab/sensors/scan3d.hpp"
@@ -35,9 +38,15 @@ class PitchingScanSource final : public ScanSource {
   /// Called after each line with (lines done, lines total).
   using Progress = std::function<void(int, int)>;
 
+  /// base_link's orientation in a frame fixed to the ground (an IMU's integrated rates; only its
+  /// changes during a scan matter), or nullopt where the sensor has none to give.
+  using AttitudeProbe = std::function<std::optional<Eigen::Quaterniond>()>;
+
   PitchingScanSource(LineScanner& scanner, PitchAxis& axis, ScanPatternConfig pattern,
                      MountConfig mount);
   void set_progress(Progress progress) { progress_ = std::move(progress); }
+  /// Read after every line; when it answered for every line, the scan is deskewed (AssembleScan).
+  void set_attitude_probe(AttitudeProbe probe) { attitude_ = std::move(probe); }
   [[nodiscard]] Result<Scan3D> Acquire() override;
 
  private:
@@ -46,6 +55,7 @@ class PitchingScanSource final : public ScanSource {
   ScanPatternConfig pattern_;
   MountConfig mount_;
   Progress progress_;
+  AttitudeProbe attitude_;
 };
 
 }  // namespace pitchlab::sensors

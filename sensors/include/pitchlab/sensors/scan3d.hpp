@@ -45,11 +45,24 @@ struct Scan3D {
   std::vector<LaserLine> lines;          ///< what the scanner delivered, with encoder pitch
   std::size_t no_returns = 0;            ///< readings flagged no-return
   std::size_t over_ranges = 0;           ///< readings flagged over-range
-  bool has_truth = false;                ///< T_world_base below is the simulator's ground truth
-  Eigen::Isometry3d T_world_base = Eigen::Isometry3d::Identity();  ///< pose during the scan
+  /// The points are in base_link as it stood at the last line: each line was turned by the
+  /// base's rotation since it, as an attitude sensor measured it (AssembleScan's attitudes).
+  /// Otherwise they are in base_link as it stood at each line (one frame while the base is still).
+  bool deskewed = false;
+  /// With deskewed: the largest rotation of the base between a line and the last one [rad].
+  double deskew_max_rad = 0.0;
+  bool has_truth = false;  ///< T_world_base below is the simulator's ground truth
+  /// Pose of the points' frame: base_link when the scan started (at its end when deskewed).
+  Eigen::Isometry3d T_world_base = Eigen::Isometry3d::Identity();
 };
 
-/// Builds the 3D scan from lines by Eq. 1 (each line's encoder pitch and the mount).
-Scan3D AssembleScan(std::vector<LaserLine> lines, const MountConfig& mount);
+/// Builds the 3D scan from lines by Eq. 1 (each line's encoder pitch and the mount). With
+/// `attitudes` (one per line: base_link's orientation while that line swept, in any frame fixed to
+/// the ground, e.g. an IMU's integrated rates), every line is turned into base_link as it stood at
+/// the last line. A robot that rocks on its tyres while the laser nods (its weight moves with the
+/// pitch) bends an uncorrected scan: 2 deg of rock moves a return 10 m away by 35 cm.
+/// Throws std::invalid_argument when `attitudes` is neither empty nor one per line.
+Scan3D AssembleScan(std::vector<LaserLine> lines, const MountConfig& mount,
+                    const std::vector<Eigen::Quaterniond>& attitudes = {});
 
 }  // namespace pitchlab::sensors

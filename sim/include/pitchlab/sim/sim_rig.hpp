@@ -10,6 +10,7 @@
 #include "pitchlab/sensors/pitching_scanner.hpp"
 #include "pitchlab/sensors/ray_caster.hpp"
 #include "pitchlab/sim/sim_base.hpp"
+#include "pitchlab/sim/sim_imu.hpp"
 #include "pitchlab/sim/sim_line_scanner.hpp"
 #include "pitchlab/sim/sim_pitch_axis.hpp"
 #include "pitchlab/sim/simulation.hpp"
@@ -29,6 +30,7 @@ struct SimRigConfig {
   sensors::PitchUnitConfig pitch_unit;
   sensors::ScanPatternConfig pattern;
   OdometryConfig odometry;
+  ImuConfig imu;  ///< deskews scans when imu.deskew
   PlacementConfig placement;
   CasterKind caster = CasterKind::kEmbree;
 };
@@ -50,7 +52,9 @@ class SimRig final : public sensors::ScanSource {
   [[nodiscard]] Result<Eigen::Isometry3d> PlaceRobot(double x_m, double y_m, double yaw_rad);
   /// Places the robot at the world's pitchlab:default_start, else at (0, 0, 0).
   [[nodiscard]] Result<Eigen::Isometry3d> PlaceAtDefaultStart();
-  /// Stops the base, then runs one pitch sweep. T_world_base is the truth when the scan started.
+  /// Stops the base, then runs one pitch sweep, deskewed by the IMU when config.imu.deskew.
+  /// T_world_base is the truth of the points' frame: when the scan started, or at its last line
+  /// when deskewed.
   [[nodiscard]] Result<sensors::Scan3D> Acquire() override;
 
   Simulation& sim() { return *sim_; }
@@ -68,6 +72,7 @@ class SimRig final : public sensors::ScanSource {
   std::unique_ptr<Simulation> sim_;
   std::unique_ptr<sensors::RayCaster> caster_;
   std::unique_ptr<SimBase> base_;
+  std::unique_ptr<SimImu> imu_;
   std::unique_ptr<SimPitchAxis> axis_;
   std::unique_ptr<SimLineScanner> scanner_;
   std::unique_ptr<sensors::PitchingScanSource> source_;
