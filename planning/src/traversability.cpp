@@ -64,33 +64,51 @@ bool HasStep(const ElevationLayers& L, int i, int j, double step_max) {
   return false;
 }
 
-// Footprint: every free cell whose centre is closer than half the robot's width plus half a cell
-// to the centre of a hazard cell (its edge, within half a cell) is blocked. Stamps a disc around
-// the hazard cells that border a non-hazard cell.
-void InflateHazards(TraversabilityGrid& T) {
+bool IsHazard(Blocked b) {
+  return b == Blocked::kDrop || b == Blocked::kStep || b == Blocked::kTooSteep;
+}
+
+// The hazard cells that border a non-hazard cell: the only ones a disc around them can reach
+// beyond the hazard itself.
+std::vector<std::size_t> HazardBorder(const TraversabilityGrid& T) {
   const GridGeometry& g = T.geometry;
-  const double reach_m = 0.5 * T.config.robot.width_m + 0.5 * g.cell_m;
-  const int r = static_cast<int>(std::ceil(reach_m / g.cell_m));
-  std::vector<std::pair<int, int>> disc;
-  for (int dj = -r; dj <= r; ++dj)
-    for (int di = -r; di <= r; ++di)
-      if (std::hypot(di, dj) * g.cell_m < reach_m - 1e-9 && (di || dj)) disc.emplace_back(di, dj);
-  const auto hazard = [&](std::size_t k) {
-    return T.blocked[k] == Blocked::kDrop || T.blocked[k] == Blocked::kStep ||
-           T.blocked[k] == Blocked::kTooSteep;
-  };
   std::vector<std::size_t> border;
   for (int j = 0; j < g.size_y; ++j)
     for (int i = 0; i < g.size_x; ++i) {
       const std::size_t k = g.Linear({i, j});
-      if (!hazard(k)) continue;
+      if (!IsHazard(T.blocked[k])) continue;
       bool edge = false;
       for (const auto& [di, dj] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
         const CellIndex nb{i + di, j + dj};
-        edge |= g.Contains(nb) && !hazard(g.Linear(nb));
+        edge |= g.Contains(nb) && !IsHazard(T.blocked[g.Linear(nb)]);
       }
       if (edge) border.push_back(k);
     }
+  return border;
+}
+
+// Cell offsets (not the centre) closer than reach_m [m].
+std::vector<std::pair<int, int>> Disc(double reach_m, double cell_m) {
+  const int r = static_cast<int>(std::ceil(reach_m / cell_m));
+  std::vector<std::pair<int, int>> disc;
+  for (int dj = -r; dj <= r; ++dj)
+    for (int di = -r; di <= r; ++di)
+      if (std::hypot(di, dj) * cell_m < reach_m - 1e-9 && (di || dj)) disc.emplace_back(di, dj);
+  return disc;
+}
+
+// How far the footprint reaches: a cell whose centre is closer than this to a hazard cell's
+// centre puts the robot over it (half the width, plus half a cell for the hazard's edge) [m].
+double FootprintReach(const TraversabilityGrid& T) {
+  return 0.5 * T.config.robot.width_m + 0.5 * T.geometry.cell_m;
+}
+
+// Footprint: every free cell whose centre is closer than the footprint's reach to the centre of
+// a hazard cell is blocked. Stamps a disc around the hazard cells that border a non-hazard cell.
+void InflateHazards(TraversabilityGrid& T, const std::vector<std::size_t>& border) {
+  const GridGeometry& g = T.geometry;
+  const double reach_m = FootprintReach(T);
+  const std::vector<std::pair<int, int>> disc = Disc(reach_m, g.cell_m);
   const auto near = [&](std::size_t k) {
     Blocked& b = T.blocked[k];
     if (b == Blocked::kFree || b == Blocked::kUnknown) b = Blocked::kNearHazard;
@@ -109,6 +127,40 @@ void InflateHazards(TraversabilityGrid& T) {
       const int cells_out = std::min({i, j, g.size_x - 1 - i, g.size_y - 1 - j}) + 1;
       if (cells_out * g.cell_m < reach_m - 1e-9) near(g.Linear({i, j}));
     }
+}
+
+// Soft clearance (PlannerConfig::clearance_m): the distance of every free cell's centre to the
+// nearest hazard cell's centre, by the same stamping out to the footprint's reach plus the
+// clearance, priced into its entry cost.
+void AddClearanceCosts(TraversabilityGrid& T, const std::vector<std::size_t>& border) {
+  const PlannerConfig& c = T.config;
+  if (!(c.clearance_m > 0 && c.clearance_cost > 0)) return;
+  const GridGeometry& g = T.geometry;
+  const double reach_m = FootprintReach(T);
+  const double outer_m = reach_m + c.clearance_m;
+  std::vector<std::pair<int, int>> disc = Disc(outer_m, g.cell_m);
+  // Only cells beyond the footprint's reach can be free; the inner ones were stamped blocked.
+  std::vector<float> offset_m;
+  std::vector<std::pair<int, int>> ring;
+  for (const auto& [di, dj] : disc) {
+    const double d = std::hypot(di, dj) * g.cell_m;
+    if (d >= reach_m - 1e-9) ring.emplace_back(di, dj), offset_m.push_back(static_cast<float>(d));
+  }
+  std::vector<float> nearest_m(g.cell_count(), std::numeric_limits<float>::infinity());
+  for (std::size_t k : border) {
+    const CellIndex h = g.FromLinear(k);
+    for (std::size_t o = 0; o < ring.size(); ++o) {
+      const CellIndex nb{h.i + ring[o].first, h.j + ring[o].second};
+      if (!g.Contains(nb)) continue;
+      float& d = nearest_m[g.Linear(nb)];
+      d = std::min(d, offset_m[o]);
+    }
+  }
+  for (std::size_t k = 0; k < g.cell_count(); ++k) {
+    if (!T.Free(k) || !std::isfinite(nearest_m[k])) continue;
+    const double beyond = std::max(0.0, nearest_m[k] - reach_m);
+    T.enter_cost[k] += static_cast<float>(c.clearance_cost * (1.0 - beyond / c.clearance_m));
+  }
 }
 
 // The 8-neighbour move mask of every cell (see TraversabilityGrid::moves).
@@ -210,6 +262,8 @@ void PlannerConfig::Validate() const {
         robot.max_inclination_rad);
   check(robot.width_m >= 0, "width_m", robot.width_m);
   check(unknown_penalty >= 0, "unknown_penalty", unknown_penalty);
+  check(clearance_m >= 0 && clearance_m <= 10, "clearance_m", clearance_m);
+  check(clearance_cost >= 0, "clearance_cost", clearance_cost);
 }
 
 PlannerConfig ParsePlannerConfig(const std::string& yaml_text, const std::string& source) {
@@ -251,6 +305,8 @@ PlannerConfig ParsePlannerConfig(const std::string& yaml_text, const std::string
         Named(source, "unknown", "'" + unknown + "' is not forbid or penalise"));
   }
   Read(root, "unknown_penalty", source, &c.unknown_penalty);
+  Read(root, "clearance_m", source, &c.clearance_m);
+  Read(root, "clearance_cost", source, &c.clearance_cost);
   try {
     c.Validate();
   } catch (const std::invalid_argument& e) {
@@ -327,7 +383,9 @@ TraversabilityGrid BuildTraversability(const ElevationLayers& L, const PlannerCo
         T.blocked[k] = Blocked::kStep;
       }
     }
-  InflateHazards(T);
+  const std::vector<std::size_t> border = HazardBorder(T);
+  InflateHazards(T, border);
+  AddClearanceCosts(T, border);
   ComputeMoves(T);
   ComputeMoveCosts(T);
   ComputeMoveCostRange(T);

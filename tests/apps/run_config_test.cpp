@@ -16,6 +16,23 @@ TEST(RunSettings, DefaultsExploreWithTheRobotsPreset) {
   EXPECT_GT(s.mission.planner.unknown_penalty, 1.0);
 }
 
+// Runs keep half a metre off hazards where there is room (wheel odometry slips on rough ground);
+// a planner section that leaves the clearance out keeps it, one that sets it wins.
+TEST(RunSettings, PathsKeepAClearanceFromHazardsUnlessTheConfigSaysOtherwise) {
+  const RunSettings d = ParseRunSettings("", "test", sim::P3Model::kP3AT);
+  EXPECT_DOUBLE_EQ(d.mission.planner.clearance_m, 0.5);
+  EXPECT_DOUBLE_EQ(d.mission.planner.clearance_cost, 1.0);
+  const RunSettings w =
+      ParseRunSettings("planner: {weights: {roughness: 5}}\n", "test", sim::P3Model::kP3AT);
+  EXPECT_DOUBLE_EQ(w.mission.planner.clearance_m, 0.5);
+  const RunSettings off = ParseRunSettings("planner: {clearance_cost: 0}\n", "test",
+                                           sim::P3Model::kP3AT);
+  EXPECT_DOUBLE_EQ(off.mission.planner.clearance_cost, 0.0);
+  EXPECT_DOUBLE_EQ(off.mission.planner.clearance_m, 0.5);
+  const RunSettings back = ParseRunSettings(RunSettingsToYaml(off), "used", sim::P3Model::kP3AT);
+  EXPECT_DOUBLE_EQ(back.mission.planner.clearance_cost, 0.0);
+}
+
 TEST(RunSettings, APlannerLimitOverridesOnlyThatLimitOfThePreset) {
   const RunSettings s =
       ParseRunSettings("planner: {max_inclination_deg: 17}\n", "test", sim::P3Model::kP3AT);

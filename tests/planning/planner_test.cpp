@@ -237,6 +237,66 @@ TEST(Planner, GapNarrowerThanTheRobotIsNotPassed) {
   EXPECT_TRUE(PlanPath(BuildTraversability(wide, at), start, goal, Algorithm::kAStar));
 }
 
+TEST(Planner, ClearanceCostFallsLinearlyFromTheFootprintsReach) {
+  // A step wall along x = 2.05 m (column 20 of 0.1 m cells) on flat ground. P3-AT: the footprint
+  // reaches 0.2985 m (half width + half a cell), so columns 17..23 are blocked; beyond, the entry
+  // cost rises by clearance_cost * (1 - (d - reach) / clearance_m) within clearance_m.
+  const ElevationLayers L = MakeLayers(41, 30, 0.1, [](int i, int) { return i == 20 ? 0.5 : 0.0; });
+  PlannerConfig plain;
+  plain.robot = RobotLimits::P3AT();
+  PlannerConfig soft = plain;
+  soft.clearance_m = 0.5;
+  soft.clearance_cost = 2.0;
+  const TraversabilityGrid A = BuildTraversability(L, plain), B = BuildTraversability(L, soft);
+  const GridGeometry& g = A.geometry;
+  const double reach = 0.5 * plain.robot.width_m + 0.05;
+  for (int i = 0; i < 41; ++i) {
+    const std::size_t k = g.Linear({i, 15});
+    EXPECT_EQ(A.blocked[k], B.blocked[k]) << i;  // the hard footprint is unchanged
+    if (!B.Free(k)) continue;
+    const double d = std::abs(i - 20) * 0.1;
+    const double expected = d < reach + 0.5 ? 2.0 * (1.0 - (d - reach) / 0.5) : 0.0;
+    EXPECT_NEAR(B.enter_cost[k] - A.enter_cost[k], expected, 1e-6) << "column " << i;
+  }
+  EXPECT_GT(B.enter_cost[g.Linear({16, 15})], A.enter_cost[g.Linear({16, 15})]);  // not all 0
+}
+
+TEST(Planner, ClearanceKeepsPathsOffHazardsWhereThereIsRoomAndStillPassesAGap) {
+  // A wall along y = 1.55 m from x = 0 to 3 m, flat ground elsewhere; start and goal 0.45 m from
+  // it (just beyond the footprint). Without clearance the path hugs the wall's margin; with it,
+  // the path bows out where the field is open. A gap 0.6 m wide in a second wall is still used.
+  const double cell = 0.1;
+  const auto z = [](int i, int j) {
+    if (j == 15 && i <= 30) return 0.5;  // the wall it runs along
+    if (i == 45 && !(j >= 12 && j < 18)) return 0.5;  // a wall across the map, 0.6 m gap
+    return 0.0;
+  };
+  const ElevationLayers L = MakeLayers(60, 40, cell, z);
+  PlannerConfig plain;
+  plain.robot = RobotLimits::P3AT();
+  PlannerConfig soft = plain;
+  soft.clearance_m = 0.5;
+  soft.clearance_cost = 2.0;
+  const Eigen::Vector2d start(0.25, 1.05), goal(2.75, 1.05);
+  const auto hug = PlanPath(BuildTraversability(L, plain), start, goal, Algorithm::kAStar);
+  const auto wide = PlanPath(BuildTraversability(L, soft), start, goal, Algorithm::kAStar);
+  ASSERT_TRUE(hug);
+  ASSERT_TRUE(wide);
+  const auto farthest_from_wall = [](const Path& p) {
+    double d = 0;
+    for (const Waypoint& w : p.waypoints) d = std::max(d, 1.55 - w.y_m);
+    return d;
+  };
+  EXPECT_LT(farthest_from_wall(*hug), 0.55);   // along the margin, at most a cell off it
+  EXPECT_GT(farthest_from_wall(*wide), 0.75);  // out into the open field
+  const auto through = PlanPath(BuildTraversability(L, soft), {4.0, 1.5}, {5.5, 1.5},
+                                Algorithm::kAStar);
+  ASSERT_TRUE(through) << "a gap the footprint fits stays passable (the wall spans the map)";
+  for (const Waypoint& w : through->waypoints) {
+    if (std::abs(w.x_m - 4.55) < 0.01) EXPECT_NEAR(w.y_m, 1.5, 0.051);  // the gap's middle (between two cells)
+  }
+}
+
 TEST(Planner, FootprintNeverHangsOffTheMapsEdge) {
   // Flat, all known: the edge is the only hazard. P3-AT: 0.497 m wide, so with 0.1 m cells the
   // cells whose centre lies within 0.2985 m of an outside cell's (the first 2 rings) are blocked.
@@ -351,7 +411,8 @@ TEST(Planner, SlopeBeyondTheRobotLimitIsTooSteep) {
 TEST(PlannerConfig, YamlWeightsPresetsAndErrors) {
   const PlannerConfig c = ParsePlannerConfig(
       "robot: p3dx\nweights: {roughness: 4, length: 2, inclination_x: 0.5, inclination_y: 0.25}\n"
-      "unknown: penalise\nunknown_penalty: 3\nmax_inclination_deg: 10\n",
+      "unknown: penalise\nunknown_penalty: 3\nmax_inclination_deg: 10\n"
+      "clearance_m: 0.4\nclearance_cost: 1.5\n",
       "test.yaml");
   EXPECT_EQ(c.robot.name, "p3dx");
   EXPECT_DOUBLE_EQ(c.robot.step_max_m, 0.025);
@@ -360,6 +421,8 @@ TEST(PlannerConfig, YamlWeightsPresetsAndErrors) {
   EXPECT_DOUBLE_EQ(c.weights.inclination_y, 0.25);
   EXPECT_EQ(c.unknown, UnknownPolicy::kPenalise);
   EXPECT_DOUBLE_EQ(c.unknown_penalty, 3);
+  EXPECT_DOUBLE_EQ(c.clearance_m, 0.4);
+  EXPECT_DOUBLE_EQ(c.clearance_cost, 1.5);
   const auto message = [](const std::string& yaml) {
     try {
       (void)ParsePlannerConfig(yaml, "bad.yaml");
@@ -372,6 +435,7 @@ TEST(PlannerConfig, YamlWeightsPresetsAndErrors) {
   EXPECT_NE(message("weights: {length: -1}\n").find("weights.length"), std::string::npos);
   EXPECT_NE(message("unknown: maybe\n").find("'unknown'"), std::string::npos);
   EXPECT_NE(message("step_max_m: abc\n").find("step_max_m"), std::string::npos);
+  EXPECT_NE(message("clearance_m: -0.1\n").find("clearance_m"), std::string::npos);
 }
 
 TEST(PathIo, CsvGeoJsonAndPicture) {

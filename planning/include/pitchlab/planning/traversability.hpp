@@ -44,6 +44,13 @@ struct PlannerConfig {
   RobotLimits robot = RobotLimits::P3AT();
   UnknownPolicy unknown = UnknownPolicy::kForbid;
   double unknown_penalty = 1.0;  ///< added to an edge entering an unknown cell (kPenalise) [1]
+  /// Soft clearance (a costmap's inflation): entering a free cell closer than clearance_m beyond
+  /// the footprint's reach (kNearHazard) to a step, drop or steep cell costs up to clearance_cost
+  /// more, falling linearly to 0 at clearance_m. Paths keep off hazards where the ground leaves
+  /// room and still pass where it does not: a robot whose odometry slips while it drives needs
+  /// the room. 0 (either): off, Eq. 5 as the paper has it.
+  double clearance_m = 0.0;     ///< [m]
+  double clearance_cost = 0.0;  ///< at the footprint's reach [1]
 
   /// Throws std::invalid_argument naming the field and value (negative weights, non-positive
   /// limits).
@@ -58,6 +65,8 @@ struct PlannerConfig {
 ///   weights: {roughness: 10, length: 1, inclination_x: 1, inclination_y: 1}
 ///   unknown: forbid              # forbid | penalise
 ///   unknown_penalty: 1.0
+///   clearance_m: 0.0             # soft clearance from hazards, and its cost at the footprint
+///   clearance_cost: 0.0
 /// Missing fields keep their defaults. Throws std::runtime_error naming the file, field and value.
 PlannerConfig LoadPlannerConfig(const std::string& path);
 /// The same from YAML text; `source_name` is used in error messages.
