@@ -73,14 +73,16 @@ void ReadImu(const YAML::Node& node, const std::string& source, sim::ImuConfig& 
     try {
       if (key == "deskew") {
         imu.deskew = kv.second.as<bool>();
+      } else if (key == "deskew_min_deg") {
+        imu.deskew_min_deg = kv.second.as<double>();
       } else if (key == "gyro_bias_dps") {
         imu.gyro_bias_dps = kv.second.as<double>();
       } else if (key == "gyro_noise_dps_rthz") {
         imu.gyro_noise_dps_rthz = kv.second.as<double>();
       } else {
         throw std::invalid_argument(source + ": imu." + key +
-                                    " is not a known setting (deskew, gyro_bias_dps, "
-                                    "gyro_noise_dps_rthz)");
+                                    " is not a known setting (deskew, deskew_min_deg, "
+                                    "gyro_bias_dps, gyro_noise_dps_rthz)");
       }
     } catch (const YAML::Exception&) {
       throw std::invalid_argument(source + ": imu." + key +
@@ -151,6 +153,7 @@ std::string AppConfigToYaml(const AppConfig& config) {
      << "  track_error: " << rig.odometry.track_error << "\n"
      << "imu:\n"
      << "  deskew: " << (rig.imu.deskew ? "true" : "false") << "\n"
+     << "  deskew_min_deg: " << rig.imu.deskew_min_deg << "\n"
      << "  gyro_bias_dps: " << rig.imu.gyro_bias_dps << "\n"
      << "  gyro_noise_dps_rthz: " << rig.imu.gyro_noise_dps_rthz << "\n"
      << sensors::SensorConfigToYaml(config.sensors);

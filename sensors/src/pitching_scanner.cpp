@@ -1,5 +1,6 @@
 #include "pitchlab/sensors/pitching_scanner.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -64,7 +65,14 @@ Result<Scan3D> PitchingScanSource::Acquire() {
     if (progress_) progress_(k + 1, n);
   }
   if (!attitude_known) attitudes.clear();  // a line without one: the scan stays as swept
-  return AssembleScan(std::move(lines), mount_, attitudes);
+  double sensed_rad = 0;
+  for (const Eigen::Quaterniond& q : attitudes) {
+    sensed_rad = std::max(sensed_rad, Eigen::AngleAxisd(attitudes.back().conjugate() * q).angle());
+  }
+  if (sensed_rad < min_rotation_rad_) attitudes.clear();  // within the sensor's own error
+  Scan3D scan = AssembleScan(std::move(lines), mount_, attitudes);
+  scan.deskew_max_rad = sensed_rad;
+  return scan;
 }
 
 }  // namespace pitchlab::sensors

@@ -17,6 +17,9 @@ void ImuConfig::Validate() const {
     throw std::invalid_argument(os.str());
   };
   if (!(gyro_bias_dps >= 0 && gyro_bias_dps <= 10)) invalid("gyro_bias_dps", gyro_bias_dps, "0 .. 10");
+  if (!(deskew_min_deg >= 0 && deskew_min_deg <= 90)) {
+    invalid("deskew_min_deg", deskew_min_deg, "0 .. 90");
+  }
   if (!(gyro_noise_dps_rthz >= 0 && gyro_noise_dps_rthz <= 10)) {
     invalid("gyro_noise_dps_rthz", gyro_noise_dps_rthz, "0 .. 10");
   }

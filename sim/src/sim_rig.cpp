@@ -1,5 +1,7 @@
 #include "pitchlab/sim/sim_rig.hpp"
 
+#include <cmath>
+
 namespace pitchlab::sim {
 
 SimRig::SimRig(const std::string& world_path, const SimRigConfig& config)
@@ -27,7 +29,8 @@ SimRig::SimRig(std::unique_ptr<Simulation> sim, const SimRigConfig& config)
   if (config_.imu.deskew) {
     imu_ = std::make_unique<SimImu>(*sim_, config_.imu);
     source_->set_attitude_probe(
-        [this]() -> std::optional<Eigen::Quaterniond> { return imu_->Orientation(); });
+        [this]() -> std::optional<Eigen::Quaterniond> { return imu_->Orientation(); },
+        config_.imu.deskew_min_deg * M_PI / 180.0);
   }
 }
 

@@ -31,14 +31,17 @@ TEST(AppConfig, TheImuDeskewsByDefaultAndFollowsTheRunSeed) {
 }
 
 TEST(AppConfig, TheImuSectionIsReadAndWrittenBackAsUsed) {
-  const ConfigFile file("imu: {deskew: false, gyro_bias_dps: 0.02, gyro_noise_dps_rthz: 0.05}\n");
+  const ConfigFile file(
+      "imu: {deskew: false, deskew_min_deg: 0.5, gyro_bias_dps: 0.02, gyro_noise_dps_rthz: 0.05}\n");
   const AppConfig c = LoadAppConfig(file.path());
   EXPECT_FALSE(c.rig.imu.deskew);
+  EXPECT_DOUBLE_EQ(c.rig.imu.deskew_min_deg, 0.5);
   EXPECT_DOUBLE_EQ(c.rig.imu.gyro_bias_dps, 0.02);
   EXPECT_DOUBLE_EQ(c.rig.imu.gyro_noise_dps_rthz, 0.05);
   const ConfigFile used(AppConfigToYaml(c));
   const AppConfig back = LoadAppConfig(used.path());
   EXPECT_FALSE(back.rig.imu.deskew);
+  EXPECT_DOUBLE_EQ(back.rig.imu.deskew_min_deg, 0.5);
   EXPECT_DOUBLE_EQ(back.rig.imu.gyro_bias_dps, 0.02);
   EXPECT_DOUBLE_EQ(back.rig.imu.gyro_noise_dps_rthz, 0.05);
 }

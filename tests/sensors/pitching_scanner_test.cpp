@@ -80,7 +80,7 @@ TEST(PitchingScanSource, ADeviceErrorNamesTheLineAndStopsTheScan) {
   EXPECT_NE(scan.error().message.find("line 17"), std::string::npos) << scan.error().message;
 }
 
-TEST(PitchingScanSource, AnAttitudeProbeDeskewsOnlyWhenItAnswersEveryLine) {
+TEST(PitchingScanSource, AnAttitudeProbeDeskewsWhenItAnswersEveryLineAboveItsNoiseFloor) {
   FakeAxis axis;
   FakeScanner scanner;
   ScanPatternConfig pattern;
@@ -102,6 +102,20 @@ TEST(PitchingScanSource, AnAttitudeProbeDeskewsOnlyWhenItAnswersEveryLine) {
   ASSERT_EQ(p.line, 0);
   const double turned = std::atan2(p.y, p.x) - std::atan2(q.y, q.x);
   EXPECT_NEAR(turned, -9 * kDeg, 1e-6);
+
+  // A rotation below the sensor's noise floor is left alone, but still reported.
+  reads = 0;
+  source.set_attitude_probe(
+      [&]() -> std::optional<Eigen::Quaterniond> {
+        return Eigen::Quaterniond(Eigen::AngleAxisd(reads++ * kDeg, Eigen::Vector3d::UnitZ()));
+      },
+      10 * kDeg);
+  scan = source.Acquire();
+  ASSERT_TRUE(scan) << scan.error().message;
+  EXPECT_FALSE(scan->deskewed);
+  EXPECT_NEAR(scan->deskew_max_rad, 9 * kDeg, 1e-9);
+  const Scan3D swept = AssembleScan(scan->lines, MountConfig{});
+  EXPECT_NEAR(scan->points.front().y, swept.points.front().y, 1e-6);
 
   // No answer for one line: the scan stays as swept, never half corrected.
   reads = 0;

@@ -45,8 +45,13 @@ class PitchingScanSource final : public ScanSource {
   PitchingScanSource(LineScanner& scanner, PitchAxis& axis, ScanPatternConfig pattern,
                      MountConfig mount);
   void set_progress(Progress progress) { progress_ = std::move(progress); }
-  /// Read after every line; when it answered for every line, the scan is deskewed (AssembleScan).
-  void set_attitude_probe(AttitudeProbe probe) { attitude_ = std::move(probe); }
+  /// Read after every line; when it answered for every line and sensed a rotation of at least
+  /// `min_rotation_rad` between a line and the last, the scan is deskewed (AssembleScan). Below
+  /// that (the sensor's own error over a scan) the correction would only add the sensor's error.
+  void set_attitude_probe(AttitudeProbe probe, double min_rotation_rad = 0.0) {
+    attitude_ = std::move(probe);
+    min_rotation_rad_ = min_rotation_rad;
+  }
   [[nodiscard]] Result<Scan3D> Acquire() override;
 
  private:
@@ -56,6 +61,7 @@ class PitchingScanSource final : public ScanSource {
   MountConfig mount_;
   Progress progress_;
   AttitudeProbe attitude_;
+  double min_rotation_rad_ = 0.0;
 };
 
 }  // namespace pitchlab::sensors

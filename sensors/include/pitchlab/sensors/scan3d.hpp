@@ -49,7 +49,8 @@ struct Scan3D {
   /// base's rotation since it, as an attitude sensor measured it (AssembleScan's attitudes).
   /// Otherwise they are in base_link as it stood at each line (one frame while the base is still).
   bool deskewed = false;
-  /// With deskewed: the largest rotation of the base between a line and the last one [rad].
+  /// The largest rotation of the base between a line and the last one an attitude sensor sensed,
+  /// also when it was too small to correct (PitchingScanSource); 0 without a sensor [rad].
   double deskew_max_rad = 0.0;
   bool has_truth = false;  ///< T_world_base below is the simulator's ground truth
   /// Pose of the points' frame: base_link when the scan started (at its end when deskewed).
