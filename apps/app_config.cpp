@@ -11,9 +11,9 @@ namespace pitchlab::apps {
 namespace {
 
 // Top-level sections any pitchlab module reads; anything else is a typo worth an error.
-const std::set<std::string> kSections = {"seed",     "robot",      "odometry",     "imu", "lms200",
-                                         "pitch_unit", "scan",     "mount",        "registration",
-                                         "elevation", "planner",   "run",          "backend",   "hw"};
+const std::set<std::string> kSections = {
+    "seed",  "robot",        "odometry",  "imu",     "lms200", "pitch_unit", "scan",
+    "mount", "registration", "elevation", "planner", "run",    "backend",    "hw"};
 
 std::string ReadFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -85,8 +85,9 @@ void ReadImu(const YAML::Node& node, const std::string& source, sim::ImuConfig& 
                                     "gyro_bias_dps, gyro_noise_dps_rthz)");
       }
     } catch (const YAML::Exception&) {
-      throw std::invalid_argument(source + ": imu." + key +
-                                  (key == "deskew" ? " must be true or false" : " must be a number"));
+      throw std::invalid_argument(
+          source + ": imu." + key +
+          (key == "deskew" ? " must be true or false" : " must be a number"));
     }
   }
 }

@@ -1,6 +1,7 @@
 #pragma once
 // The run configuration a user gives with --config FILE: one YAML document whose sections belong
-// to the modules (lms200, pitch_unit, scan, mount: sensors; robot, odometry, imu: sim), plus the seed.
+// to the modules (lms200, pitch_unit, scan, mount: sensors; robot, odometry, imu: sim), plus the
+// seed.
 
 #include <cstdint>
 #include <optional>
@@ -12,9 +13,9 @@
 namespace pitchlab::apps {
 
 struct AppConfig {
-  std::uint64_t seed = 1;        ///< one seed for every random source of a run
+  std::uint64_t seed = 1;  ///< one seed for every random source of a run
   sensors::SensorConfig sensors;
-  sim::SimRigConfig rig;         ///< assembled from the above
+  sim::SimRigConfig rig;                     ///< assembled from the above
   std::string source = "built-in defaults";  ///< file it came from
 };
 

@@ -33,7 +33,7 @@ namespace {
 
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 constexpr double kMapMargin_m = 1.0;
-constexpr double kAttitudeSigma_rad = 0.2 * kDegToRad;  // a MEMS inclinometer, at rest
+constexpr double kAttitudeSigma_rad = 0.2 * kDegToRad;           // a MEMS inclinometer, at rest
 constexpr std::uint64_t kAttitudeSeedSalt = 0x6174746974756465;  // "attitude": its own stream
 
 CliArgs RunArgs() {
@@ -42,15 +42,16 @@ CliArgs RunArgs() {
                "the map (odometry as prior), update the elevation map, plan to the goal, drive a\n"
                "prefix of the path, repeat until the goal. Scored against ground truth; writes a\n"
                "run folder with scans, maps, paths, trajectories, metrics.json and report.html.");
-  args.Option("world", "NAME|FILE.xml", "built-in world (" + BuiltinWorldNames() +
-                                            ") or any MJCF file", "terrain")
+  args.Option("world", "NAME|FILE.xml",
+              "built-in world (" + BuiltinWorldNames() + ") or any MJCF file", "terrain")
       .Option("start", "x,y,yaw", "start pose: metres, metres, degrees (default: the world's)")
       .Option("goal", "x,y", "goal in metres (default: the world's default goal)")
       .Option("robot", "p3at|p3dx", "robot model, overrides the config's robot.model")
       .Option("seed", "N", "seed of every random source, overrides the config's seed")
       .Option("config", "FILE.yaml", "configuration (see README)")
       .Option("out", "DIR", "run folder to create (default: runs/<world>-s<seed>-<time>)")
-      .Option("backend", "sim|hw", "sim (default) or hw: the real devices of the config's `hw` "
+      .Option("backend", "sim|hw",
+              "sim (default) or hw: the real devices of the config's `hw` "
               "section (`run --backend hw --help`), overrides the config's backend")
       .Flag("json", "print metrics.json on stdout at the end")
       .Flag("quiet", "no progress on stderr");
@@ -68,7 +69,8 @@ std::string DefaultOut(const std::string& world, std::uint64_t seed) {
 worlds::WorldMetadata LoadMetadata(const std::filesystem::path& world) {
   char error[1000] = "";
   mjModel* model = mj_loadXML(world.string().c_str(), nullptr, error, sizeof(error));
-  if (model == nullptr) throw std::runtime_error("cannot load world '" + world.string() + "': " + error);
+  if (model == nullptr)
+    throw std::runtime_error("cannot load world '" + world.string() + "': " + error);
   const worlds::WorldMetadata meta = worlds::ReadWorldMetadata(model);
   mj_deleteModel(model);
   return meta;
@@ -84,11 +86,12 @@ int RunRun(int argc, char** argv) {
   if (!args.Parse(argc, argv)) return 0;
   const bool quiet = args.Flagged("quiet");
 
-  AppConfig config = LoadAppConfig(args.Has("config") ? std::optional(args.Get("config"))
-                                                      : std::nullopt);
+  AppConfig config =
+      LoadAppConfig(args.Has("config") ? std::optional(args.Get("config")) : std::nullopt);
   if (args.Has("seed")) {
     const std::vector<double> seed = args.GetNumbers("seed", 1);
-    if (seed[0] < 0 || seed[0] != std::floor(seed[0])) throw CliError("--seed must be an integer >= 0");
+    if (seed[0] < 0 || seed[0] != std::floor(seed[0]))
+      throw CliError("--seed must be an integer >= 0");
     config.seed = static_cast<std::uint64_t>(seed[0]);
     config.sensors.lms200.seed = config.rig.lms200.seed = config.rig.odometry.seed =
         config.rig.imu.seed = config.seed;
@@ -116,7 +119,8 @@ int RunRun(int argc, char** argv) {
     throw CliError("world '" + world + "' names no default goal: give --goal x,y");
   }
   const worlds::Bounds2d& b = meta.bounds;
-  if (goal.x() < b.x_min_m || goal.x() > b.x_max_m || goal.y() < b.y_min_m || goal.y() > b.y_max_m) {
+  if (goal.x() < b.x_min_m || goal.x() > b.x_max_m || goal.y() < b.y_min_m ||
+      goal.y() > b.y_max_m) {
     throw std::runtime_error("goal (" + std::to_string(goal.x()) + ", " + std::to_string(goal.y()) +
                              ") is off the map: the world spans x " + std::to_string(b.x_min_m) +
                              " .. " + std::to_string(b.x_max_m) + ", y " +
@@ -142,7 +146,8 @@ int RunRun(int argc, char** argv) {
   }
   // Ground truth on the same grid: the true map, what is truly traversable, the true optimum.
   if (!quiet) std::fprintf(stderr, "run: ground truth of %s\n", world.c_str());
-  mapping::ElevationMap truth_map = mapping::ComputeTrueElevationMap(rig.caster(), mission.map_area);
+  mapping::ElevationMap truth_map =
+      mapping::ComputeTrueElevationMap(rig.caster(), mission.map_area);
   const mapping::ElevationLayers truth_layers = mapping::ComputeLayers(truth_map, mission.layers);
   const planning::TraversabilityGrid truth_grid =
       planning::BuildTraversability(truth_layers, mission.planner);
@@ -162,7 +167,8 @@ int RunRun(int argc, char** argv) {
     const Eigen::Matrix3d R = sim.T_world_base().linear();
     const double roll = std::atan2(R(2, 1), R(2, 2));
     const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
-    return Eigen::Vector2d(roll + attitude_noise(attitude_rng), pitch + attitude_noise(attitude_rng));
+    return Eigen::Vector2d(roll + attitude_noise(attitude_rng),
+                           pitch + attitude_noise(attitude_rng));
   };
   MissionObserver observer;
   observer.on_stop = [&](const StopRecord& stop, const MissionResult& so_far) {
@@ -175,8 +181,7 @@ int RunRun(int argc, char** argv) {
     std::fprintf(stderr, "run: %s | sim %.0f s, wall %.1f s (%.0fx real time)\n", text.c_str(),
                  sim.time_s(), wall, wall > 0 ? sim.time_s() / wall : 0.0);
   };
-  const MissionResult result =
-      RunMission(rig, rig.base(), *placed, mission, probes, observer);
+  const MissionResult result = RunMission(rig, rig.base(), *placed, mission, probes, observer);
   const planning::TraversabilityGrid final_grid = planning::BuildTraversability(
       mapping::ComputeLayers(result.elevation, mission.layers), mission.planner);
   const RunScore score =

@@ -3,8 +3,8 @@
 #include "traversability_image.hpp"
 
 #include <cmath>
-#include <filesystem>
 #include <cstdio>
+#include <filesystem>
 #include <sstream>
 #include <stdexcept>
 

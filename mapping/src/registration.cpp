@@ -69,7 +69,8 @@ Limits ConstraintLimits(const RegistrationPrior& prior, const RegistrationConfig
   Limits l{config.constraint_translation_m, config.constraint_rotation_deg, false};
   if (prior.odometry && prior.odometry_uncertainty) {
     const GuessUncertainty& u = *prior.odometry_uncertainty;
-    const double t = u.translation_m + kResultTolerance_m, r = u.rotation_deg + kResultTolerance_deg;
+    const double t = u.translation_m + kResultTolerance_m,
+                 r = u.rotation_deg + kResultTolerance_deg;
     l.from_bound = t < l.translation_m || r < l.rotation_deg;
     l.translation_m = std::min(l.translation_m, t);
     l.rotation_deg = std::min(l.rotation_deg, r);

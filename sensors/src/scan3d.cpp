@@ -62,9 +62,14 @@ Scan3D AssembleScan(std::vector<LaserLine> lines, const MountConfig& mount,
     }
     for (std::size_t i = 0; i < line.ranges_m.size(); ++i) {
       switch (line.status[i]) {
-        case ReadingStatus::kValid: break;
-        case ReadingStatus::kOverRange: ++scan.over_ranges; continue;
-        default: ++scan.no_returns; continue;
+        case ReadingStatus::kValid:
+          break;
+        case ReadingStatus::kOverRange:
+          ++scan.over_ranges;
+          continue;
+        default:
+          ++scan.no_returns;
+          continue;
       }
       const double rho = line.ranges_m[i];
       const double theta = line.Angle(i);

@@ -16,7 +16,8 @@ void ImuConfig::Validate() const {
     os << "imu." << field << " = " << value << " is invalid (" << allowed << ")";
     throw std::invalid_argument(os.str());
   };
-  if (!(gyro_bias_dps >= 0 && gyro_bias_dps <= 10)) invalid("gyro_bias_dps", gyro_bias_dps, "0 .. 10");
+  if (!(gyro_bias_dps >= 0 && gyro_bias_dps <= 10))
+    invalid("gyro_bias_dps", gyro_bias_dps, "0 .. 10");
   if (!(deskew_min_deg >= 0 && deskew_min_deg <= 90)) {
     invalid("deskew_min_deg", deskew_min_deg, "0 .. 90");
   }

@@ -30,7 +30,7 @@ SimRig::SimRig(std::unique_ptr<Simulation> sim, const SimRigConfig& config)
     imu_ = std::make_unique<SimImu>(*sim_, config_.imu);
     source_->set_attitude_probe(
         [this]() -> std::optional<Eigen::Quaterniond> { return imu_->Orientation(); },
-        config_.imu.deskew_min_deg * M_PI / 180.0);
+        config_.imu.deskew_min_deg* M_PI / 180.0);
   }
 }
 

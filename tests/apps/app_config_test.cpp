@@ -32,7 +32,8 @@ TEST(AppConfig, TheImuDeskewsByDefaultAndFollowsTheRunSeed) {
 
 TEST(AppConfig, TheImuSectionIsReadAndWrittenBackAsUsed) {
   const ConfigFile file(
-      "imu: {deskew: false, deskew_min_deg: 0.5, gyro_bias_dps: 0.02, gyro_noise_dps_rthz: 0.05}\n");
+      "imu: {deskew: false, deskew_min_deg: 0.5, gyro_bias_dps: 0.02, gyro_noise_dps_rthz: "
+      "0.05}\n");
   const AppConfig c = LoadAppConfig(file.path());
   EXPECT_FALSE(c.rig.imu.deskew);
   EXPECT_DOUBLE_EQ(c.rig.imu.deskew_min_deg, 0.5);

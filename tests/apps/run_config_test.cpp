@@ -25,8 +25,8 @@ TEST(RunSettings, PathsKeepAClearanceFromHazardsUnlessTheConfigSaysOtherwise) {
   const RunSettings w =
       ParseRunSettings("planner: {weights: {roughness: 5}}\n", "test", sim::P3Model::kP3AT);
   EXPECT_DOUBLE_EQ(w.mission.planner.clearance_m, 0.5);
-  const RunSettings off = ParseRunSettings("planner: {clearance_cost: 0}\n", "test",
-                                           sim::P3Model::kP3AT);
+  const RunSettings off =
+      ParseRunSettings("planner: {clearance_cost: 0}\n", "test", sim::P3Model::kP3AT);
   EXPECT_DOUBLE_EQ(off.mission.planner.clearance_cost, 0.0);
   EXPECT_DOUBLE_EQ(off.mission.planner.clearance_m, 0.5);
   const RunSettings back = ParseRunSettings(RunSettingsToYaml(off), "used", sim::P3Model::kP3AT);

@@ -267,7 +267,7 @@ TEST(Planner, ClearanceKeepsPathsOffHazardsWhereThereIsRoomAndStillPassesAGap) {
   // the path bows out where the field is open. A gap 0.6 m wide in a second wall is still used.
   const double cell = 0.1;
   const auto z = [](int i, int j) {
-    if (j == 15 && i <= 30) return 0.5;  // the wall it runs along
+    if (j == 15 && i <= 30) return 0.5;               // the wall it runs along
     if (i == 45 && !(j >= 12 && j < 18)) return 0.5;  // a wall across the map, 0.6 m gap
     return 0.0;
   };
@@ -289,11 +289,12 @@ TEST(Planner, ClearanceKeepsPathsOffHazardsWhereThereIsRoomAndStillPassesAGap) {
   };
   EXPECT_LT(farthest_from_wall(*hug), 0.55);   // along the margin, at most a cell off it
   EXPECT_GT(farthest_from_wall(*wide), 0.75);  // out into the open field
-  const auto through = PlanPath(BuildTraversability(L, soft), {4.0, 1.5}, {5.5, 1.5},
-                                Algorithm::kAStar);
+  const auto through =
+      PlanPath(BuildTraversability(L, soft), {4.0, 1.5}, {5.5, 1.5}, Algorithm::kAStar);
   ASSERT_TRUE(through) << "a gap the footprint fits stays passable (the wall spans the map)";
   for (const Waypoint& w : through->waypoints) {
-    if (std::abs(w.x_m - 4.55) < 0.01) EXPECT_NEAR(w.y_m, 1.5, 0.051);  // the gap's middle (between two cells)
+    if (std::abs(w.x_m - 4.55) < 0.01)
+      EXPECT_NEAR(w.y_m, 1.5, 0.051);  // the gap's middle (between two cells)
   }
 }
 

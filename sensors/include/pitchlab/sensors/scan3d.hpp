@@ -13,9 +13,10 @@ namespace pitchlab::sensors {
 /// Where the laser sits on the robot (calibratable). Frames: base_link -> laser_mount (the pitch
 /// axis, parallel to base_link's y at pitch 0) -> laser (mirror centre).
 struct MountConfig {
-  Eigen::Vector3d t_base_mount_m{0.10, 0.0, 0.45};   ///< pitch axis position in base_link [m]
-  Eigen::Vector3d t_mount_laser_m{0.0, 0.0, 0.09};   ///< mirror centre from the pitch axis [m]
-  Eigen::Vector3d misalignment_rpy_rad{0.0, 0.0, 0.0};  ///< scan plane vs mount, roll/pitch/yaw [rad]
+  Eigen::Vector3d t_base_mount_m{0.10, 0.0, 0.45};  ///< pitch axis position in base_link [m]
+  Eigen::Vector3d t_mount_laser_m{0.0, 0.0, 0.09};  ///< mirror centre from the pitch axis [m]
+  Eigen::Vector3d misalignment_rpy_rad{0.0, 0.0,
+                                       0.0};  ///< scan plane vs mount, roll/pitch/yaw [rad]
 
   /// T_mount_laser at zero pitch: the misalignment rotation and the mirror offset.
   Eigen::Isometry3d MountToLaser() const;
@@ -39,12 +40,12 @@ struct ScanPoint {
 
 /// A full 3D scan: valid returns as points in base_link, the raw lines, and (in simulation) truth.
 struct Scan3D {
-  double stamp_s = 0.0;                  ///< first line's stamp [s]
-  double duration_s = 0.0;               ///< first line's start to last line's end [s]
-  std::vector<ScanPoint> points;         ///< valid returns, line-major
-  std::vector<LaserLine> lines;          ///< what the scanner delivered, with encoder pitch
-  std::size_t no_returns = 0;            ///< readings flagged no-return
-  std::size_t over_ranges = 0;           ///< readings flagged over-range
+  double stamp_s = 0.0;           ///< first line's stamp [s]
+  double duration_s = 0.0;        ///< first line's start to last line's end [s]
+  std::vector<ScanPoint> points;  ///< valid returns, line-major
+  std::vector<LaserLine> lines;   ///< what the scanner delivered, with encoder pitch
+  std::size_t no_returns = 0;     ///< readings flagged no-return
+  std::size_t over_ranges = 0;    ///< readings flagged over-range
   /// The points are in base_link as it stood at the last line: each line was turned by the
   /// base's rotation since it, as an attitude sensor measured it (AssembleScan's attitudes).
   /// Otherwise they are in base_link as it stood at each line (one frame while the base is still).

@@ -12,8 +12,9 @@
 
 namespace pitchlab::sim {
 
-/// A MEMS rate gyro triad; the defaults are the datasheet figures of a tactical-grade part (ADIS16470
-/// class: in-run bias stability 8 deg/h, angle random walk 0.34 deg/sqrt(h)). Errors on by default.
+/// A MEMS rate gyro triad; the defaults are the datasheet figures of a tactical-grade part
+/// (ADIS16470 class: in-run bias stability 8 deg/h, angle random walk 0.34 deg/sqrt(h)). Errors on
+/// by default.
 struct ImuConfig {
   std::uint64_t seed = 1;
   bool deskew = true;  ///< scans are deskewed by it (SimRig) ...
@@ -21,7 +22,7 @@ struct ImuConfig {
   /// within the gyros' own error over a scan (3 sigma of the defaults' bias and random walk over
   /// the seed's 18 s: 0.19 deg), and on flat floors bent false drops into far, grazing ground [deg]
   double deskew_min_deg = 0.2;
-  double gyro_bias_dps = 0.003;        ///< each axis' constant bias ~ N(0, this), drawn once [deg/s]
+  double gyro_bias_dps = 0.003;  ///< each axis' constant bias ~ N(0, this), drawn once [deg/s]
   double gyro_noise_dps_rthz = 0.008;  ///< white rate noise density [deg/s/sqrt(Hz)]
 
   /// Throws std::invalid_argument naming the field and value.
