@@ -88,7 +88,10 @@ void Inclination(const ElevationMap& map, int ci, int cj, const LayerConfig& con
 
 // Unknown cells whose clearance is below the lowest point of every observed neighbour by more than
 // drop_depth become drops (seeds); grown breadth-first from them, below the same reference, up to
-// drop_flood_m, so a ditch is marked across and a sunken court along its rim.
+// drop_flood_m, so a ditch is marked across and a sunken court along its rim. A neighbour a ray
+// passed under (a desk top, a car's body, a canopy: its points hang over free space) is not ground
+// at its lowest point but at most at that ray: rays under an office desk read the floor between
+// its legs as drops below the desk top, which closed rooms off.
 float LowestObservedNeighbour(const ElevationLayers& L, const CellIndex& c) {
   const GridGeometry& g = L.geometry;
   float ref = std::numeric_limits<float>::infinity();
@@ -97,7 +100,9 @@ float LowestObservedNeighbour(const ElevationLayers& L, const CellIndex& c) {
       const CellIndex nb{c.i + di, c.j + dj};
       if (!g.Contains(nb)) continue;
       const std::size_t kn = g.Linear(nb);
-      if (L.state[kn] == CellState::kObserved) ref = std::min(ref, L.min_z[kn]);
+      if (L.state[kn] == CellState::kObserved) {
+        ref = std::min({ref, L.min_z[kn], L.clearance_z[kn]});
+      }
     }
   return ref;
 }

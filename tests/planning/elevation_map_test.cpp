@@ -249,18 +249,23 @@ TEST(ElevationMap, MergeOfUnknownCellsLeavesSeenGroundAsItWas) {
 }
 
 TEST(ElevationMap, DitchShowsAsDropNotAsUnknown) {
-  // Flat ground z = 0 except a ditch 1 m wide and 0.6 m deep at x in [4, 5); the laser at
-  // (0, 0, 0.55) sees the near ground, the far wall and the far ground, never the ditch floor.
-  const Eigen::Vector3f sensor(0.0f, 0.0f, 0.55f);
-  std::vector<Eigen::Vector3f> pts;
-  for (double y = -1.0; y < 1.0; y += 0.05) {
-    for (double x = 0.5; x < 4.0; x += 0.05) pts.emplace_back(float(x), float(y), 0.0f);
-    for (double z = -0.6; z < 0.0; z += 0.02) pts.emplace_back(5.0f, float(y), float(z));
-    for (double x = 5.0; x < 8.0; x += 0.05) pts.emplace_back(float(x), float(y), 0.0f);
+  // Flat ground z = 0 except a ditch 1 m wide and 1 m deep at x in [4, 5). A laser at (0, 0, 0.55)
+  // sees the near and the far ground, never into the ditch (its rays pass over it); a second one
+  // standing in the ditch (at x = 4.05, 0.55 m up: z = -0.45) sees its far wall 0.45 m under the
+  // rim. Its rays cross the ditch 0.45 m below the near rim's ground, beside it: a drop there,
+  // flooded along the ditch under the same rim.
+  const Eigen::Vector3f sensor(0.0f, 0.0f, 0.55f), in_ditch(4.05f, 0.0f, -0.45f);
+  std::vector<Eigen::Vector3f> pts, across;
+  for (int n = -20; n < 20; ++n) {  // 5 cm apart, by index: the rim stays in its cell
+    const float y = 0.05f * n;
+    for (int m = 10; m < 80; ++m) pts.emplace_back(0.05f * m, y, 0.0f);
+    for (int m = 102; m < 160; ++m) pts.emplace_back(0.05f * m, y, 0.0f);
+    across.emplace_back(5.0f, y, -0.45f);
   }
   ElevationMap map(GridGeometry::FromArea(0, -1, 8, 2, 0.1));
   const InsertStats s = map.InsertScan(pts.data(), pts.size(), sensor);
   EXPECT_GT(s.clearance_cells, 0u);
+  (void)map.InsertScan(across.data(), across.size(), in_ditch);
   const ElevationLayers L = ComputeLayers(map);
   int drops = 0, unknown = 0;
   for (int i = 40; i < 50; ++i) {
@@ -278,20 +283,22 @@ TEST(ElevationMap, DitchShowsAsDropNotAsUnknown) {
 
 TEST(ElevationMap, ADropSeededBySomethingTallDoesNotFloodTheWholeShadow) {
   // Ground z = 0 up to x = 3, a fence seen only at its 0.8 m top in the cell [3.0, 3.1), then a
-  // shadow to a far wall at x = 7.95 hit 0.5 m up: its rays cross the shadow at about 0.5 m,
-  // 0.3 m under the fence top. The cell beside the fence is a drop by the rule (its only observed
-  // neighbour is the fence); the flood from it stops after drop_flood_m instead of running over
-  // the whole shadow, which is flat ground the laser merely did not see.
-  const Eigen::Vector3f sensor(0.0f, 0.0f, 0.55f);
-  std::vector<Eigen::Vector3f> pts;
+  // shadow up to a far wall at x = 7.95, seen from beyond the fence 0.55 m up and hit 0.5 m up:
+  // those rays cross the shadow at about 0.5 m, 0.3 m under the fence top. The cell beside the
+  // fence is a drop by the rule (its only observed neighbour is the fence); the flood from it
+  // stops after drop_flood_m instead of running over the whole shadow, which is flat ground the
+  // laser merely did not see.
+  const Eigen::Vector3f sensor(0.0f, 0.0f, 0.55f), beyond(3.15f, 0.0f, 0.55f);
+  std::vector<Eigen::Vector3f> pts, far;
   for (double y = -0.5; y < 0.5; y += 0.05) {
     for (double x = 0.52; x < 3.0; x += 0.05) pts.emplace_back(float(x), float(y), 0.0f);
     pts.emplace_back(3.05f, float(y), 0.8f);
-    pts.emplace_back(7.95f, float(y), 0.5f);
+    far.emplace_back(7.95f, float(y), 0.5f);
   }
   const GridGeometry g = GridGeometry::FromArea(0, -0.5, 8, 1, 0.1);
   ElevationMap map(g);
   (void)map.InsertScan(pts.data(), pts.size(), sensor);
+  (void)map.InsertScan(far.data(), far.size(), beyond);
   const ElevationLayers L = ComputeLayers(map);
   const auto state = [&](double x) { return L.state[g.Linear(g.IndexOf(x, 0.05))]; };
   EXPECT_EQ(state(3.15), CellState::kDrop);
@@ -301,6 +308,30 @@ TEST(ElevationMap, ADropSeededBySomethingTallDoesNotFloodTheWholeShadow) {
   unbounded.drop_flood_m = 100;
   EXPECT_EQ(ComputeLayers(map, unbounded).state[g.Linear(g.IndexOf(6.05, 0.05))],
             CellState::kDrop);  // what the flood did before it was bounded
+}
+
+TEST(ElevationMap, FloorUnderADeskTopIsNoDrop) {
+  // Floor z = 0 out to x = 3 and beyond x = 4.5, a desk top at 0.75 m over x in [3, 4.5) seen from
+  // (0, 0, 0.55), and rays under it to a wall at x = 6 hit 0.3 m up: under the top they pass at
+  // 0.33-0.45 m, more than drop_depth below the top. The floor between the desk's legs is unseen,
+  // not a drop: the top's own cells had rays pass under them, so the top is no ground reference.
+  const Eigen::Vector3f sensor(0.0f, 0.0f, 0.55f);
+  std::vector<Eigen::Vector3f> pts;
+  for (double y = -0.5; y < 0.5; y += 0.05) {
+    for (double x = 0.52; x < 3.0; x += 0.05) pts.emplace_back(float(x), float(y), 0.0f);
+    for (double x = 3.05; x < 4.5; x += 0.1) pts.emplace_back(float(x), float(y), 0.75f);
+    pts.emplace_back(6.0f, float(y), 0.3f);
+  }
+  const GridGeometry g = GridGeometry::FromArea(0, -0.5, 7, 1, 0.1);
+  ElevationMap map(g);
+  (void)map.InsertScan(pts.data(), pts.size(), sensor);
+  const ElevationLayers L = ComputeLayers(map);
+  int drops = 0;
+  for (std::size_t k = 0; k < g.cell_count(); ++k) drops += L.state[k] == CellState::kDrop;
+  EXPECT_EQ(drops, 0);
+  // The cells beyond the desk's far edge: unknown, crossed by rays, beside the top only.
+  EXPECT_EQ(L.state[g.Linear(g.IndexOf(4.55, 0.05))], CellState::kUnknown);
+  EXPECT_TRUE(std::isfinite(L.clearance_z[g.Linear(g.IndexOf(4.55, 0.05))]));
 }
 
 TEST(ElevationMap, SignOverOpenGroundIsLeftOutOfTheGroundCells) {
