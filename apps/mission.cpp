@@ -186,11 +186,16 @@ class Mission {
   bool last_stop_turned_only_ = false;  // the previous stop only turned to look ahead
   bool backed_off_ = false;             // the last drive ended backing off from a tilt
   std::vector<FeltHazard> felt_;
+  // Per map cell, the shortest range a registered scan saw it from [m] (+inf: never so). A
+  // recovery doubts only what was never seen from close: doubt measured from where the robot
+  // stands made it walk back and forth between two routes, each far from the other's end.
+  std::vector<float> nearest_view_m_;
 };
 
 MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
   result_.start_s = probes_.now_s();
   result_.elevation = mapping::ElevationMap(config_.map_area);
+  nearest_view_m_.assign(config_.map_area.cell_count(), std::numeric_limits<float>::infinity());
   T_world_map_ = T_world_base_ = T_world_start;
   Result<sensors::Odometry> odo = base_.ReadOdometry();
   if (!odo) {
@@ -306,8 +311,15 @@ void Mission::UpdateElevation(StopRecord& stop) {
   const Eigen::Isometry3f T = stop.T_world_base.cast<float>();
   std::vector<Eigen::Vector3f> near;  // map frame, within map_range_m of the laser
   near.reserve(stop.scan.points.size());
+  const mapping::GridGeometry& g = config_.map_area;
   for (const sensors::ScanPoint& p : stop.scan.points) {
-    if (p.range_m <= config_.map_range_m) near.push_back(T * Eigen::Vector3f(p.x, p.y, p.z));
+    if (p.range_m > config_.map_range_m) continue;
+    near.push_back(T * Eigen::Vector3f(p.x, p.y, p.z));
+    const mapping::CellIndex c = g.IndexOf(near.back().x(), near.back().y());
+    if (!stop.elevation_from_odometry && g.Contains(c)) {
+      float& nearest = nearest_view_m_[g.Linear(c)];
+      nearest = std::min(nearest, p.range_m);
+    }
   }
   // At the odometry pose, the height comes from the map's ground where the scan overlaps it.
   if (stop.elevation_from_odometry) {
@@ -465,11 +477,10 @@ void Mission::Plan(StopRecord& stop) const {
         [&](std::size_t k) {
           if (layers.state[k] == mapping::CellState::kDrop) return true;
           return layers.state[k] != mapping::CellState::kUnknown &&
-                 (layers.geometry.CenterOf(layers.geometry.FromLinear(k)) - here).norm() >
-                     kFarDoubt_m;
+                 nearest_view_m_[k] > kFarDoubt_m;
         },
-        "the inferred drops and everything seen farther than " + std::to_string(int(kFarDoubt_m)) +
-            " m away");
+        "the inferred drops and everything never seen from closer than " +
+            std::to_string(int(kFarDoubt_m)) + " m");
   }
   if (!path) {
     stop.plan_error = path.error().message;
