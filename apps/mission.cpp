@@ -315,8 +315,9 @@ void Mission::UpdateElevation(StopRecord& stop) {
   for (const sensors::ScanPoint& p : stop.scan.points) {
     if (p.range_m > config_.map_range_m) continue;
     near.push_back(T * Eigen::Vector3f(p.x, p.y, p.z));
+    if (stop.elevation_from_odometry) continue;  // a registered view only
     const mapping::CellIndex c = g.IndexOf(near.back().x(), near.back().y());
-    if (!stop.elevation_from_odometry && g.Contains(c)) {
+    if (g.Contains(c)) {
       float& nearest = nearest_view_m_[g.Linear(c)];
       nearest = std::min(nearest, p.range_m);
     }

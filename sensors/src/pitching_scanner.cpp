@@ -1,6 +1,5 @@
 #include "pitchlab/sensors/pitching_scanner.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -65,10 +64,7 @@ Result<Scan3D> PitchingScanSource::Acquire() {
     if (progress_) progress_(k + 1, n);
   }
   if (!attitude_known) attitudes.clear();  // a line without one: the scan stays as swept
-  double sensed_rad = 0;
-  for (const Eigen::Quaterniond& q : attitudes) {
-    sensed_rad = std::max(sensed_rad, Eigen::AngleAxisd(attitudes.back().conjugate() * q).angle());
-  }
+  const double sensed_rad = MaxTurnToLast(attitudes);
   if (sensed_rad < min_rotation_rad_) attitudes.clear();  // within the sensor's own error
   Scan3D scan = AssembleScan(std::move(lines), mount_, attitudes);
   scan.deskew_max_rad = sensed_rad;

@@ -32,6 +32,14 @@ Eigen::Vector3d BeamPointInBase(double rho_m, double theta_rad, double gamma_rad
   return mount.BaseToLaser(gamma_rad) * in_plane;
 }
 
+double MaxTurnToLast(const std::vector<Eigen::Quaterniond>& attitudes) {
+  double max_rad = 0;
+  for (const Eigen::Quaterniond& q : attitudes) {
+    max_rad = std::max(max_rad, Eigen::AngleAxisd(attitudes.back().conjugate() * q).angle());
+  }
+  return max_rad;
+}
+
 Scan3D AssembleScan(std::vector<LaserLine> lines, const MountConfig& mount,
                     const std::vector<Eigen::Quaterniond>& attitudes) {
   if (!attitudes.empty() && attitudes.size() != lines.size()) {
@@ -41,6 +49,7 @@ Scan3D AssembleScan(std::vector<LaserLine> lines, const MountConfig& mount,
   }
   Scan3D scan;
   scan.deskewed = !attitudes.empty();
+  scan.deskew_max_rad = MaxTurnToLast(attitudes);
   if (!lines.empty()) {
     scan.stamp_s = lines.front().stamp_s;
     const LaserLine& last = lines.back();
@@ -57,7 +66,6 @@ Scan3D AssembleScan(std::vector<LaserLine> lines, const MountConfig& mount,
       // decimetres away, which moves the laser by millimetres per degree; the turn itself moves
       // far returns by centimetres per degree.
       const Eigen::Quaterniond to_last = attitudes.back().conjugate() * attitudes[l];
-      scan.deskew_max_rad = std::max(scan.deskew_max_rad, Eigen::AngleAxisd(to_last).angle());
       T_base_laser.prerotate(to_last.normalized().toRotationMatrix());
     }
     for (std::size_t i = 0; i < line.ranges_m.size(); ++i) {

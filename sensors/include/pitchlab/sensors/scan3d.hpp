@@ -58,6 +58,9 @@ struct Scan3D {
   Eigen::Isometry3d T_world_base = Eigen::Isometry3d::Identity();
 };
 
+/// The largest rotation between any of `attitudes` and the last one [rad]; 0 when empty.
+double MaxTurnToLast(const std::vector<Eigen::Quaterniond>& attitudes);
+
 /// Builds the 3D scan from lines by Eq. 1 (each line's encoder pitch and the mount). With
 /// `attitudes` (one per line: base_link's orientation while that line swept, in any frame fixed to
 /// the ground, e.g. an IMU's integrated rates), every line is turned into base_link as it stood at
