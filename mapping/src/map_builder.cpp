@@ -51,7 +51,8 @@ PointCloud MapBuilder::LocalTarget(const Eigen::Isometry3d& T_map_last) const {
 
 Result<MergeStep> MapBuilder::Add(const PointCloud& cloud_base,
                                   const std::optional<Eigen::Isometry3d>& odometry_T_map_base,
-                                  const std::optional<GuessUncertainty>& odometry_uncertainty) {
+                                  const std::optional<GuessUncertainty>& odometry_uncertainty,
+                                  const std::optional<MeasuredTilt>& measured_tilt) {
   MergeStep step;
   step.scan_index = scans_seen_++;
   if (trajectory_.empty()) {  // the first scan defines the map frame
@@ -73,6 +74,10 @@ Result<MergeStep> MapBuilder::Add(const PointCloud& cloud_base,
   RegistrationPrior prior;
   if (odometry_T_map_base) prior.odometry = T_map_last.inverse() * *odometry_T_map_base;
   prior.odometry_uncertainty = odometry_uncertainty;
+  if (odometry_T_map_base && measured_tilt) {  // registration works in the last scan's frame
+    prior.tilt = measured_tilt;
+    prior.tilt->up_target = T_map_last.linear().transpose() * measured_tilt->up_target;
+  }
   prior.previous_motion = last_motion_ ? *last_motion_ : Eigen::Isometry3d::Identity();
   Result<RegistrationResult> r =
       Register(LocalTarget(T_map_last), cloud_base, prior, config_.registration);

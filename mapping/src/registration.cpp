@@ -78,6 +78,12 @@ Limits ConstraintLimits(const RegistrationPrior& prior, const RegistrationConfig
   return l;
 }
 
+// How far `icp` tilts the source from the odometry guess's measured tilt [deg]; 0 without one.
+double TiltOff(const IcpResult& icp, const RegistrationPrior& prior) {
+  if (!prior.odometry || !prior.tilt) return 0;
+  return TiltBetween(icp.T_target_source, *prior.odometry, prior.tilt->up_target);
+}
+
 // Why `icp` may not be merged, or empty when it may.
 std::string Rejection(const IcpResult& icp, const RegistrationPrior& prior,
                       const RegistrationConfig& config) {
@@ -98,9 +104,38 @@ std::string Rejection(const IcpResult& icp, const RegistrationPrior& prior,
          << " deg from the " << (prior.odometry ? "odometry prior" : "constant-velocity motion")
          << " (limit " << limits.translation_m << " m / " << limits.rotation_deg << " deg"
          << (limits.from_bound ? ", the odometry's error bound" : "") << ")";
+    } else if (const double tilt = TiltOff(icp, prior);
+               prior.tilt && tilt > prior.tilt->tolerance_deg) {
+      os << "tilt: result tilts the scan " << tilt << " deg from the measured roll and pitch "
+         << "(limit " << prior.tilt->tolerance_deg << " deg)";
     }
   }
   return os.str();
+}
+
+// The rotation axes that tilt the source (the two horizontal ones in the target frame): held, ICP
+// keeps the source's up where the guess had it and turns it about up only.
+Weakness TiltAxes(const Eigen::Vector3d& up_target) {
+  const Eigen::Vector3d u = up_target.normalized(), a = u.unitOrthogonal();
+  Weakness held;
+  held.rotation_axes = {a, u.cross(a)};
+  held.rotation_ratios = {0.0, 0.0};
+  return held;
+}
+
+// `weak` without what holding the tilt already fixes: a weak rotation axis within 60 deg of
+// horizontal is dropped (its tilting part is held), a steeper one becomes the turn about up.
+Weakness WithoutTilt(Weakness weak, const Eigen::Vector3d& up_target) {
+  const Eigen::Vector3d u = up_target.normalized();
+  Weakness out = weak;
+  out.rotation_axes.clear(), out.rotation_ratios.clear();
+  for (std::size_t k = 0; k < weak.rotation_axes.size(); ++k) {
+    if (std::abs(weak.rotation_axes[k].dot(u)) < 0.5) continue;
+    out.rotation_axes.push_back(u);
+    out.rotation_ratios.push_back(weak.rotation_ratios[k]);
+    break;  // only one axis is left free
+  }
+  return out;
 }
 
 // The clouds after the voxel grid, with what ICP needs of the target.
@@ -266,6 +301,8 @@ struct FromGuess {
   std::string rejection;      // empty: accepted
   bool carried = false;       // degenerate: the weak directions were kept from the guess
   bool undetermined = false;  // degenerate, and the guess may not supply the weak directions
+  Weakness held;              // the tilt axes, when ICP was re-run with the measured tilt held
+  double tilt_off_deg = 0;    // ... because free ICP tilted the source this far from it
 };
 
 // In degenerate geometry the guess supplies the weak directions (ICP re-run with them kept at the
@@ -296,18 +333,31 @@ FromGuess IcpFromGuess(const IcpTarget& target, const PointCloud& source, const 
   }
   out.icp = PointToPlaneLm(target, source, guess, config, {});
   out.rejection = Rejection(out.icp, prior, config);
+  // Free ICP tilted the scan beyond what the inclinometer allows (too little overlap to pin the
+  // floor's plane, ghosts in the map: office, 26 % of the scan fitting 2.4 deg pitched): roll and
+  // pitch are held at the measured ones, and the fit decides the rest.
+  if (path == RegistrationPath::kOdometry && prior.tilt) {
+    if (const double off = TiltOff(out.icp, prior); off > prior.tilt->tolerance_deg) {
+      out.held = TiltAxes(prior.tilt->up_target);
+      out.tilt_off_deg = off;
+      const int first = out.icp.iterations;
+      out.icp = PointToPlaneLm(target, source, guess, config, out.held);
+      out.icp.iterations += first;
+      out.rejection = Rejection(out.icp, prior, config);
+    }
+  }
   const std::optional<GuessUncertainty>& u = prior.odometry_uncertainty;
   const bool may_carry =
       path == RegistrationPath::kFallback ||
       (u && (u->translation_m <= config.carry_max_m || u->rotation_deg <= config.carry_max_deg));
   if (!out.rejection.empty() && !may_carry) return out;  // no probe needed: searched or failed
-  const Weakness weak =
-      Union(GuessDegenerateDirections(target, source, out.icp, config), ambiguous);
+  Weakness weak = Union(GuessDegenerateDirections(target, source, out.icp, config), ambiguous);
+  if (out.held.any()) weak = WithoutTilt(weak, prior.tilt->up_target);
   if (!weak.any()) return out;
   const std::string untrusted = UntrustedGuess(weak, path, prior, config);
   if (untrusted.empty()) {
     const int first = out.icp.iterations;
-    out.icp = PointToPlaneLm(target, source, guess, config, weak);
+    out.icp = PointToPlaneLm(target, source, guess, config, Union(out.held, weak));
     out.icp.iterations += first;
     out.rejection = Rejection(out.icp, prior, config);
     out.carried = true;
@@ -384,13 +434,14 @@ struct Verified {
 // each start: screens many starts cheaply; the promising ones are refined with the full ICP.
 std::vector<IcpResult> Screen(const IcpTarget& target, const PointCloud& source,
                               const std::vector<Eigen::Isometry3d>& starts,
-                              const RegistrationConfig& config, int& iterations) {
+                              const RegistrationConfig& config, const Weakness& held,
+                              int& iterations) {
   RegistrationConfig screen = config;
   screen.icp_max_iterations = 8;
   const PointCloud few = EvenSubsample(source, 300);
   std::vector<IcpResult> out;
   for (const Eigen::Isometry3d& start : starts) {
-    out.push_back(PointToPlaneLm(target, few, start, screen, {}));
+    out.push_back(PointToPlaneLm(target, few, start, screen, held));
     iterations += out.back().iterations;
   }
   return out;
@@ -472,7 +523,8 @@ Verified VerifyHypotheses(const PointCloud& source, const IcpTarget& target, con
   auto verify = [&](const std::vector<Start>& starts, std::size_t refine) {
     std::vector<Eigen::Isometry3d> poses;
     for (const Start& s : starts) poses.push_back(s.T);
-    const std::vector<IcpResult> screened = Screen(target, source, poses, config, best.iterations);
+    const std::vector<IcpResult> screened =
+        Screen(target, source, poses, config, {}, best.iterations);
     std::vector<std::size_t> order(starts.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
@@ -535,21 +587,30 @@ Verified VerifyHypotheses(const PointCloud& source, const IcpTarget& target, con
 // the best-fitting accepted result, if any.
 std::optional<IcpResult> SearchAroundGuess(const IcpTarget& target, const PointCloud& source,
                                            const Start& guess, const RegistrationPrior& prior,
-                                           const RegistrationConfig& config, int& iterations) {
+                                           const RegistrationConfig& config, const Weakness& held,
+                                           int& iterations) {
   std::vector<Eigen::Isometry3d> poses;
   for (const Start& s : GuessGrid(guess, prior, config)) poses.push_back(s.T);
-  std::vector<IcpResult> screened = Screen(target, source, poses, config, iterations);
+  std::vector<IcpResult> screened = Screen(target, source, poses, config, held, iterations);
   std::stable_sort(screened.begin(), screened.end(),
                    [](const auto& a, const auto& b) { return a.inlier_ratio > b.inlier_ratio; });
   std::optional<IcpResult> best;
   for (std::size_t i = 0; i < std::min<std::size_t>(2, screened.size()); ++i) {
-    const IcpResult icp = PointToPlaneLm(target, source, screened[i].T_target_source, config, {});
+    const IcpResult icp = PointToPlaneLm(target, source, screened[i].T_target_source, config, held);
     iterations += icp.iterations;
     if (Rejection(icp, prior, config).empty() && (!best || icp.inlier_ratio > best->inlier_ratio)) {
       best = icp;
     }
   }
   return best;
+}
+
+std::string HeldNote(double tilt_off_deg) {
+  std::ostringstream os;
+  os.precision(3);
+  os << " (roll and pitch held at the measured ones: free ICP tilted the scan " << tilt_off_deg
+     << " deg from them)";
+  return os.str();
 }
 
 void Fill(RegistrationResult& out, const IcpResult& icp, RegistrationPath path) {
@@ -581,6 +642,13 @@ PoseError ComparePoses(const Eigen::Isometry3d& estimate, const Eigen::Isometry3
   return {Eigen::AngleAxisd(d.linear()).angle() * 180.0 / kPi, d.translation().norm()};
 }
 
+double TiltBetween(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b,
+                   const Eigen::Vector3d& up_target) {
+  const Eigen::Vector3d ua = a.linear().transpose() * up_target;
+  const Eigen::Vector3d ub = b.linear().transpose() * up_target;
+  return std::atan2(ua.cross(ub).norm(), ua.dot(ub)) * 180.0 / kPi;
+}
+
 Eigen::Isometry3d PoseFromXyzRpyDeg(double x, double y, double z, double roll_deg, double pitch_deg,
                                     double yaw_deg) {
   const double k = kPi / 180.0;
@@ -609,6 +677,14 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
     std::ostringstream os;
     os << "odometry_uncertainty must be finite and >= 0, got " << u->translation_m << " m / "
        << u->rotation_deg << " deg";
+    return Fail(Error::Code::kInvalidArgument, os.str());
+  }
+
+  if (const auto& t = prior.tilt; t && !(t->up_target.allFinite() && t->up_target.norm() > 0.5 &&
+                                         std::isfinite(t->tolerance_deg) && t->tolerance_deg > 0)) {
+    std::ostringstream os;
+    os << "tilt: up_target must be a finite unit vector and tolerance_deg finite and > 0, got up "
+       << Vector(t->up_target) << ", tolerance " << t->tolerance_deg << " deg";
     return Fail(Error::Code::kInvalidArgument, os.str());
   }
 
@@ -726,7 +802,7 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
         config.guess_search_m > 0) {
       int iterations = 0;
       const std::optional<IcpResult> found = SearchAroundGuess(
-          icp_target, icp_source, {guess, path, ToString(path)}, prior, config, iterations);
+          icp_target, icp_source, {guess, path, ToString(path)}, prior, config, g.held, iterations);
       out.iterations += iterations;
       // Only a pose the scene pins down may replace the guess: in a corridor a grid start fits
       // anywhere along the axis, and nothing says where.
@@ -751,7 +827,8 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
                 "whose error bound is within carry_max_m / carry_max_deg)";
       notes.push_back(
           std::string("took the ") + ToString(path) + " path" + (g.carried ? carried : "") +
-          (searched ? " (ICP from the best of a grid of starts around the guess)" : ""));
+          (searched ? " (ICP from the best of a grid of starts around the guess)" : "") +
+          (g.held.any() ? HeldNote(g.tilt_off_deg) : ""));
       break;
     }
     notes.push_back(std::string(ToString(path)) + " path rejected: " + g.rejection);

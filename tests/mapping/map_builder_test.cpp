@@ -43,6 +43,45 @@ TEST(MapBuilder, AnOfficeSequenceFollowsTheGroundTruthAndGrowsTheMap) {
   }
 }
 
+// The attitude sensor's up comes in the map frame (the first scan's base_link) and registration
+// works in the last scan's frame. Scans as if taken standing tilted each its own way (the first
+// pitched 8 deg, the next rolled 8 deg, the third both ways) with odometry 6 deg off in heading:
+// with each guess's measured tilt right, no result is held and the trajectory follows the truth.
+// (Up left in the map's frame is 11 deg off in the second scan's: the third scan's heading
+// correction then reads as a tilt of over a degree, and the correct result is held.)
+TEST(MapBuilder, AMeasuredTiltGivenInTheMapFrameHoldsNoCorrectResult) {
+  const Eigen::Isometry3d tilts[] = {PoseFromXyzRpyDeg(0, 0, 0, 0, 8, 0),
+                                     PoseFromXyzRpyDeg(0, 0, 0, 8, 0, 0),
+                                     PoseFromXyzRpyDeg(0, 0, 0, -5, -4, 0)};
+  MapBuilder builder{MapConfig{}};
+  std::vector<Eigen::Isometry3d> truths;  // T_world_base of each tilted scan
+  Eigen::Vector3d up_map = Eigen::Vector3d::UnitZ();
+  for (std::size_t i = 0; i < std::size(tilts); ++i) {
+    const Pose2& p = kOfficePath[i];
+    const sensors::Scan3D scan = SimulatedScan("office", p.x_m, p.y_m, p.yaw_deg, 10 + i);
+    truths.push_back(scan.T_world_base * tilts[i]);
+    const PointCloud cloud = TransformCloud(CloudFromScan(scan), tilts[i].inverse());
+    if (i == 0) {
+      ASSERT_TRUE(builder.Add(cloud));
+      up_map = truths[0].linear().transpose() * Eigen::Vector3d::UnitZ();
+      continue;
+    }
+    const Eigen::Isometry3d truth = truths[0].inverse() * truths[i];
+    // Odometry off in x, y and heading (a turn about up), its roll and pitch measured.
+    Eigen::Isometry3d odometry = Eigen::Isometry3d(Eigen::AngleAxisd(0.1, up_map)) * truth;
+    odometry.translation() += Eigen::Vector3d(0.1, -0.08, 0);
+    Result<MergeStep> step =
+        builder.Add(cloud, odometry, GuessUncertainty{0.3, 8.0}, MeasuredTilt{up_map, 0.5});
+    ASSERT_TRUE(step) << step.error().message;
+    EXPECT_TRUE(step->merged) << "scan " << i << ": " << step->registration.reason;
+    EXPECT_EQ(step->registration.reason.find("held"), std::string::npos)
+        << "scan " << i << ": " << step->registration.reason;
+    const PoseError e = ComparePoses(step->T_map_base, truth);
+    EXPECT_LT(e.rotation_deg, kMaxRotationError_deg) << "scan " << i;
+    EXPECT_LT(e.translation_m, kMaxTranslationError_m) << "scan " << i;
+  }
+}
+
 TEST(MapBuilder, AScanFromAnotherWorldIsReportedAndNotMerged) {
   MapBuilder builder{MapConfig{}};
   ASSERT_TRUE(builder.Add(CloudFromScan(SimulatedScan("office", -8, 0, 0, 10))));

@@ -18,6 +18,7 @@ using testing::SimulatedScan;
 constexpr double kMaxRotationError_deg = 0.5;
 constexpr double kMaxTranslationError_m = 0.03;
 constexpr double kNoiseSigma_m = 0.005;
+constexpr double kPi = 3.14159265358979323846;
 
 // `T_target_source` applied to `cloud_target` gives the source cloud seen from the moved robot,
 // every other point (so no point is shared) with fresh seeded noise.
@@ -385,6 +386,63 @@ TEST(Register, ThePclBackendAlsoRecoversAKnownTransform) {
   const PoseError e = ComparePoses(r->T_target_source, truth);
   EXPECT_LT(e.rotation_deg, 1.0) << r->reason;
   EXPECT_LT(e.translation_m, 0.05) << r->reason;
+}
+
+TEST(TiltBetween, MeasuresRollAndPitchAndIsBlindToATurnAboutUp) {
+  const Eigen::Isometry3d level = PoseFromXyzRpyDeg(0.3, -0.2, 0.1, 0, 0, 10);
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  EXPECT_NEAR(TiltBetween(level, PoseFromXyzRpyDeg(2, 1, 0, 0, 0, 70), z), 0.0, 1e-9);
+  EXPECT_NEAR(TiltBetween(level, PoseFromXyzRpyDeg(0, 0, 0, 0, 2.0, 10), z), 2.0, 1e-9);
+  EXPECT_NEAR(TiltBetween(level, PoseFromXyzRpyDeg(0, 0, 0, 3.0, 4.0, -80), z),
+              std::acos(std::cos(3.0 * kPi / 180) * std::cos(4.0 * kPi / 180)) * 180 / kPi, 1e-9);
+  // A target frame tilted 5 deg (the map's first scan on a slope): up is its own vector there, and
+  // a turn about that up still changes no tilt.
+  const Eigen::Isometry3d R_world_target = PoseFromXyzRpyDeg(0, 0, 0, 0, 5, 0);
+  const Eigen::Vector3d up = R_world_target.linear().transpose() * z;
+  const Eigen::Isometry3d turned = Eigen::Isometry3d(Eigen::AngleAxisd(0.7, up)) * level;
+  EXPECT_NEAR(TiltBetween(level, turned, up), 0.0, 1e-9);
+  EXPECT_GT(TiltBetween(level, turned, z), 1.0);  // wrong up: the turn reads as a tilt
+}
+
+// The inclinometer's roll and pitch at standstill bound the result's tilt. The source below was
+// seen pitched 1.5 deg and the guess says level (the inclinometer is off by 1.5 deg, beyond its
+// 1 deg tolerance): free ICP finds the 1.5 deg, so ICP is re-run with roll and pitch held at the
+// guess's,
+// and the result keeps the guess's tilt exactly, fitting only x, y, z and the turn about up. With
+// the inclinometer right, nothing is held and the truth is recovered.
+TEST(Register, AResultTiltedBeyondTheMeasuredTiltIsHeldAtIt) {
+  const PointCloud cloud = CloudFromScan(SimulatedScan("office", -8, 0, 0));
+  const Eigen::Isometry3d truth = PoseFromXyzRpyDeg(0.4, 0.1, 0.02, 0, 1.5, 6);
+  const PointCloud source = MovedCopy(cloud, truth, 13);
+  RegistrationConfig config;
+  config.features = FeatureKind::kNone;  // ICP from the odometry guess alone
+  RegistrationPrior prior;
+  prior.odometry = PoseFromXyzRpyDeg(0.3, 0.2, 0, 0, 0, 4);  // level: 1.5 deg off in pitch
+  prior.odometry_uncertainty = GuessUncertainty{0.5, 5.0};
+  prior.tilt = MeasuredTilt{Eigen::Vector3d::UnitZ(), 1.0};
+  Result<RegistrationResult> held = Register(EveryOther(cloud), source, prior, config);
+  ASSERT_TRUE(held) << held.error().message;
+  ASSERT_TRUE(held->success) << held->reason;
+  EXPECT_NE(held->reason.find("roll and pitch held"), std::string::npos) << held->reason;
+  EXPECT_NEAR(TiltBetween(held->T_target_source, *prior.odometry, Eigen::Vector3d::UnitZ()), 0.0,
+              1e-6);
+  // The free directions still come from the scans: the yaw and the x, y of the truth.
+  const Eigen::Vector3d x = held->T_target_source.linear().col(0);
+  EXPECT_NEAR(std::atan2(x.y(), x.x()) * 180 / kPi, 6.0, 0.5) << held->reason;
+  EXPECT_NEAR(held->T_target_source.translation().x(), truth.translation().x(), 0.1);
+  EXPECT_NEAR(held->T_target_source.translation().y(), truth.translation().y(), 0.1);
+
+  prior.odometry = truth * PoseFromXyzRpyDeg(-0.1, 0.1, 0, 0, 0, -2);  // the tilt right
+  Result<RegistrationResult> free = Register(EveryOther(cloud), source, prior, config);
+  ASSERT_TRUE(free) << free.error().message;
+  ASSERT_TRUE(free->success) << free->reason;
+  EXPECT_EQ(free->reason.find("held"), std::string::npos) << free->reason;
+  ExpectNear(*free, truth);
+
+  prior.tilt->up_target = Eigen::Vector3d(0, 0, std::nan(""));
+  Result<RegistrationResult> bad = Register(EveryOther(cloud), source, prior, config);
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("up_target"), std::string::npos) << bad.error().message;
 }
 
 TEST(Register, TheSameInputGivesTheSameOutput) {

@@ -48,12 +48,14 @@ class MapBuilder {
   /// Registers `cloud_base` (points in its base_link [m]) against the map and merges it when the
   /// registration succeeds. `odometry_T_map_base`: odometry's guess of its pose, when known;
   /// `odometry_uncertainty`: how far that guess may be off the motion since the last merged scan
-  /// (see RegistrationPrior). Errors: bad input (see Register). A failed registration is a step
-  /// with merged == false.
+  /// (see RegistrationPrior); `measured_tilt`: that guess's roll and pitch were measured, up
+  /// given in `map` (see RegistrationPrior::tilt). Errors: bad input (see Register). A failed
+  /// registration is a step with merged == false.
   [[nodiscard]] Result<MergeStep> Add(
       const PointCloud& cloud_base,
       const std::optional<Eigen::Isometry3d>& odometry_T_map_base = {},
-      const std::optional<GuessUncertainty>& odometry_uncertainty = {});
+      const std::optional<GuessUncertainty>& odometry_uncertainty = {},
+      const std::optional<MeasuredTilt>& measured_tilt = {});
 
   /// The merged map in `map` [m], one centroid per voxel.
   PointCloud MapCloud() const;

@@ -30,6 +30,13 @@ struct GuessUncertainty {
   double rotation_deg = 0;   ///< [deg]
 };
 
+/// The odometry guess's roll and pitch were measured against gravity (an inclinometer read at
+/// standstill): a result that tilts the source farther from them is wrong however well it fits.
+struct MeasuredTilt {
+  Eigen::Vector3d up_target = Eigen::Vector3d::UnitZ();  ///< gravity's up in the target frame
+  double tolerance_deg = 1.0;  ///< the guess's tilt is right within this [deg]; finite, > 0
+};
+
 /// What the caller knows before aligning. Both transforms are T_target_source.
 struct RegistrationPrior {
   std::optional<Eigen::Isometry3d> odometry;         ///< odometry's guess; enables the constraint
@@ -40,6 +47,10 @@ struct RegistrationPrior {
   /// bound also narrows the geometric constraint (constraint_translation_m / _rotation_deg) and
   /// the grid searched around the guess (guess_search_m / _deg) to itself. Finite, >= 0.
   std::optional<GuessUncertainty> odometry_uncertainty;
+  /// With an odometry guess: its measured tilt. ICP from the guess whose result tilts the source
+  /// more than tolerance_deg from it is re-run with roll and pitch held at the guess's (x, y, z
+  /// and the turn about up stay free), and the result says so; any result beyond it is rejected.
+  std::optional<MeasuredTilt> tilt;
 };
 
 /// Wall time per stage [s] (for both clouds together).
@@ -79,6 +90,12 @@ struct PoseError {
 };
 /// Error of `estimate` against `truth` (both T_target_source): angle and norm of truth^-1 estimate.
 PoseError ComparePoses(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth);
+
+/// Angle between the up directions `a` and `b` (both T_target_source) give the source, `up_target`
+/// being up in the target frame [deg]: their difference in roll and pitch, blind to a turn about
+/// up.
+double TiltBetween(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b,
+                   const Eigen::Vector3d& up_target);
 
 /// x, y, z [m], roll, pitch, yaw [deg] (fixed-axis XYZ, as ROS) -> transform.
 Eigen::Isometry3d PoseFromXyzRpyDeg(double x, double y, double z, double roll_deg, double pitch_deg,
