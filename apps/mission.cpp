@@ -154,6 +154,16 @@ class Mission {
     if (!probes_.roll_pitch_rad) return std::nullopt;
     return probes_.roll_pitch_rad();
   }
+  // The attitude standing still: the mean of kStillReads reads, whose noise averages out (what
+  // is left is the sensor's bias, the same for every stop: the map is consistently tilted by it,
+  // the scans agree with each other).
+  std::optional<Eigen::Vector2d> StillAttitude() const {
+    constexpr int kStillReads = 25;
+    if (!probes_.roll_pitch_rad) return std::nullopt;
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    for (int i = 0; i < kStillReads; ++i) sum += probes_.roll_pitch_rad();
+    return sum / kStillReads;
+  }
   // Angle of base_link's z from vertical [rad]; 0 without an attitude sensor.
   double Tilt() const {
     const std::optional<Eigen::Vector2d> a = Attitude();
@@ -252,7 +262,8 @@ bool Mission::Stop(int k) {
     result_.reason = "base: " + odo.error().message;
     return false;
   }
-  stop.T_world_base_odom = Propagate(T_world_base_, odo_ref_, *odo, Attitude());
+  const std::optional<Eigen::Vector2d> attitude = StillAttitude();
+  stop.T_world_base_odom = Propagate(T_world_base_, odo_ref_, *odo, attitude);
   // Algorithm 1 against the map, odometry as the prior (none for the scan that starts the map).
   const std::optional<Eigen::Isometry3d> prior =
       k == 0 ? std::nullopt
@@ -261,7 +272,15 @@ bool Mission::Stop(int k) {
       config_.odometry_error_m +
           config_.odometry_error_per_m * (result_.odometry_distance_m - merged_distance_m_),
       config_.odometry_error_deg + config_.odometry_error_dps * (stop.stamp_s - merged_stamp_s_)};
-  Result<mapping::MergeStep> merge = builder_.Add(mapping::CloudFromScan(stop.scan), prior, bound);
+  // The attitude sensor's roll and pitch at standstill: the prior's tilt is right within
+  // tilt_tolerance_deg, up being the world's z seen from the map frame.
+  std::optional<mapping::MeasuredTilt> tilt;
+  if (attitude) {
+    tilt = mapping::MeasuredTilt{T_world_map_.linear().transpose() * Eigen::Vector3d::UnitZ(),
+                                 config_.tilt_tolerance_deg};
+  }
+  Result<mapping::MergeStep> merge =
+      builder_.Add(mapping::CloudFromScan(stop.scan), prior, bound, tilt);
   if (merge) stop.merge = *merge;
   if (stop.merge.merged) {
     merged_distance_m_ = result_.odometry_distance_m;
@@ -556,7 +575,7 @@ bool Mission::Rebase() {
     result_.reason = "base: " + odo.error().message;
     return false;
   }
-  T_world_map_ = T_world_base_ = Estimate(*odo);
+  T_world_map_ = T_world_base_ = Propagate(T_world_base_, odo_ref_, *odo, StillAttitude());
   odo_ref_ = *odo;
   return true;
 }

@@ -33,7 +33,10 @@ namespace {
 
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 constexpr double kMapMargin_m = 1.0;
-constexpr double kAttitudeSigma_rad = 0.2 * kDegToRad;           // a MEMS inclinometer, at rest
+// The attitude sensor, a MEMS inclinometer: 0.2 deg of noise per read, and a calibration residual
+// of 0.1 deg per axis, constant over a run (drawn per seed).
+constexpr double kAttitudeSigma_rad = 0.2 * kDegToRad;
+constexpr double kAttitudeBiasSigma_rad = 0.1 * kDegToRad;
 constexpr std::uint64_t kAttitudeSeedSalt = 0x6174746974756465;  // "attitude": its own stream
 
 CliArgs RunArgs() {
@@ -160,15 +163,17 @@ int RunRun(int argc, char** argv) {
   MissionProbes probes;
   probes.now_s = [&sim] { return sim.time_s(); };
   probes.true_pose = [&sim] { return sim.T_world_base(); };
-  // The attitude sensor: a MEMS inclinometer's roll and pitch, truth plus seeded white noise.
+  // The attitude sensor: the inclinometer's roll and pitch, truth plus its seeded bias and noise.
   std::mt19937_64 attitude_rng(config.seed ^ kAttitudeSeedSalt);
   std::normal_distribution<double> attitude_noise(0.0, kAttitudeSigma_rad);
-  probes.roll_pitch_rad = [&sim, &attitude_rng, &attitude_noise] {
+  std::normal_distribution<double> attitude_bias(0.0, kAttitudeBiasSigma_rad);
+  const Eigen::Vector2d bias(attitude_bias(attitude_rng), attitude_bias(attitude_rng));
+  probes.roll_pitch_rad = [&sim, &attitude_rng, &attitude_noise, bias] {
     const Eigen::Matrix3d R = sim.T_world_base().linear();
     const double roll = std::atan2(R(2, 1), R(2, 2));
     const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
-    return Eigen::Vector2d(roll + attitude_noise(attitude_rng),
-                           pitch + attitude_noise(attitude_rng));
+    return Eigen::Vector2d(roll + bias.x() + attitude_noise(attitude_rng),
+                           pitch + bias.y() + attitude_noise(attitude_rng));
   };
   MissionObserver observer;
   observer.on_stop = [&](const StopRecord& stop, const MissionResult& so_far) {

@@ -91,6 +91,7 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
       {"odometry_error_per_m", &m.odometry_error_per_m},
       {"odometry_error_deg", &m.odometry_error_deg},
       {"odometry_error_dps", &m.odometry_error_dps},
+      {"tilt_tolerance_deg", &m.tilt_tolerance_deg},
       {"lookahead_m", &m.follower.lookahead_m},
       {"max_speed_mps", &m.follower.max_speed_mps},
       {"max_yaw_rate_rps", &m.follower.max_yaw_rate_rps}};
@@ -130,6 +131,10 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
       throw std::invalid_argument(source + ": run." + name + " = " + std::to_string(value) +
                                   " must be finite and >= 0");
     }
+  }
+  if (!(m.tilt_tolerance_deg > 0 && m.tilt_tolerance_deg <= 90)) {
+    throw std::invalid_argument(source + ": run.tilt_tolerance_deg = " +
+                                std::to_string(m.tilt_tolerance_deg) + " is outside (0, 90] deg");
   }
   if (m.max_stops < 1 || !(m.drive_per_stop_m > 0) || !(m.goal_tolerance_m > 0) ||
       !(m.time_budget_s > 0) || !(m.control_period_s > 0)) {
@@ -231,6 +236,7 @@ std::string RunSettingsToYaml(const RunSettings& s) {
      << "  odometry_error_per_m: " << m.odometry_error_per_m << "\n"
      << "  odometry_error_deg: " << m.odometry_error_deg << "\n"
      << "  odometry_error_dps: " << m.odometry_error_dps << "\n"
+     << "  tilt_tolerance_deg: " << m.tilt_tolerance_deg << "\n"
      << "  algorithm: " << planning::ToString(m.algorithm) << "\n"
      << "  lookahead_m: " << m.follower.lookahead_m << "\n"
      << "  max_speed_mps: " << m.follower.max_speed_mps << "\n"

@@ -129,9 +129,27 @@ TEST(RunSettings, TheOdometryErrorBoundIsReadAndANegativeOneNamed) {
   }
 }
 
+TEST(RunSettings, TheTiltToleranceIsReadAndAnImpossibleOneNamed) {
+  EXPECT_EQ(ParseRunSettings("", "f.yaml", sim::P3Model::kP3DX).mission.tilt_tolerance_deg, 0.5);
+  EXPECT_EQ(ParseRunSettings("run: {tilt_tolerance_deg: 1.5}\n", "f.yaml", sim::P3Model::kP3DX)
+                .mission.tilt_tolerance_deg,
+            1.5);
+  for (const char* bad : {"run: {tilt_tolerance_deg: 0}\n", "run: {tilt_tolerance_deg: 120}\n",
+                          "run: {tilt_tolerance_deg: .nan}\n"}) {
+    try {
+      ParseRunSettings(bad, "f.yaml", sim::P3Model::kP3DX);
+      FAIL() << "accepted: " << bad;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("f.yaml: run.tilt_tolerance_deg"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 TEST(RunSettings, WrittenYamlReadsBackTheSame) {
   const RunSettings s = ParseRunSettings(
-      "run: {goal_tolerance_m: 0.3, odometry_error_m: 0.2}\nplanner: {weights: {roughness: 5}}\n"
+      "run: {goal_tolerance_m: 0.3, odometry_error_m: 0.2, tilt_tolerance_deg: 0.8}\n"
+      "planner: {weights: {roughness: 5}}\n"
       "registration: {max_rmse_m: 0.03}\n",
       "t", sim::P3Model::kP3AT);
   const RunSettings back = ParseRunSettings(RunSettingsToYaml(s), "back", sim::P3Model::kP3AT);
