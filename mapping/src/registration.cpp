@@ -631,7 +631,7 @@ void Fill(RegistrationResult& out, const IcpResult& icp, RegistrationPath path) 
 // the point spacing: ICP's gates and the inlier distance (a 0.1 m inlier at 0.05 m spacing would
 // count points a voxel off the surface). The directions `frozen` stay where `at` has them. Only the
 // target near the source is used (within the widest gate and a normal radius of its box at `at`):
-// the source spans about a metre, the target may span the room.
+// a confined source spans about a metre, its target may span the room.
 IcpResult HalfScaleIcp(const PointCloud& target, const PointCloud& source,
                        const Eigen::Isometry3d& at, const Weakness& frozen,
                        const RegistrationConfig& half) {
@@ -672,14 +672,14 @@ RegistrationConfig HalfScale(const RegistrationConfig& config) {
 // A success in a confined scene is refined and scored again at half the scale (HalfScaleIcp); a
 // result the half-scale acceptance test rejects is a failure. The search for the pose (features,
 // verification, probes) ran at full scale and is not repeated.
-void RefineConfined(const PointCloud& target, const PointCloud& source, std::size_t source_voxels,
+void RefineConfined(const PointCloud& target, const PointCloud& source, std::size_t voxels,
                     const Weakness& frozen, const RegistrationPrior& prior,
                     const RegistrationConfig& config, RegistrationResult& out) {
   const RegistrationConfig half = HalfScale(config);
   const IcpResult icp = HalfScaleIcp(target, source, out.T_target_source, frozen, half);
   Fill(out, icp, out.path);
   std::ostringstream os;
-  os << "; confined scene (" << source_voxels << " source voxels < confined_scene_voxels "
+  os << "; confined scene (" << voxels << " voxels in the smaller cloud < confined_scene_voxels "
      << config.confined_scene_voxels << "): final ICP at half scale";
   if (const std::string rejection = Rejection(icp, prior, half); !rejection.empty()) {
     out.success = false;
@@ -782,9 +782,11 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
   out.timings.normals_s = lap.Lap();
   const IcpTarget icp_target{prep.target_icp, prep.target_normals, coarse, fine, fine_cell};
   const PointCloud icp_source = EvenSubsample(prep.source_icp, config.icp_max_points);
-  const bool confined =
-      config.backend == RegistrationBackend::kFast &&
-      prep.source_icp.size() < static_cast<std::size_t>(config.confined_scene_voxels);
+  // The target's normals straddle a corner's edges as much as the source's points do: either
+  // cloud confined makes the pair confined.
+  const std::size_t fewest_voxels = std::min(prep.target_icp.size(), prep.source_icp.size());
+  const bool confined = config.backend == RegistrationBackend::kFast &&
+                        fewest_voxels < static_cast<std::size_t>(config.confined_scene_voxels);
 
   // Geometric constraint: around the odometry prior, else around the constant-velocity motion.
   std::optional<PriorRegion> region;
@@ -838,7 +840,7 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
         out.success = true;
         out.reason = note.empty() ? std::string(ToString(path)) : note;
         if (confined) {
-          RefineConfined(target, source, prep.source_icp.size(), {}, prior, config, out);
+          RefineConfined(target, source, fewest_voxels, {}, prior, config, out);
           out.timings.icp_s += lap.Lap();
         }
         out.timings.total_s = total.Lap();
@@ -913,7 +915,7 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
   }
   for (std::size_t i = 0; i < notes.size(); ++i) out.reason += (i ? "; " : "") + notes[i];
   if (out.success && confined) {
-    RefineConfined(target, source, prep.source_icp.size(), frozen, prior, config, out);
+    RefineConfined(target, source, fewest_voxels, frozen, prior, config, out);
     out.timings.icp_s += lap.Lap();
   }
   out.timings.total_s = total.Lap();
