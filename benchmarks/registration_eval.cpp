@@ -1,14 +1,14 @@
 // registration_eval: Algorithm 1 scored against the simulator's ground truth (issue 3).
-// Simulates scan pairs in the worlds (target at a random free pose, source 0.3-1.2 m / up to 20 deg
-// further on, as stop-scan-go steps), registers them with an odometry guess offset from the truth
-// by each sweep level (Algorithm 1's initial guess; the prior bounds its error by the level), and
-// prints JSON: per pair and level the rotation / translation error, fitness, path and stage times;
-// per world x level x noise the success rate; the same pairs without any prior (global
-// registration); the PCL default pipeline on a subset of the same pairs; Table 1 (NARF vs FPFH);
-// and scan-to-map sequences with their drift. Time per pair is wall clock per stage and this
-// thread's CPU time (one core, whatever else runs), as median / p95 / max over the target pairs,
-// all pairs and the full-size (72k-point) pairs. False successes (success reported, > 5 cm or
-// > 1 deg off the truth) are counted over every pair and level. Progress and a summary go to
+// Simulates scan pairs in the worlds (target at a random pose a stop-scan-go robot stops at, source
+// 0.3-1.2 m / up to 20 deg further on, as the next stop), registers them with an odometry guess
+// offset from the truth by each sweep level (Algorithm 1's initial guess; the prior bounds its
+// error by the level), and prints JSON: per pair and level the rotation / translation error,
+// fitness, path and stage times; per world x level x noise the success rate; the same pairs without
+// any prior (global registration); the PCL default pipeline on a subset of the same pairs; Table 1
+// (NARF vs FPFH); and scan-to-map sequences with their drift. Time per pair is wall clock per stage
+// and this thread's CPU time (one core, whatever else runs), as median / p95 / max over the target
+// pairs, all pairs and the full-size (72k-point) pairs. False successes (success reported, > 5 cm
+// or > 1 deg off the truth) are counted over every pair and level. Progress and a summary go to
 // stderr.
 
 #include <algorithm>
@@ -36,6 +36,7 @@
 
 #include "pitchlab/mapping/map_builder.hpp"
 #include "pitchlab/mapping/registration.hpp"
+#include "pitchlab/sim/robot_model.hpp"
 #include "pitchlab/sim/sim_rig.hpp"
 
 namespace {
@@ -56,6 +57,13 @@ constexpr double kMaxTruthDrift_m = 0.005;
 // Poses higher or lower than this above the default start are not stops of a ground robot [m]:
 // above every curb, step and slope the P3 drives in the sampled regions, below any roof.
 constexpr double kMaxClimb_m = 2.0;
+// The planner keeps the robot's footprint plus this clearance free of obstacles
+// (MissionConfig::safety_margin_m, apps/mission.hpp) [m].
+constexpr double kPlannerSafetyMargin_m = 0.08;
+// A point this far above base_link's ground plane is an obstacle: above the range noise of the
+// floor and the support step the placement accepts under the footprint
+// (sim::PlacementConfig::max_step_m) [m].
+constexpr double kObstacleMin_m = 0.05;
 
 struct Options {
   std::vector<std::string> worlds = {"office", "cluttered", "urban", "terrain", "corridor"};
@@ -143,6 +151,25 @@ struct SimScan {
   Eigen::Isometry3d T_world_base;
 };
 
+// Where the planner lets no obstacle be (base_link, [m]): the footprint box of the rig's P3 grown
+// by the planner's safety margin, from kObstacleMin_m up to the top of the robot (the laser's
+// mirror).
+struct KeepOut {
+  Eigen::Vector3f min, max;
+  bool Contains(const Eigen::Vector3f& p) const {
+    return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();
+  }
+};
+
+KeepOut FootprintKeepOut(const sim::SimRigConfig& config) {
+  const sim::P3Params& p = sim::ParamsFor(config.robot.model);
+  const double half_length = 0.5 * p.length_m + kPlannerSafetyMargin_m;
+  const double half_width = 0.5 * p.width_m + kPlannerSafetyMargin_m;
+  const double top = config.robot.mount.BaseToLaser(0.0).translation().z();
+  return {Eigen::Vector3d(p.footprint_x_m - half_length, -half_width, kObstacleMin_m).cast<float>(),
+          Eigen::Vector3d(p.footprint_x_m + half_length, half_width, top).cast<float>()};
+}
+
 // One rig per world and noise level; scans at requested poses with their truth checked.
 class ScanFactory {
  public:
@@ -152,11 +179,12 @@ class ScanFactory {
     config.lms200.seed = seed;
     rig_ = std::make_unique<sim::SimRig>(std::string(PITCHLAB_WORLDS_DIR) + "/" + world + ".xml",
                                          config);
+    keep_out_ = FootprintKeepOut(rig_->config());
     if (Result<Eigen::Isometry3d> start = rig_->PlaceAtDefaultStart())
       start_z_ = start->translation().z();
   }
-  // A scan from (x, y, yaw), or nothing when the robot cannot stand there or moved during the
-  // sweep (then the single ground-truth pose would not describe the scan).
+  // A scan from (x, y, yaw), or nothing when the robot cannot stand there, would not stop there, or
+  // moved during the sweep (then the single ground-truth pose would not describe the scan).
   std::optional<SimScan> At(double x, double y, double yaw_rad) {
     Result<Eigen::Isometry3d> placed = rig_->PlaceRobot(x, y, yaw_rad);
     if (!placed) return std::nullopt;
@@ -174,7 +202,16 @@ class ScanFactory {
       ++drifted_;
       return std::nullopt;
     }
-    return SimScan{mapping::CloudFromScan(*scan), scan->T_world_base};
+    SimScan out{mapping::CloudFromScan(*scan), scan->T_world_base};
+    // The planner keeps the footprint plus its safety margin clear of obstacles, so a stop-scan-go
+    // robot never stops where its scan shows one there; and such a pose can leave directions
+    // unobservable (office, the nose 3 cm from a wall: no floor in view, z and roll free).
+    if (std::any_of(out.cloud.begin(), out.cloud.end(),
+                    [&](const Eigen::Vector3f& p) { return keep_out_.Contains(p); })) {
+      ++obstructed_;
+      return std::nullopt;
+    }
+    return out;
   }
   // Where targets are drawn: the world's bounds, or `radius_m` around its default start when the
   // robot only holds still there (on terrain slopes the P3 slides during the 9 s sweep).
@@ -188,11 +225,13 @@ class ScanFactory {
   }
   int drifted() const { return drifted_; }
   int unreachable() const { return unreachable_; }
+  int obstructed() const { return obstructed_; }
 
  private:
   std::unique_ptr<sim::SimRig> rig_;
+  KeepOut keep_out_;
   std::optional<double> start_z_;  // ground height at the world's default start [m]
-  int drifted_ = 0, unreachable_ = 0;
+  int drifted_ = 0, unreachable_ = 0, obstructed_ = 0;
 };
 
 struct Pair {
@@ -202,6 +241,7 @@ struct Pair {
   Eigen::Isometry3d truth;  // T_target_source
   double overlap = 0;
   int id = 0;
+  std::size_t icp_voxels[2] = {0, 0};  // target, source after our icp_voxel_m grid
 };
 
 // Fraction of the source's 0.2 m voxels that the target occupies once aligned by the truth.
@@ -257,6 +297,7 @@ std::vector<Pair> MakePairs(const Options& o, const std::string& world, double n
   }
   stats["drifted_scans_resampled"] = factory.drifted();
   stats["unreachable_poses_resampled"] = factory.unreachable();
+  stats["obstructed_poses_resampled"] = factory.obstructed();
   return pairs;
 }
 
@@ -267,7 +308,8 @@ std::string CachePath(const Options& o, const std::string& world, double noise_m
                       const std::mt19937_64& rng) {
   std::ostringstream key;
   key << rng << " " << world << " " << noise_m << " " << o.targets << " "
-      << (o.near_start.count(world) ? o.near_start_radius_m : 0.0) << " climb " << kMaxClimb_m;
+      << (o.near_start.count(world) ? o.near_start_radius_m : 0.0) << " climb " << kMaxClimb_m
+      << " keep-out " << kPlannerSafetyMargin_m << " " << kObstacleMin_m;
   std::ostringstream name;
   name << o.pair_cache << "/" << world << "_" << noise_m << "_" << std::hex
        << std::hash<std::string>{}(key.str()) << ".bin";
@@ -414,7 +456,8 @@ json PairInfo(const Pair& p, double level_m, double level_deg, const Eigen::Isom
       {"guess_offset_m", offset.translation_m},
       {"guess_offset_deg", offset.rotation_deg},
       {"overlap", p.overlap},
-      {"points", {p.target.cloud.size(), p.source.cloud.size()}}};
+      {"points", {p.target.cloud.size(), p.source.cloud.size()}},
+      {"icp_voxels", {p.icp_voxels[0], p.icp_voxels[1]}}};
 }
 
 double Percentile(std::vector<double> v, double q) {
@@ -592,6 +635,8 @@ int main(int argc, char** argv) {
     for (std::size_t i = 0; i < all.size(); ++i) {
       Pair& p = all[i];
       p.id = static_cast<int>(i);
+      p.icp_voxels[0] = mapping::VoxelDownsample(p.target.cloud, ours.icp_voxel_m).size();
+      p.icp_voxels[1] = mapping::VoxelDownsample(p.source.cloud, ours.icp_voxel_m).size();
       const bool reference_pair = p.noise_m == 0.005;
       const bool baseline = reference_pair && baseline_done[p.world] < o.baseline_pairs;
       const bool table1 = reference_pair && table1_done[p.world] < o.table1_pairs;

@@ -303,6 +303,7 @@ struct FromGuess {
   bool undetermined = false;  // degenerate, and the guess may not supply the weak directions
   Weakness held;              // the tilt axes, when ICP was re-run with the measured tilt held
   double tilt_off_deg = 0;    // ... because free ICP tilted the source this far from it
+  Weakness frozen;            // the directions the final ICP kept at the guess
 };
 
 // In degenerate geometry the guess supplies the weak directions (ICP re-run with them kept at the
@@ -339,6 +340,7 @@ FromGuess IcpFromGuess(const IcpTarget& target, const PointCloud& source, const 
   if (path == RegistrationPath::kOdometry && prior.tilt) {
     if (const double off = TiltOff(out.icp, prior); off > prior.tilt->tolerance_deg) {
       out.held = TiltAxes(prior.tilt->up_target);
+      out.frozen = out.held;
       out.tilt_off_deg = off;
       const int first = out.icp.iterations;
       out.icp = PointToPlaneLm(target, source, guess, config, out.held);
@@ -357,7 +359,8 @@ FromGuess IcpFromGuess(const IcpTarget& target, const PointCloud& source, const 
   const std::string untrusted = UntrustedGuess(weak, path, prior, config);
   if (untrusted.empty()) {
     const int first = out.icp.iterations;
-    out.icp = PointToPlaneLm(target, source, guess, config, Union(out.held, weak));
+    out.frozen = Union(out.held, weak);
+    out.icp = PointToPlaneLm(target, source, guess, config, out.frozen);
     out.icp.iterations += first;
     out.rejection = Rejection(out.icp, prior, config);
     out.carried = true;
@@ -623,6 +626,68 @@ void Fill(RegistrationResult& out, const IcpResult& icp, RegistrationPath path) 
   out.iterations += icp.iterations;
 }
 
+// A confined scene (config.confined_scene_voxels): the final ICP from `at` and its scores at half
+// the scale. The voxel grid and the normal radius are halved, and with them the distances tied to
+// the point spacing: ICP's gates and the inlier distance (a 0.1 m inlier at 0.05 m spacing would
+// count points a voxel off the surface). The directions `frozen` stay where `at` has them. Only the
+// target near the source is used (within the widest gate and a normal radius of its box at `at`):
+// a confined source spans about a metre, its target may span the room.
+IcpResult HalfScaleIcp(const PointCloud& target, const PointCloud& source,
+                       const Eigen::Isometry3d& at, const Weakness& frozen,
+                       const RegistrationConfig& half) {
+  const PointCloud source_icp =
+      EvenSubsample(VoxelDownsample(source, half.icp_voxel_m), half.icp_max_points);
+  Eigen::AlignedBox3f box;
+  const Eigen::Isometry3f Tf = at.cast<float>();
+  for (const Eigen::Vector3f& p : source_icp) box.extend(Tf * p);
+  const float margin = static_cast<float>(half.icp_max_distance_m + half.icp_normal_radius_m);
+  box.min().array() -= margin;
+  box.max().array() += margin;
+  PointCloud near;
+  for (const Eigen::Vector3f& p : target) {
+    if (box.contains(p)) near.push_back(p);
+  }
+  const PointCloud target_icp = VoxelDownsample(near, half.icp_voxel_m);
+  const float fine_cell = static_cast<float>(
+      std::max({half.icp_min_distance_m, half.inlier_distance_m, half.icp_normal_radius_m}));
+  const VoxelHashIndex fine(target_icp, fine_cell);
+  const VoxelHashIndex coarse(target_icp, std::max<double>(fine_cell, half.icp_max_distance_m));
+  const Normals normals =
+      EstimateNormals(target_icp, fine, static_cast<float>(half.icp_normal_radius_m), kViewpoint);
+  const IcpTarget icp_target{target_icp, normals, coarse, fine, fine_cell};
+  return PointToPlaneLm(icp_target, source_icp, at, half, frozen);
+}
+
+// The config of HalfScaleIcp: the ICP scale and its distances halved.
+RegistrationConfig HalfScale(const RegistrationConfig& config) {
+  RegistrationConfig half = config;
+  half.icp_voxel_m *= 0.5;
+  half.icp_normal_radius_m *= 0.5;
+  half.icp_max_distance_m *= 0.5;
+  half.icp_min_distance_m *= 0.5;
+  half.inlier_distance_m *= 0.5;
+  return half;
+}
+
+// A success in a confined scene is refined and scored again at half the scale (HalfScaleIcp); a
+// result the half-scale acceptance test rejects is a failure. The search for the pose (features,
+// verification, probes) ran at full scale and is not repeated.
+void RefineConfined(const PointCloud& target, const PointCloud& source, std::size_t voxels,
+                    const Weakness& frozen, const RegistrationPrior& prior,
+                    const RegistrationConfig& config, RegistrationResult& out) {
+  const RegistrationConfig half = HalfScale(config);
+  const IcpResult icp = HalfScaleIcp(target, source, out.T_target_source, frozen, half);
+  Fill(out, icp, out.path);
+  std::ostringstream os;
+  os << "; confined scene (" << voxels << " voxels in the smaller cloud < confined_scene_voxels "
+     << config.confined_scene_voxels << "): final ICP at half scale";
+  if (const std::string rejection = Rejection(icp, prior, half); !rejection.empty()) {
+    out.success = false;
+    os << ", rejected there: " << rejection;
+  }
+  out.reason += os.str();
+}
+
 }  // namespace
 
 const char* ToString(RegistrationPath path) {
@@ -717,6 +782,11 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
   out.timings.normals_s = lap.Lap();
   const IcpTarget icp_target{prep.target_icp, prep.target_normals, coarse, fine, fine_cell};
   const PointCloud icp_source = EvenSubsample(prep.source_icp, config.icp_max_points);
+  // The target's normals straddle a corner's edges as much as the source's points do: either
+  // cloud confined makes the pair confined.
+  const std::size_t fewest_voxels = std::min(prep.target_icp.size(), prep.source_icp.size());
+  const bool confined = config.backend == RegistrationBackend::kFast &&
+                        fewest_voxels < static_cast<std::size_t>(config.confined_scene_voxels);
 
   // Geometric constraint: around the odometry prior, else around the constant-velocity motion.
   std::optional<PriorRegion> region;
@@ -769,6 +839,10 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
       if (!ambiguous.any() && rejection.empty()) {
         out.success = true;
         out.reason = note.empty() ? std::string(ToString(path)) : note;
+        if (confined) {
+          RefineConfined(target, source, fewest_voxels, {}, prior, config, out);
+          out.timings.icp_s += lap.Lap();
+        }
         out.timings.total_s = total.Lap();
         return out;
       }
@@ -795,6 +869,7 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
   if (prior.previous_motion && config.constant_velocity_fallback) {
     guesses.emplace_back(RegistrationPath::kFallback, *prior.previous_motion);
   }
+  Weakness frozen;  // what the accepted ICP from a guess kept at the guess
   for (const auto& [path, guess] : guesses) {
     FromGuess g = IcpFromGuess(icp_target, icp_source, prep, guess, path, ambiguous, prior, config);
     bool searched = false;
@@ -809,6 +884,7 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
       if (found && !GuessDegenerateDirections(icp_target, icp_source, *found, config).any()) {
         notes.push_back(std::string("ICP from the ") + ToString(path) + " guess: " + g.rejection);
         g.icp = *found, g.rejection.clear(), searched = true, g.carried = false;
+        g.frozen = g.held;                   // the search kept only the tilt
         out.iterations -= g.icp.iterations;  // Fill adds the winner's own
       } else if (found) {
         g.rejection +=
@@ -820,6 +896,7 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
     Fill(out, g.icp, path);
     if (g.rejection.empty()) {
       out.success = true;
+      frozen = g.frozen;
       const char* carried =
           path == RegistrationPath::kFallback
               ? " (degenerate: constant velocity assumed along the weak directions)"
@@ -837,6 +914,10 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
     notes.push_back("no odometry prior or previous motion to fall back on");
   }
   for (std::size_t i = 0; i < notes.size(); ++i) out.reason += (i ? "; " : "") + notes[i];
+  if (out.success && confined) {
+    RefineConfined(target, source, fewest_voxels, frozen, prior, config, out);
+    out.timings.icp_s += lap.Lap();
+  }
   out.timings.total_s = total.Lap();
   return out;
 }

@@ -67,6 +67,7 @@ void VisitFields(RegistrationConfig& c, Visitor&& v) {
   v("icp_max_distance_m", c.icp_max_distance_m);
   v("icp_min_distance_m", c.icp_min_distance_m);
   v("icp_max_points", c.icp_max_points);
+  v("confined_scene_voxels", c.confined_scene_voxels);
   v("constraint_translation_m", c.constraint_translation_m);
   v("constraint_rotation_deg", c.constraint_rotation_deg);
   v("constant_velocity_fallback", c.constant_velocity_fallback);
@@ -147,6 +148,8 @@ void RegistrationConfig::Validate() const {
   require(icp_min_distance_m > 0 && icp_min_distance_m <= icp_max_distance_m, "icp_min_distance_m",
           icp_min_distance_m, "must be in (0, icp_max_distance_m]");
   require(icp_max_points >= 50, "icp_max_points", icp_max_points, "must be >= 50");
+  require(confined_scene_voxels >= 0, "confined_scene_voxels", confined_scene_voxels,
+          "must be >= 0");
   require(constraint_translation_m > 0, "constraint_translation_m", constraint_translation_m,
           "must be > 0");
   require(constraint_rotation_deg > 0 && constraint_rotation_deg <= 180, "constraint_rotation_deg",

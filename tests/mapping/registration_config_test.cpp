@@ -57,6 +57,9 @@ TEST(RegistrationConfig, AWrongTypeOrValueIsAnErrorNamingFieldAndValue) {
             std::string::npos);
   EXPECT_NE(ErrorOf("registration: {guess_degeneracy_ratio: 1}").find("must be in [0, 1)"),
             std::string::npos);
+  EXPECT_NE(ErrorOf("registration: {confined_scene_voxels: -1}")
+                .find("registration.confined_scene_voxels = -1"),
+            std::string::npos);
 }
 
 TEST(RegistrationConfig, YamlRoundTripGivesTheSameConfig) {
