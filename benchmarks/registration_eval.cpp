@@ -156,7 +156,7 @@ struct SimScan {
 // margin each side, traversability's FootprintReach takes half of it), from kObstacleMin_m up to
 // the top of the robot (the laser's mirror). Not the footprint box grown by the margin: its
 // corners reach past the disc, and the planner stops the robot there (office, a wall 0.43 m
-// from base_link off the box's corner).
+// from base_link that only the box's corner reached).
 struct KeepOut {
   float radius = 0, min_z = 0, max_z = 0;
   bool Contains(const Eigen::Vector3f& p) const {
