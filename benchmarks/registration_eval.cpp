@@ -57,7 +57,7 @@ constexpr double kMaxTruthDrift_m = 0.005;
 // Poses higher or lower than this above the default start are not stops of a ground robot [m]:
 // above every curb, step and slope the P3 drives in the sampled regions, below any roof.
 constexpr double kMaxClimb_m = 2.0;
-// The planner keeps the robot's footprint plus this clearance free of obstacles
+// The planner keeps half the robot's width plus this clearance free of obstacles
 // (MissionConfig::safety_margin_m, apps/mission.hpp) [m].
 constexpr double kPlannerSafetyMargin_m = 0.08;
 // A point this far above base_link's ground plane is an obstacle: above the range noise of the
@@ -151,23 +151,24 @@ struct SimScan {
   Eigen::Isometry3d T_world_base;
 };
 
-// Where the planner lets no obstacle be (base_link, [m]): the footprint box of the rig's P3 grown
-// by the planner's safety margin, from kObstacleMin_m up to the top of the robot (the laser's
-// mirror).
+// Where the planner lets no obstacle be (base_link, [m]): the disc it keeps clear around the pose,
+// of radius half the robot's width plus its safety margin (MissionPlanner grows the width by the
+// margin each side, traversability's FootprintReach takes half of it), from kObstacleMin_m up to
+// the top of the robot (the laser's mirror). Not the footprint box grown by the margin: its
+// corners reach past the disc, and the planner stops the robot there (office, a wall 0.43 m
+// from base_link that only the box's corner reached).
 struct KeepOut {
-  Eigen::Vector3f min, max;
+  float radius = 0, min_z = 0, max_z = 0;
   bool Contains(const Eigen::Vector3f& p) const {
-    return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();
+    return p.z() >= min_z && p.z() <= max_z && p.head<2>().squaredNorm() < radius * radius;
   }
 };
 
 KeepOut FootprintKeepOut(const sim::SimRigConfig& config) {
   const sim::P3Params& p = sim::ParamsFor(config.robot.model);
-  const double half_length = 0.5 * p.length_m + kPlannerSafetyMargin_m;
-  const double half_width = 0.5 * p.width_m + kPlannerSafetyMargin_m;
+  const double radius = 0.5 * p.width_m + kPlannerSafetyMargin_m;
   const double top = config.robot.mount.BaseToLaser(0.0).translation().z();
-  return {Eigen::Vector3d(p.footprint_x_m - half_length, -half_width, kObstacleMin_m).cast<float>(),
-          Eigen::Vector3d(p.footprint_x_m + half_length, half_width, top).cast<float>()};
+  return {static_cast<float>(radius), static_cast<float>(kObstacleMin_m), static_cast<float>(top)};
 }
 
 // One rig per world and noise level; scans at requested poses with their truth checked.
@@ -203,9 +204,10 @@ class ScanFactory {
       return std::nullopt;
     }
     SimScan out{mapping::CloudFromScan(*scan), scan->T_world_base};
-    // The planner keeps the footprint plus its safety margin clear of obstacles, so a stop-scan-go
-    // robot never stops where its scan shows one there; and such a pose can leave directions
-    // unobservable (office, the nose 3 cm from a wall: no floor in view, z and roll free).
+    // The planner keeps a disc of half the width plus its safety margin clear of obstacles, so a
+    // stop-scan-go robot never stops where its scan shows one there; and such a pose can leave
+    // directions unobservable (office, the nose 3 cm from a wall: no floor in view, z and roll
+    // free).
     if (std::any_of(out.cloud.begin(), out.cloud.end(),
                     [&](const Eigen::Vector3f& p) { return keep_out_.Contains(p); })) {
       ++obstructed_;
@@ -309,7 +311,7 @@ std::string CachePath(const Options& o, const std::string& world, double noise_m
   std::ostringstream key;
   key << rng << " " << world << " " << noise_m << " " << o.targets << " "
       << (o.near_start.count(world) ? o.near_start_radius_m : 0.0) << " climb " << kMaxClimb_m
-      << " keep-out " << kPlannerSafetyMargin_m << " " << kObstacleMin_m;
+      << " keep-out disc " << kPlannerSafetyMargin_m << " " << kObstacleMin_m;
   std::ostringstream name;
   name << o.pair_cache << "/" << world << "_" << noise_m << "_" << std::hex
        << std::hash<std::string>{}(key.str()) << ".bin";
