@@ -43,7 +43,11 @@ std::uint16_t Crc16Ccitt(const std::uint8_t* data, std::size_t size) {
 
 std::vector<std::uint8_t> Encode(const Frame& frame) {
   const std::size_t n = std::min(frame.payload.size(), kMaxLen - 1);
-  std::vector<std::uint8_t> out = {kSync, std::uint8_t(1 + n), frame.command};
+  std::vector<std::uint8_t> out;
+  out.reserve(3 + n + 2);  // sized up front: growing a 3-byte vector trips GCC 12's -Warray-bounds
+  out.push_back(kSync);
+  out.push_back(std::uint8_t(1 + n));
+  out.push_back(frame.command);
   out.insert(out.end(), frame.payload.begin(), frame.payload.begin() + long(n));
   Put(out, Crc16Ccitt(out.data() + 1, out.size() - 1), 2);
   return out;
