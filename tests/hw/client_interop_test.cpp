@@ -71,8 +71,13 @@ class Wire {
 // A request as both LMS clients build it: STX, address 0, LEN = command + data (LE), the bytes,
 // SICK's CRC (LE) over everything before it.
 Bytes LmsRequest(const Bytes& command_and_data) {
-  Bytes t = {0x02, 0x00, std::uint8_t(command_and_data.size() & 0xFF),
-             std::uint8_t(command_and_data.size() >> 8)};
+  Bytes t;
+  t.reserve(4 + command_and_data.size() + 2);  // sized up front: see pitch::Encode
+  for (const std::uint8_t b :
+       {std::uint8_t(0x02), std::uint8_t(0x00), std::uint8_t(command_and_data.size() & 0xFF),
+        std::uint8_t(command_and_data.size() >> 8)}) {
+    t.push_back(b);
+  }
   t.insert(t.end(), command_and_data.begin(), command_and_data.end());
   const std::uint16_t crc = lms200::Crc16(t.data(), t.size());
   t.push_back(std::uint8_t(crc & 0xFF));
