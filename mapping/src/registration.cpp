@@ -127,15 +127,16 @@ Weakness TiltAxes(const Eigen::Vector3d& up_target) {
 // horizontal is dropped (its tilting part is held), a steeper one becomes the turn about up.
 Weakness WithoutTilt(Weakness weak, const Eigen::Vector3d& up_target) {
   const Eigen::Vector3d u = up_target.normalized();
-  Weakness out = weak;
-  out.rotation_axes.clear(), out.rotation_ratios.clear();
-  for (std::size_t k = 0; k < weak.rotation_axes.size(); ++k) {
+  std::vector<Eigen::Vector3d> axes;
+  std::vector<double> ratios;
+  for (std::size_t k = 0; k < weak.rotation_axes.size() && axes.empty(); ++k) {
     if (std::abs(weak.rotation_axes[k].dot(u)) < 0.5) continue;
-    out.rotation_axes.push_back(u);
-    out.rotation_ratios.push_back(weak.rotation_ratios[k]);
-    break;  // only one axis is left free
+    axes.push_back(u);  // only the turn about up is left free
+    ratios.push_back(weak.rotation_ratios[k]);
   }
-  return out;
+  weak.rotation_axes = std::move(axes);
+  weak.rotation_ratios = std::move(ratios);
+  return weak;
 }
 
 // The clouds after the voxel grid, with what ICP needs of the target.
