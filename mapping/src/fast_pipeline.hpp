@@ -70,6 +70,8 @@ struct IcpTarget {
   const VoxelHashIndex& coarse;
   const VoxelHashIndex& fine;
   float fine_cell_m;
+  /// The scan taken at the target frame's origin (registration's free-space evidence); null: none.
+  const PointCloud* view = nullptr;
 };
 
 struct IcpResult {

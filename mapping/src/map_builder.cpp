@@ -64,6 +64,7 @@ Result<MergeStep> MapBuilder::Add(const PointCloud& cloud_base,
                                                      " points that are not finite (NaN/inf)");
     }
     Insert(VoxelDownsample(cloud_base, config_.map_voxel_m));
+    last_scan_ = cloud_base;
     trajectory_.push_back({step.scan_index, Eigen::Isometry3d::Identity()});
     step.merged = true;
     step.registration.success = true;
@@ -79,6 +80,7 @@ Result<MergeStep> MapBuilder::Add(const PointCloud& cloud_base,
     prior.tilt->up_target = T_map_last.linear().transpose() * measured_tilt->up_target;
   }
   prior.previous_motion = last_motion_ ? *last_motion_ : Eigen::Isometry3d::Identity();
+  prior.target_scan = &last_scan_;  // the map was seen from many places; free space from one
   Result<RegistrationResult> r =
       Register(LocalTarget(T_map_last), cloud_base, prior, config_.registration);
   if (!r) return tl::make_unexpected(r.error());
@@ -87,6 +89,7 @@ Result<MergeStep> MapBuilder::Add(const PointCloud& cloud_base,
   step.T_map_base = T_map_last * r->T_target_source;
   Insert(TransformCloud(VoxelDownsample(cloud_base, config_.map_voxel_m), step.T_map_base));
   trajectory_.push_back({step.scan_index, step.T_map_base});
+  last_scan_ = cloud_base;
   last_motion_ = r->T_target_source;
   step.merged = true;
   return step;

@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
 
 #include "fast_pipeline.hpp"
 #include "pcl_pipeline.hpp"
+#include "seen_space.hpp"
 
 namespace pitchlab::mapping {
 namespace {
@@ -145,17 +147,69 @@ struct Prepared {
   Normals target_normals;
 };
 
-// Whether a probe that ends `away` from `at` (beyond a quarter of the probe) shows the direction
-// degenerate: below degeneracy_ratio always (in a corridor the best-fitting pose along the axis
-// may be a wrong one, so fits cannot decide there); above it only when the probe's end fits about
+// A probe's end is refuted by free space when at least kRefuted of the source's points lie where
+// the target's scan saw through (SeenSpace), and kRefutedOverAt times as many as at `at` (which
+// then is not contradicted). Measured on registration_eval's 750 runs and the tests' corridor: no
+// violation at the truth in any scene; a street's probes 1 m along either way 1.9 % and 0.8 %;
+// the bare corridor's probes, where one way shows violations (up to 2 %: its far ends), show
+// none the other way.
+constexpr double kRefuted = 0.005;
+constexpr int kRefutedOverAt = 10;
+
+// The free-space evidence against probed poses, the target's range image built at the first ask
+// (only a probe below degeneracy_ratio that does not come back needs it).
+class FreeSpaceCheck {
+ public:
+  FreeSpaceCheck(const IcpTarget& target, const PointCloud& source, const IcpResult& at)
+      : target_(target), source_(source), at_(at) {}
+  bool Refutes(const IcpResult& probe) {
+    if (!target_.view) return false;
+    if (!seen_) {
+      seen_.emplace(*target_.view, kViewpoint, kSeenBin_deg);
+      at_violations_ = seen_->Violations(source_, at_.T_target_source);
+    }
+    const int v = seen_->Violations(source_, probe.T_target_source);
+    return v >= kRefuted * static_cast<double>(source_.size()) &&
+           v >= kRefutedOverAt * at_violations_;
+  }
+
+ private:
+  static constexpr double kSeenBin_deg = 1.0;  // about the LMS200's beam spacing at 1 deg mode
+  const IcpTarget& target_;
+  const PointCloud& source_;
+  const IcpResult& at_;
+  std::optional<SeenSpace> seen_;
+  int at_violations_ = 0;
+};
+
+// ICP restarted off `at` along a weak direction, one way (sign +1) or the other (-1), and whether
+// it ended away (beyond a quarter of the restart's offset), i.e. did not come back.
+struct Probe {
+  IcpResult end;
+  bool away = false;
+};
+
+// Whether a direction of eigenvalue ratio `direction_ratio` is degenerate, by its probes. When
+// the probe comes back, it is not. Above degeneracy_ratio it is when the probe's end fits about
 // as well (inliers at most kSameFit fewer): a pose elsewhere that fits clearly worse is another,
-// poorer minimum, not a free direction.
+// poorer minimum, not a free direction. Below it fits cannot decide (in a corridor the
+// best-fitting pose along the axis may be a wrong one: zero motion fits 96 % of the source where
+// the truth fits 80 %), only free space can: it is degenerate unless the probe's end is refuted
+// and the probe the other way comes back or is refuted too. Both ways, as free space is one-sided:
+// a corridor moved towards its seen end shows violations, moved away none; a slope turned up into
+// the view does, turned down out of it does not (ICP comes back from there).
 constexpr double kSameFit = 0.01;
-bool Undetermined(bool away, double direction_ratio, const IcpResult& at, const IcpResult& probe,
+bool Undetermined(double direction_ratio, const IcpResult& at,
+                  const std::function<Probe(double sign)>& probe, FreeSpaceCheck& free_space,
                   const RegistrationConfig& config) {
-  if (!away) return false;
-  return direction_ratio < config.degeneracy_ratio ||
-         probe.inlier_ratio >= at.inlier_ratio - kSameFit;
+  const Probe one = probe(+1.0);
+  if (!one.away) return false;
+  if (direction_ratio >= config.degeneracy_ratio) {
+    return one.end.inlier_ratio >= at.inlier_ratio - kSameFit;
+  }
+  if (!free_space.Refutes(one.end)) return true;
+  const Probe other = probe(-1.0);
+  return other.away && !free_space.Refutes(other.end);
 }
 
 // The directions along which the solution is not unique: of those the scene constrains weakly at
@@ -169,41 +223,41 @@ Weakness DegenerateDirections(const IcpTarget& target, const PointCloud& source,
   if (at.degeneracy >= ratio) return out;
   const Weakness weak =
       WeakDirections(target, source, at.T_target_source, config, ratio, max_per_kind);
+  FreeSpaceCheck free_space(target, source, at);
   for (std::size_t k = 0; k < weak.translations.size(); ++k) {
     const Eigen::Vector3d& d = weak.translations[k];
-    if (weak.translation_ratios[k] < config.free_ratio) {  // no probe can vouch for it
+    const double r = weak.translation_ratios[k];
+    const auto probe = [&](double sign) {
+      const Eigen::Isometry3d start =
+          Eigen::Translation3d(sign * config.degeneracy_probe_m * d) * at.T_target_source;
+      Probe p{PointToPlaneLm(target, source, start, config, {})};
+      p.away = ComparePoses(p.end.T_target_source, at.T_target_source).translation_m >=
+               0.25 * config.degeneracy_probe_m;
+      return p;
+    };
+    // Below free_ratio no probe can vouch for it.
+    if (r < config.free_ratio || Undetermined(r, at, probe, free_space, config)) {
       out.translations.push_back(d);
-      out.translation_ratios.push_back(weak.translation_ratios[k]);
-      continue;
-    }
-    const Eigen::Isometry3d start =
-        Eigen::Translation3d(config.degeneracy_probe_m * d) * at.T_target_source;
-    const IcpResult probe = PointToPlaneLm(target, source, start, config, {});
-    const double back_m = ComparePoses(probe.T_target_source, at.T_target_source).translation_m;
-    if (Undetermined(back_m >= 0.25 * config.degeneracy_probe_m, weak.translation_ratios[k], at,
-                     probe, config)) {
-      out.translations.push_back(d);
-      out.translation_ratios.push_back(weak.translation_ratios[k]);
+      out.translation_ratios.push_back(r);
     }
   }
   const Eigen::Vector3d c = at.T_target_source.translation();
   for (std::size_t k = 0; k < weak.rotation_axes.size(); ++k) {
     const Eigen::Vector3d& axis = weak.rotation_axes[k];
-    if (weak.rotation_ratios[k] < config.free_ratio) {
+    const double r = weak.rotation_ratios[k];
+    const auto probe = [&](double sign) {
+      const Eigen::Isometry3d turn =
+          Eigen::Translation3d(c) *
+          Eigen::AngleAxisd(sign * config.degeneracy_probe_deg * kPi / 180.0, axis) *
+          Eigen::Translation3d(-c);
+      Probe p{PointToPlaneLm(target, source, turn * at.T_target_source, config, {})};
+      p.away = ComparePoses(p.end.T_target_source, at.T_target_source).rotation_deg >=
+               0.25 * config.degeneracy_probe_deg;
+      return p;
+    };
+    if (r < config.free_ratio || Undetermined(r, at, probe, free_space, config)) {
       out.rotation_axes.push_back(axis);
-      out.rotation_ratios.push_back(weak.rotation_ratios[k]);
-      continue;
-    }
-    const Eigen::Isometry3d turn =
-        Eigen::Translation3d(c) *
-        Eigen::AngleAxisd(config.degeneracy_probe_deg * kPi / 180.0, axis) *
-        Eigen::Translation3d(-c);
-    const IcpResult probe = PointToPlaneLm(target, source, turn * at.T_target_source, config, {});
-    const double back_deg = ComparePoses(probe.T_target_source, at.T_target_source).rotation_deg;
-    if (Undetermined(back_deg >= 0.25 * config.degeneracy_probe_deg, weak.rotation_ratios[k], at,
-                     probe, config)) {
-      out.rotation_axes.push_back(axis);
-      out.rotation_ratios.push_back(weak.rotation_ratios[k]);
+      out.rotation_ratios.push_back(r);
     }
   }
   return out;
@@ -784,7 +838,8 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
   prep.target_normals = EstimateNormals(prep.target_icp, fine,
                                         static_cast<float>(config.icp_normal_radius_m), kViewpoint);
   out.timings.normals_s = lap.Lap();
-  const IcpTarget icp_target{prep.target_icp, prep.target_normals, coarse, fine, fine_cell};
+  const PointCloud* view = prior.target_scan ? prior.target_scan : &target;  // free-space evidence
+  const IcpTarget icp_target{prep.target_icp, prep.target_normals, coarse, fine, fine_cell, view};
   const PointCloud icp_source = EvenSubsample(prep.source_icp, config.icp_max_points);
   // The target's normals straddle a corner's edges as much as the source's points do: either
   // cloud confined makes the pair confined.

@@ -74,6 +74,7 @@ class MapBuilder {
   MapConfig config_;
   std::unordered_map<std::uint64_t, Voxel> voxels_;
   std::vector<TrajectoryPose> trajectory_;
+  PointCloud last_scan_;  // the last merged scan in its base_link: the registration's view
   std::optional<Eigen::Isometry3d> last_motion_;  // T_prev_last of the last two merged scans
   std::size_t scans_seen_ = 0;
 };

@@ -51,6 +51,12 @@ struct RegistrationPrior {
   /// more than tolerance_deg from it is re-run with roll and pitch held at the guess's (x, y, z
   /// and the turn about up stay free), and the result says so; any result beyond it is rejected.
   std::optional<MeasuredTilt> tilt;
+  /// The one scan the target's sensor took at the target frame's origin, in that frame, when the
+  /// target is not that scan itself (a map built from many, whose points were seen from elsewhere).
+  /// Where fits cannot decide along a weakly constrained direction (a street, the heading on a
+  /// slope), a pose that puts source points in space this scan saw through is refuted. Null: the
+  /// target is one scan. Not owned; must outlive the call.
+  const PointCloud* target_scan = nullptr;
 };
 
 /// Wall time per stage [s] (for both clouds together).
