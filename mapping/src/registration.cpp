@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "fast_pipeline.hpp"
+#include "guess_grid.hpp"
 #include "pcl_pipeline.hpp"
 #include "seen_space.hpp"
 
@@ -522,22 +523,20 @@ struct Start {
 // The 3 x 3 x 3 grid over the guess's uncertainty (guess_search_m, guess_search_deg about the
 // vertical, or the odometry's error bound where that is tighter): neighbours lie guess_search_m
 // apart, so every pose of the region is within ICP's capture range of one (0.6 m spacing, 0.5 m
-// gate; a 12 deg turn moves a point 5 m out 0.5 m).
+// gate; a 12 deg turn moves a point 5 m out 0.5 m). The vertical is the measured up when the prior
+// has a tilt (every start then keeps the measured tilt: a held ICP keeps its start's, and turned
+// about the source's own z a start 10 deg tilted moves its tilt by 2 deg, beyond the tilt check),
+// else the source's z.
 std::vector<Start> GuessGrid(const Start& guess, const RegistrationPrior& prior,
                              const RegistrationConfig& config) {
   const Limits limits = ConstraintLimits(prior, config);
   const double step_m = std::min(config.guess_search_m, limits.translation_m);
   const double step_deg = std::min(config.guess_search_deg, limits.rotation_deg);
+  const Eigen::Vector3d up =
+      prior.tilt ? prior.tilt->up_target : Eigen::Vector3d(guess.T.linear().col(2));
   std::vector<Start> out;
-  for (int ix = -1; ix <= 1; ++ix) {
-    for (int iy = -1; iy <= 1; ++iy) {
-      for (int iyaw = -1; iyaw <= 1; ++iyaw) {
-        if (ix == 0 && iy == 0 && iyaw == 0) continue;  // the guess itself
-        out.push_back(
-            {guess.T * PoseFromXyzRpyDeg(ix * step_m, iy * step_m, 0, 0, 0, iyaw * step_deg),
-             guess.path, "a grid of starts around " + guess.name});
-      }
-    }
+  for (const Eigen::Isometry3d& T : GuessGridStarts(guess.T, step_m, step_deg, up)) {
+    out.push_back({T, guess.path, "a grid of starts around " + guess.name});
   }
   return out;
 }
