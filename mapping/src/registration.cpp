@@ -175,7 +175,9 @@ class FreeSpaceCheck {
   }
 
  private:
-  static constexpr double kSeenBin_deg = 1.0;  // about the LMS200's beam spacing at 1 deg mode
+  // Two or more of a seed-pattern scan's 0.5 deg beams and ~0.5 deg lines per bin: inside the
+  // field of view a bin is rarely empty.
+  static constexpr double kSeenBin_deg = 1.0;
   const IcpTarget& target_;
   const PointCloud& source_;
   const IcpResult& at_;
@@ -909,7 +911,8 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
       if (ambiguous.any()) {
         os << "feature alignment ambiguous: degenerate geometry (ICP restarted "
            << config.degeneracy_probe_m << " m / " << config.degeneracy_probe_deg
-           << " deg along the weakest direction does not come back)";
+           << " deg along the weakest direction does not come back, and nothing rules out where "
+              "it ends: a fit about as good, or no free-space violation)";
       } else {
         os << "feature alignment rejected: " << rejection;
       }
