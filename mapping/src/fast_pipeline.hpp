@@ -14,6 +14,7 @@
 
 namespace pitchlab::mapping {
 
+class LazySeenSpace;
 using Normals = std::vector<Eigen::Vector3f>;  // NaN where a point has too few neighbours
 using FeatureMatrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
@@ -70,8 +71,9 @@ struct IcpTarget {
   const VoxelHashIndex& coarse;
   const VoxelHashIndex& fine;
   float fine_cell_m;
-  /// The scan taken at the target frame's origin (registration's free-space evidence); null: none.
-  const PointCloud* view = nullptr;
+  /// What the scan taken at the target frame's origin saw through (registration's free-space
+  /// evidence); null: nothing known.
+  const LazySeenSpace* seen = nullptr;
 };
 
 struct IcpResult {

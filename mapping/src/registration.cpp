@@ -157,32 +157,26 @@ struct Prepared {
 constexpr double kRefuted = 0.005;
 constexpr int kRefutedOverAt = 10;
 
-// The free-space evidence against probed poses, the target's range image built at the first ask
-// (only a probe below degeneracy_ratio that does not come back needs it).
+// The free-space evidence against probed poses around `at` (its own violations counted at the
+// first ask).
 class FreeSpaceCheck {
  public:
   FreeSpaceCheck(const IcpTarget& target, const PointCloud& source, const IcpResult& at)
       : target_(target), source_(source), at_(at) {}
   bool Refutes(const IcpResult& probe) {
-    if (!target_.view) return false;
-    if (!seen_) {
-      seen_.emplace(*target_.view, kViewpoint, kSeenBin_deg);
-      at_violations_ = seen_->Violations(source_, at_.T_target_source);
-    }
-    const int v = seen_->Violations(source_, probe.T_target_source);
+    if (!target_.seen) return false;
+    const SeenSpace& seen = target_.seen->Get();
+    if (!at_violations_) at_violations_ = seen.Violations(source_, at_.T_target_source);
+    const int v = seen.Violations(source_, probe.T_target_source);
     return v >= kRefuted * static_cast<double>(source_.size()) &&
-           v >= kRefutedOverAt * at_violations_;
+           v >= kRefutedOverAt * *at_violations_;
   }
 
  private:
-  // Two or more of a seed-pattern scan's 0.5 deg beams and ~0.5 deg lines per bin: inside the
-  // field of view a bin is rarely empty.
-  static constexpr double kSeenBin_deg = 1.0;
   const IcpTarget& target_;
   const PointCloud& source_;
   const IcpResult& at_;
-  std::optional<SeenSpace> seen_;
-  int at_violations_ = 0;
+  std::optional<int> at_violations_;
 };
 
 // ICP restarted off `at` along a weak direction, one way (sign +1) or the other (-1), and whether
@@ -839,8 +833,10 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
   prep.target_normals = EstimateNormals(prep.target_icp, fine,
                                         static_cast<float>(config.icp_normal_radius_m), kViewpoint);
   out.timings.normals_s = lap.Lap();
-  const PointCloud* view = prior.target_scan ? prior.target_scan : &target;  // free-space evidence
-  const IcpTarget icp_target{prep.target_icp, prep.target_normals, coarse, fine, fine_cell, view};
+  // Free-space evidence: the target's own scan unless it is a map. Two or more of a seed-pattern
+  // scan's 0.5 deg beams and ~0.5 deg lines per 1 deg bin: inside the view a bin is rarely empty.
+  const LazySeenSpace seen(prior.target_scan ? *prior.target_scan : target, kViewpoint, 1.0);
+  const IcpTarget icp_target{prep.target_icp, prep.target_normals, coarse, fine, fine_cell, &seen};
   const PointCloud icp_source = EvenSubsample(prep.source_icp, config.icp_max_points);
   // The target's normals straddle a corner's edges as much as the source's points do: either
   // cloud confined makes the pair confined.

@@ -5,6 +5,7 @@
 // registration of multiple 3D data sets", 2003). The pose that put it there is wrong, however
 // well the rest fits; registration asks this where fits cannot decide.
 
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -41,6 +42,24 @@ class SeenSpace {
   float bin_rad_;
   int rows_, cols_;
   std::vector<float> nearest_;  // per bin, the nearest return's range [m]; +inf: none
+};
+
+/// A SeenSpace built at the first ask and kept: most registrations never need one, a few ask
+/// several times (the feature winner's probes, then a guess's).
+class LazySeenSpace {
+ public:
+  LazySeenSpace(const PointCloud& scan, const Eigen::Vector3f& sensor, double bin_deg)
+      : scan_(scan), sensor_(sensor), bin_deg_(bin_deg) {}
+  const SeenSpace& Get() const {
+    if (!built_) built_.emplace(scan_, sensor_, bin_deg_);
+    return *built_;
+  }
+
+ private:
+  const PointCloud& scan_;
+  Eigen::Vector3f sensor_;
+  double bin_deg_;
+  mutable std::optional<SeenSpace> built_;
 };
 
 }  // namespace pitchlab::mapping
