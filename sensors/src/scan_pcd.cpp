@@ -123,6 +123,7 @@ Result<void> WriteScanPcd(const Scan3D& scan, const std::string& path) {
   // PCL's writer has no place for comments: its header, our lines after its first (comment) line.
   std::string header = pcl::PCDWriter().generateHeaderBinary(cloud, origin, q.cast<float>());
   header.insert(header.find('\n') + 1, HeaderComments(scan));
+  header += "DATA binary\n";  // generateHeaderBinary stops before it, as writeBinary adds it
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     out.write(header.data(), static_cast<std::streamsize>(header.size()));
