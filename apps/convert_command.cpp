@@ -56,10 +56,11 @@ void PrintSummary(const sensors::Scan3D& scan, const std::string& out) {
   const double yaw_deg = std::atan2(R(1, 0), R(0, 0)) * 180.0 / M_PI;
   const char* kind = scan.has_truth ? "truth" : scan.has_odometry ? "odometry" : "unknown";
   const Eigen::Vector3d o = scan.sensor_origin.value_or(Eigen::Vector3d::Zero());
-  std::printf("wrote %s: %zu points, %zu no-returns; pose (%s) %.3f %.3f %.3f m, yaw %.2f deg; "
-              "sensor origin %.3f %.3f %.3f m\n",
-              out.c_str(), scan.points.size(), scan.no_returns, kind, t.x(), t.y(), t.z(),
-              yaw_deg, o.x(), o.y(), o.z());
+  std::printf(
+      "wrote %s: %zu points, %zu no-returns; pose (%s) %.3f %.3f %.3f m, yaw %.2f deg; "
+      "sensor origin %.3f %.3f %.3f m\n",
+      out.c_str(), scan.points.size(), scan.no_returns, kind, t.x(), t.y(), t.z(), yaw_deg, o.x(),
+      o.y(), o.z());
 }
 
 }  // namespace

@@ -64,9 +64,7 @@ bool IsUosHeader(const std::vector<std::string_view>& fields) {
 
 }  // namespace
 
-Eigen::Vector3d PointFrom3dtk(const Eigen::Vector3d& p_cm) {
-  return AxisChange() * p_cm * kCmToM;
-}
+Eigen::Vector3d PointFrom3dtk(const Eigen::Vector3d& p_cm) { return AxisChange() * p_cm * kCmToM; }
 
 Eigen::Isometry3d TransformFrom3dtk(const Eigen::Matrix4d& T_cm) {
   const Eigen::Matrix3d C = AxisChange();
@@ -126,10 +124,12 @@ Result<Eigen::Isometry3d> Read3dtkFrames(const std::string& path) {
     }
     last = T;
   }
-  if (!last) return Fail(Error::Code::kInvalidArgument, "slam6d frames file '" + path + "' is empty");
+  if (!last) {
+    return Fail(Error::Code::kInvalidArgument, "slam6d frames file '" + path + "' is empty");
+  }
   Eigen::Matrix4d T = *last;  // re-orthonormalized: the six printed digits leave R off by ~1e-6
-  T.topLeftCorner<3, 3>() = Eigen::Quaterniond(T.topLeftCorner<3, 3>()).normalized()
-                                .toRotationMatrix();
+  T.topLeftCorner<3, 3>() =
+      Eigen::Quaterniond(T.topLeftCorner<3, 3>()).normalized().toRotationMatrix();
   return TransformFrom3dtk(T);
 }
 
@@ -156,7 +156,9 @@ Result<Scan3D> Read3dtkScan(const std::string& path) {
     const std::vector<std::string_view> fields = detail::SplitFields(line);
     if (readings == 0 && IsUosHeader(fields)) continue;
     double v[3];
-    if (const auto why = ParseFinite(fields, 3, v)) return FailAt(path, line_no, "x y z [cm] " + *why);
+    if (const auto why = ParseFinite(fields, 3, v)) {
+      return FailAt(path, line_no, "x y z [cm] " + *why);
+    }
     ++readings;
     const Eigen::Vector3d p_cm(v[0], v[1], v[2]);
     const double r_cm = p_cm.norm();

@@ -20,9 +20,8 @@ Result<Scan3D> ReadCloudFile(const std::string& path) {
   if (ext == ".3d") return Read3dtkScan(path);
   if (ext == ".ply") return ReadPly(path);
   if (ext == ".xyz" || ext == ".txt") return ReadXyz(path);
-  return Fail(Error::Code::kInvalidArgument,
-              "'" + path + "': unknown point-cloud format '" + ext +
-                  "' (known: .pcd, .3d, .ply, .xyz, .txt)");
+  return Fail(Error::Code::kInvalidArgument, "'" + path + "': unknown point-cloud format '" + ext +
+                                                 "' (known: .pcd, .3d, .ply, .xyz, .txt)");
 }
 
 void SetSensorOrigin(Scan3D& scan, const Eigen::Vector3d& origin_m) {

@@ -53,10 +53,10 @@ std::optional<Scalar> ScalarNamed(std::string_view name) {
     Scalar s;
   };
   static const Entry kTypes[] = {
-      {"char", "int8", {Kind::kSigned, 1}},     {"uchar", "uint8", {Kind::kUnsigned, 1}},
-      {"short", "int16", {Kind::kSigned, 2}},   {"ushort", "uint16", {Kind::kUnsigned, 2}},
-      {"int", "int32", {Kind::kSigned, 4}},     {"uint", "uint32", {Kind::kUnsigned, 4}},
-      {"float", "float32", {Kind::kFloat, 4}},  {"double", "float64", {Kind::kFloat, 8}}};
+      {"char", "int8", {Kind::kSigned, 1}},    {"uchar", "uint8", {Kind::kUnsigned, 1}},
+      {"short", "int16", {Kind::kSigned, 2}},  {"ushort", "uint16", {Kind::kUnsigned, 2}},
+      {"int", "int32", {Kind::kSigned, 4}},    {"uint", "uint32", {Kind::kUnsigned, 4}},
+      {"float", "float32", {Kind::kFloat, 4}}, {"double", "float64", {Kind::kFloat, 8}}};
   for (const Entry& e : kTypes) {
     if (name == e.a || name == e.b) return e.s;
   }
@@ -128,9 +128,13 @@ Result<Header> ReadHeader(const std::string& path, const std::string& data) {
     if (f.empty()) continue;
     if (f[0] == "end_header") break;
     if (f[0] == "comment" || f[0] == "obj_info") {
-      if (auto r = ReadOriginComment(path, line_no, f, header); !r) return tl::make_unexpected(r.error());
+      if (auto r = ReadOriginComment(path, line_no, f, header); !r) {
+        return tl::make_unexpected(r.error());
+      }
     } else if (f[0] == "format") {
-      if (f.size() != 3 || f[2] != "1.0") return BadLine(path, line_no, "expected 'format TYPE 1.0'");
+      if (f.size() != 3 || f[2] != "1.0") {
+        return BadLine(path, line_no, "expected 'format TYPE 1.0'");
+      }
       if (f[1] == "ascii") {
         header.format = Format::kAscii;
       } else if (f[1] == "binary_little_endian") {
@@ -148,7 +152,9 @@ Result<Header> ReadHeader(const std::string& path, const std::string& data) {
       }
       header.elements.push_back({std::string(f[1]), static_cast<std::uint64_t>(*n), {}});
     } else if (f[0] == "property") {
-      if (auto r = ReadProperty(path, line_no, f, header); !r) return tl::make_unexpected(r.error());
+      if (auto r = ReadProperty(path, line_no, f, header); !r) {
+        return tl::make_unexpected(r.error());
+      }
     } else {
       return BadLine(path, line_no, "unknown header keyword '" + std::string(f[0]) + "'");
     }
@@ -183,11 +189,16 @@ double Decode(const char* p, Scalar s, bool swap) {
     return static_cast<double>(value);
   };
   switch (s.kind) {
-    case Kind::kFloat: return s.size == 4 ? as(float{}) : as(double{});
+    case Kind::kFloat:
+      return s.size == 4 ? as(float{}) : as(double{});
     case Kind::kSigned:
-      return s.size == 1 ? as(std::int8_t{}) : s.size == 2 ? as(std::int16_t{}) : as(std::int32_t{});
+      return s.size == 1   ? as(std::int8_t{})
+             : s.size == 2 ? as(std::int16_t{})
+                           : as(std::int32_t{});
     case Kind::kUnsigned:
-      return s.size == 1 ? as(std::uint8_t{}) : s.size == 2 ? as(std::uint16_t{}) : as(std::uint32_t{});
+      return s.size == 1   ? as(std::uint8_t{})
+             : s.size == 2 ? as(std::uint16_t{})
+                           : as(std::uint32_t{});
   }
   return 0.0;
 }
@@ -199,11 +210,13 @@ bool HostIsLittleEndian() {
   return first == 1;
 }
 
+// `line_no` 0 for binary data (no lines to name).
 Result<void> AddVertex(const std::string& path, std::uint64_t i, const Eigen::Vector3d& v,
-                       const std::string& where, Scan3D& scan) {
+                       int line_no, Scan3D& scan) {
   if (!v.allFinite()) {
-    return Bad(path, where + "vertex " + std::to_string(i) + " (counting from 0) has a " +
-                         "coordinate that is not finite");
+    const std::string where = line_no > 0 ? "line " + std::to_string(line_no) + ": " : "";
+    return Bad(path, where + "vertex " + std::to_string(i) +
+                         " (counting from 0) has a coordinate that is not finite");
   }
   scan.points.push_back(detail::MakePoint(v, Eigen::Vector3d::Zero()));
   return {};
@@ -215,15 +228,18 @@ Result<void> ReadBinary(const std::string& path, const std::string& data, const 
   const char* p = data.data() + header.data_offset;
   const char* const end = data.data() + data.size();
   auto truncated = [&](const Element& e, std::uint64_t i) {
-    return Bad(path, "the data end inside element '" + e.name + "' " + std::to_string(i) +
-                         " of " + std::to_string(e.count) + " (truncated file?)");
+    return Bad(path, "the data end inside element '" + e.name + "' " + std::to_string(i) + " of " +
+                         std::to_string(e.count) + " (truncated file?)");
   };
   for (const Element& e : header.elements) {
+    if (e.properties.empty()) continue;  // holds no bytes, however large its count
     const bool is_vertex = e.name == "vertex" && scan.points.empty();
     if (is_vertex) {  // no more than the bytes left can hold: the count may be a lie
       std::uint64_t min_bytes = 0;
-      for (const Property& prop : e.properties) min_bytes += prop.count ? prop.count->size : prop.type.size;
-      scan.points.reserve(std::min<std::uint64_t>(e.count, (end - p) / std::max<std::uint64_t>(min_bytes, 1)));
+      for (const Property& prop : e.properties)
+        min_bytes += prop.count ? prop.count->size : prop.type.size;
+      scan.points.reserve(
+          std::min<std::uint64_t>(e.count, (end - p) / std::max<std::uint64_t>(min_bytes, 1)));
     }
     for (std::uint64_t i = 0; i < e.count; ++i) {
       Eigen::Vector3d v;
@@ -233,8 +249,10 @@ Result<void> ReadBinary(const std::string& path, const std::string& data, const 
         if (prop.count) {
           if (end - p < prop.count->size) return truncated(e, i);
           const double n = Decode(p, *prop.count, swap);
-          if (n < 0) return Bad(path, "element '" + e.name + "' " + std::to_string(i) +
-                                          ": a list of negative length");
+          if (n < 0) {
+            return Bad(path, "element '" + e.name + "' " + std::to_string(i) +
+                                 ": a list of negative length");
+          }
           p += prop.count->size;
           bytes = static_cast<std::uint64_t>(n) * prop.type.size;
         }
@@ -247,7 +265,7 @@ Result<void> ReadBinary(const std::string& path, const std::string& data, const 
         p += bytes;
       }
       if (is_vertex) {
-        if (auto r = AddVertex(path, i, v, "", scan); !r) return r;
+        if (auto r = AddVertex(path, i, v, 0, scan); !r) return r;
       }
     }
   }
@@ -260,6 +278,7 @@ Result<void> ReadAscii(const std::string& path, const std::string& data, const H
   int line_no = header.lines;
   std::string line;
   for (const Element& e : header.elements) {
+    if (e.properties.empty()) continue;  // holds no values, so no lines
     const bool is_vertex = e.name == "vertex" && scan.points.empty();
     for (std::uint64_t i = 0; i < e.count; ++i) {
       std::vector<std::string_view> f;
@@ -279,8 +298,9 @@ Result<void> ReadAscii(const std::string& path, const std::string& data, const H
         }
         const std::optional<double> n = detail::ParseNumber(f[t]);
         if (!n || (type.kind != Kind::kFloat && *n != std::floor(*n))) {
-          return BadLine(path, line_no, "'" + std::string(f[t]) + "' is not a valid " +
-                                            (type.kind == Kind::kFloat ? "number" : "integer"));
+          return BadLine(path, line_no,
+                         "'" + std::string(f[t]) + "' is not a valid " +
+                             (type.kind == Kind::kFloat ? "number" : "integer"));
         }
         ++t;
         return *n;
@@ -303,11 +323,12 @@ Result<void> ReadAscii(const std::string& path, const std::string& data, const H
         }
       }
       if (t != f.size()) {
-        return BadLine(path, line_no, std::to_string(f.size()) + " values where the header " +
-                                          "declares " + std::to_string(t) + " for '" + e.name + "'");
+        return BadLine(path, line_no,
+                       std::to_string(f.size()) + " values where the header " + "declares " +
+                           std::to_string(t) + " for '" + e.name + "'");
       }
       if (is_vertex) {
-        if (auto r = AddVertex(path, i, v, "line " + std::to_string(line_no) + ": ", scan); !r) {
+        if (auto r = AddVertex(path, i, v, line_no, scan); !r) {
           return r;
         }
       }

@@ -43,8 +43,8 @@ Result<Scan3D> ReadXyz(const std::string& path) {
       if (!std::isfinite(*number)) return fail("'" + std::string(fields[i]) + "' is not finite");
       v[i] = *number;
     }
-    scan.points.push_back(detail::MakePoint(Eigen::Vector3d(v[0], v[1], v[2]),
-                                            Eigen::Vector3d::Zero()));
+    scan.points.push_back(
+        detail::MakePoint(Eigen::Vector3d(v[0], v[1], v[2]), Eigen::Vector3d::Zero()));
   }
   if (in.bad()) return Fail(Error::Code::kFailed, "error reading point file '" + path + "'");
   if (scan.points.empty()) {

@@ -75,8 +75,8 @@ std::string HeaderComments(const Scan3D& scan) {
     const Eigen::Vector3d& o = *scan.sensor_origin;
     os << kOriginKey << ' ' << o.x() << ' ' << o.y() << ' ' << o.z() << '\n';
   }
-  os << kPoseKey << ' ' << (scan.has_truth ? "truth" : scan.has_odometry ? "odometry" : "unknown")
-     << '\n';
+  const char* pose = scan.has_truth ? "truth" : scan.has_odometry ? "odometry" : "unknown";
+  os << kPoseKey << ' ' << pose << '\n';
   return os.str();
 }
 
@@ -94,7 +94,8 @@ Result<Comments> ReadComments(const std::string& path) {
     if (line.rfind(kOriginKey, 0) == 0 && f.size() >= 2 && f[1] == "sensor_origin") {
       Eigen::Vector3d o;
       for (int i = 0; i < 3; ++i) {
-        const std::optional<double> v = f.size() == 5 ? detail::ParseNumber(f[2 + i]) : std::nullopt;
+        const std::optional<double> v =
+            f.size() == 5 ? detail::ParseNumber(f[2 + i]) : std::nullopt;
         if (!v || !std::isfinite(*v)) {
           return Fail(Error::Code::kInvalidArgument,
                       "PCD '" + path + "': '" + line + "' is not 'sensor_origin x y z' [m]");

@@ -80,12 +80,11 @@ TEST_F(ConvertCli, ThreeDtkScanBecomesAPcdWithTheSamePointsPoseAndOrigin) {
 TEST_F(ConvertCli, PoseFromFramesReplacesThePoseAndOriginOverrideIsKept) {
   const std::string in = Write("cloud.xyz", "1 2 3\n4 5 6\n");
   // A slam6d line: identity rotation, translation (10, 20, 150) cm in 3DTK's frame, type 2.
-  const std::string frames =
-      Write("scan001.frames", "1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1 1\n"
-                              "1 0 0 0 0 1 0 0 0 0 1 0 10 20 150 1 2\n");
+  const std::string frames = Write("scan001.frames",
+                                   "1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1 1\n"
+                                   "1 0 0 0 0 1 0 0 0 0 1 0 10 20 150 1 2\n");
   const std::string out = Path("cloud.pcd");
-  ASSERT_EQ(Convert({in, "--out", out, "--pose-from", frames, "--sensor-origin", "0.1,0,0.54"}),
-            0);
+  ASSERT_EQ(Convert({in, "--out", out, "--pose-from", frames, "--sensor-origin", "0.1,0,0.54"}), 0);
   Result<sensors::Scan3D> back = sensors::ReadScanPcd(out);
   ASSERT_TRUE(back) << back.error().message;
   // (10, 20, 150) cm 3DTK = 1.5 m forward, 0.1 m right, 0.2 m up.
@@ -117,8 +116,8 @@ TEST_F(ConvertCli, ExistingOutputIsRefusedAndLeftAlone) {
 
 TEST_F(ConvertCli, CommandLineMistakesExitTwo) {
   const std::string in = Write("cloud.xyz", "1 2 3\n");
-  EXPECT_EQ(Convert({in}), 2);                                  // no --out
-  EXPECT_EQ(Convert({in, "--out", Path("x.ply")}), 2);          // not a PCD name
+  EXPECT_EQ(Convert({in}), 2);                          // no --out
+  EXPECT_EQ(Convert({in, "--out", Path("x.ply")}), 2);  // not a PCD name
   EXPECT_EQ(Convert({in, "--out", Path("x.pcd"), "--sensor-origin", "1,2"}), 2);
   EXPECT_EQ(Convert({in, "--out", Path("x.pcd"), "--sensor-origin", "1,nan,2"}), 2);
   EXPECT_EQ(Convert({in, "--out", Path("x.pcd"), "--pose-from", Path("x.txt")}), 2);

@@ -23,7 +23,8 @@ namespace fs = std::filesystem;
 
 const fs::path kCorridor = PITCHLAB_3DTK_CORRIDOR_DIR;
 constexpr double kDegToRad = M_PI / 180.0;
-// Text files hold points to 6-9 significant digits and ScanPoint keeps floats: 1e-6 m is below both.
+// Text files hold points to 6-9 significant digits and ScanPoint keeps floats: 1e-6 m is below
+// both.
 constexpr double kPointTolM = 1e-6;
 
 class CloudFile : public ::testing::Test {
@@ -63,11 +64,10 @@ TEST(ThreeDtk, ConvertedPoseMovesConvertedPointsAs3dtkMovesItsOwn) {
   const Eigen::Matrix4d T3 = Matrix3dtkFromPose({-3.1, -7.5, 156.9}, {12.0, -35.0, 71.0});
   const Eigen::Isometry3d T = TransformFrom3dtk(T3);
   EXPECT_NEAR(T.rotation().determinant(), 1.0, 1e-12);  // a rotation, not a reflection
-  for (const Eigen::Vector3d p : {Eigen::Vector3d(10, -20, 300), Eigen::Vector3d(-250, 40, 7),
-                                  Eigen::Vector3d(0, 0, 0)}) {
+  for (const Eigen::Vector3d p :
+       {Eigen::Vector3d(10, -20, 300), Eigen::Vector3d(-250, 40, 7), Eigen::Vector3d(0, 0, 0)}) {
     const Eigen::Vector3d moved3 = (T3 * p.homogeneous()).head<3>();
-    EXPECT_TRUE((T * PointFrom3dtk(p)).isApprox(PointFrom3dtk(moved3), 1e-12))
-        << p.transpose();
+    EXPECT_TRUE((T * PointFrom3dtk(p)).isApprox(PointFrom3dtk(moved3), 1e-12)) << p.transpose();
   }
 }
 
@@ -88,11 +88,11 @@ TEST_F(CloudFile, TinyThreeDtkScanGivesHandComputedPointsAndPose) {
   // in REP-103 a yaw of -90 deg at (2, -1, 0).
   Write("scan007.pose", "100 0 200\n0 90 0\n");
   const std::string path = Write("scan007.3d",
-                                 "0 0 100\n"        // 1 m forward -> (1, 0, 0)
-                                 "100 0 0\n"        // 1 m right -> (0, -1, 0)
-                                 "0 50 200\n"       // 2 m forward, 0.5 m up -> (2, 0, 0.5)
-                                 "0 0 3276\n"       // the maximum-range code: a no-return
-                                 "10.1 0 0\n"       // under 48 cm: dropped
+                                 "0 0 100\n"   // 1 m forward -> (1, 0, 0)
+                                 "100 0 0\n"   // 1 m right -> (0, -1, 0)
+                                 "0 50 200\n"  // 2 m forward, 0.5 m up -> (2, 0, 0.5)
+                                 "0 0 3276\n"  // the maximum-range code: a no-return
+                                 "10.1 0 0\n"  // under 48 cm: dropped
                                  "\n");
   Result<Scan3D> scan = ReadCloudFile(path);
   ASSERT_TRUE(scan) << scan.error().message;
@@ -210,8 +210,9 @@ void Put(std::string& out, T value, bool big) {
 // after x (double), y (float), z (double), including a list inside the vertex element.
 std::string MakePly(Ply format) {
   std::string s = "ply\nformat ";
-  s += format == Ply::kAscii ? "ascii" : format == Ply::kLittle ? "binary_little_endian"
-                                                                 : "binary_big_endian";
+  s += format == Ply::kAscii    ? "ascii"
+       : format == Ply::kLittle ? "binary_little_endian"
+                                : "binary_big_endian";
   s += " 1.0\ncomment written by cloud_file_test\n"
        "element face 2\nproperty list uchar int vertex_indices\n"
        "element vertex 3\nproperty uchar red\nproperty double x\nproperty float32 y\n"
@@ -248,9 +249,9 @@ std::string MakePly(Ply format) {
 }
 
 TEST_F(CloudFile, PlyAsciiLittleAndBigEndianGiveTheSamePoints) {
-  for (const auto& [format, name] : {std::pair{Ply::kAscii, "ascii.ply"},
-                                     std::pair{Ply::kLittle, "little.PLY"},
-                                     std::pair{Ply::kBig, "big.ply"}}) {
+  for (const auto& [format, name] :
+       {std::pair{Ply::kAscii, "ascii.ply"}, std::pair{Ply::kLittle, "little.PLY"},
+        std::pair{Ply::kBig, "big.ply"}}) {
     Result<Scan3D> scan = ReadCloudFile(Write(name, MakePly(format)));
     ASSERT_TRUE(scan) << name << ": " << scan.error().message;
     ASSERT_EQ(scan->points.size(), kPlyPoints.size()) << name;
@@ -332,8 +333,7 @@ TEST_F(CloudFile, XyzNonFiniteShortOrEmptyIsAnError) {
   for (const auto& [name, text, where] :
        {std::tuple{"nan.xyz", "1 2 3\n1 nan 3\n", "line 2"},
         std::tuple{"inf.xyz", "1 2 -inf\n", "line 1"},
-        std::tuple{"short.xyz", "1 2 3\n4 5\n", "line 2"},
-        std::tuple{"empty.xyz", "", "no points"},
+        std::tuple{"short.xyz", "1 2 3\n4 5\n", "line 2"}, std::tuple{"empty.xyz", "", "no points"},
         std::tuple{"comments.xyz", "# only\n\n", "no points"}}) {
     const std::string path = Write(name, text);
     Result<Scan3D> scan = ReadCloudFile(path);
