@@ -221,14 +221,16 @@ Result<Scan3D> ReadScanPcd(const std::string& path) {
   } else {  // a PCD from elsewhere (or from pitchlab before the comment): simulation's convention
     scan.has_truth = !scan.T_world_base.isApprox(Eigen::Isometry3d::Identity());
   }
-  // Without our comment, the PCD convention: VIEWPOINT is the acquisition viewpoint, so the sensor
-  // stood at the origin of the points' frame.
-  const Eigen::Vector3d sensor = comments->sensor_origin.value_or(Eigen::Vector3d::Zero());
-  if (orange < 0) {
-    SetSensorOrigin(scan, sensor);  // no range field: each point's distance from the sensor
-  } else {
-    scan.sensor_origin = sensor;  // keep the measured ranges (from the mirror as it pitched)
-  }
+  if (comments->sensor_origin) {
+    scan.sensor_origin = comments->sensor_origin;
+  } else if (!comments->pose) {
+    // A PCD from elsewhere: the PCD convention, VIEWPOINT is the acquisition viewpoint, so the
+    // sensor stood at the origin of the points' frame.
+    scan.sensor_origin = Eigen::Vector3d::Zero();
+  }  // else ours, written without an origin (a merged map): it stays unknown
+  // Ranges stay as the scanner measured them (from the mirror as it pitched); a file without a
+  // range field gets each point's distance from the sensor.
+  if (orange < 0 && scan.sensor_origin) SetSensorOrigin(scan, *scan.sensor_origin);
   return scan;
 }
 

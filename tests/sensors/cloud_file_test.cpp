@@ -393,6 +393,7 @@ TEST_F(CloudFile, SimulatedScanWithoutOriginKeepsItsTruthFlag) {
   ASSERT_TRUE(back) << back.error().message;
   EXPECT_TRUE(back->has_truth);
   EXPECT_FALSE(back->has_odometry);
+  EXPECT_FALSE(back->sensor_origin);  // ours, written without one: still unknown, not (0,0,0)
 }
 
 TEST_F(CloudFile, ForeignPcdHasItsSensorAtThePointsFrameOrigin) {

@@ -17,9 +17,11 @@ namespace pitchlab::sensors {
 [[nodiscard]] Result<void> WriteScanPcd(const Scan3D& scan, const std::string& path);
 
 /// Reads a PCD written by WriteScanPcd (or any PCD with x y z; NaN points count as no_returns):
-/// points, the VIEWPOINT as T_world_base, and our comments. Without them (a foreign PCD) the PCD
-/// convention holds: VIEWPOINT is where the points were taken from, so sensor_origin = (0,0,0),
-/// and has_truth is set when the VIEWPOINT is not the identity. Lines are not restored.
+/// points, the VIEWPOINT as T_world_base, and our comments (a file of ours without the origin
+/// comment leaves sensor_origin unset). Without them (a foreign PCD) the PCD convention holds:
+/// VIEWPOINT is where the points were taken from, so sensor_origin = (0,0,0), and has_truth is set
+/// when the VIEWPOINT is not the identity. Without a range field, range_m is the distance from
+/// the sensor origin. Lines are not restored.
 [[nodiscard]] Result<Scan3D> ReadScanPcd(const std::string& path);
 
 }  // namespace pitchlab::sensors
