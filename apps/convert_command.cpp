@@ -50,17 +50,18 @@ PoseFile PoseFileKind(const std::string& path) {
   throw CliError("--pose-from '" + path + "': expected a 3DTK .pose or a slam6d .frames file");
 }
 
-void PrintSummary(const sensors::Scan3D& scan, const std::string& out) {
+// `pose_label`: what the pose is ("odometry", "from scan001.frames", ...).
+void PrintSummary(const sensors::Scan3D& scan, const std::string& out,
+                  const std::string& pose_label) {
   const Eigen::Vector3d t = scan.T_world_base.translation();
   const Eigen::Matrix3d R = scan.T_world_base.rotation();
   const double yaw_deg = std::atan2(R(1, 0), R(0, 0)) * 180.0 / M_PI;
-  const char* kind = scan.has_truth ? "truth" : scan.has_odometry ? "odometry" : "unknown";
   const Eigen::Vector3d o = scan.sensor_origin.value_or(Eigen::Vector3d::Zero());
   std::printf(
       "wrote %s: %zu points, %zu no-returns; pose (%s) %.3f %.3f %.3f m, yaw %.2f deg; "
       "sensor origin %.3f %.3f %.3f m\n",
-      out.c_str(), scan.points.size(), scan.no_returns, kind, t.x(), t.y(), t.z(), yaw_deg, o.x(),
-      o.y(), o.z());
+      out.c_str(), scan.points.size(), scan.no_returns, pose_label.c_str(), t.x(), t.y(), t.z(),
+      yaw_deg, o.x(), o.y(), o.z());
 }
 
 }  // namespace
@@ -95,7 +96,8 @@ int RunConvert(int argc, char** argv) {
   if (const Result<void> written = sensors::WriteScanPcd(scan, out); !written) {
     throw std::runtime_error(written.error().message);
   }
-  PrintSummary(scan, out);
+  const char* kind = scan.has_truth ? "truth" : scan.has_odometry ? "odometry" : "unknown";
+  PrintSummary(scan, out, pose_kind ? "from " + args.Get("pose-from") : std::string(kind));
   return 0;
 }
 
