@@ -160,11 +160,14 @@ TEST(ThreeDtk, RealCorridorScansReadWithTheirCountsAndOdometry) {
   EXPECT_NEAR(t.z(), -0.0750803, 1e-7);
   // Its rotation (1.36, -0.85, -0.56 deg about 3DTK's x, y, z) is small: under 2 deg in all.
   EXPECT_LT(AngleDeg(scan1->T_world_base, Eigen::Isometry3d::Identity()), 2.0);
-  // Most points of a corridor scan lie ahead or behind within the corridor: the walls are left
-  // and right, so |y| stays within a few metres while x spans tens of metres.
+  // The axis change puts the scan where a 180 deg LMS looks: nothing behind the scanner (x >= 0;
+  // 3DTK's z), returns out to 31.8 m ahead and down to 1.77 m below it (awk over the file:
+  // x 0..31.8, z -1.77..7.96 m).
   Eigen::AlignedBox3d box;
   for (const ScanPoint& p : scan1->points) box.extend(At(p));
-  EXPECT_GT(box.sizes().x(), box.sizes().y());
+  EXPECT_GT(box.min().x(), -0.001);
+  EXPECT_NEAR(box.max().x(), 31.80, 0.01);
+  EXPECT_NEAR(box.min().z(), -1.768, 0.001);
 }
 
 TEST(ThreeDtk, Slam6dFramesOfScan001AreWithinSourcesFigureOfTheOdometry) {
