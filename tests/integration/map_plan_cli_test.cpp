@@ -62,6 +62,9 @@ TEST_F(MapPlanCli, ScanMapPlanWritesFilesThatParse) {
   const nlohmann::json map = nlohmann::json::parse(map_run_.out);
   EXPECT_GT(map["known_cells"].get<int>(), 100);
   EXPECT_TRUE(map.contains("truth"));
+  // --world's frame is the simulator's, z up: nothing to level.
+  EXPECT_NE(map["levelling"]["method"].get<std::string>().find("--world"), std::string::npos);
+  EXPECT_EQ(map["max_height_m"].get<double>(), 1.0);
   EXPECT_EQ(nlohmann::json::parse(Slurp(dir_ / "map" / "map.json"))["cell_m"], 0.1);
   const auto loaded = mapping::LoadElevationMap((dir_ / "map" / "map.plem").string());
   ASSERT_TRUE(loaded) << loaded.error().message;
