@@ -48,9 +48,11 @@ CliArgs MapArgs() {
                "--no-level keeps the clouds' frame (their poses came levelled by an IMU).\n"
                "\n"
                "Height band: points higher than --max-height above the ground under the sensor\n"
-               "that saw them, plus 35 % (the P3-AT's grade) of their distance from it, are not\n"
-               "ground; nor are points on a surface the laser saw from below (a ceiling, a\n"
-               "desk's underside). Cells whose only points were those stay unknown.");
+               "that saw them are not ground (a ceiling, a canopy), unless the laser saw their\n"
+               "surface from above: terrain rising ahead may climb 35 % (the P3-AT's grade) of\n"
+               "its distance higher. Points on a surface the laser saw from below (a ceiling, a\n"
+               "desk's underside) are never ground. Cells whose only points were those stay\n"
+               "unknown.");
   args.Positionals("CLOUD.pcd", "one or more clouds", 1, 1000)
       .Option("cell", "METRES", "cell size [m]", "0.1")
       .Option("out", "DIR", "output folder (created)")
@@ -85,10 +87,12 @@ LoadedCloud LoadCloud(const std::string& path) {
   c.points.reserve(scan->points.size());
   for (const sensors::ScanPoint& p : scan->points)
     c.points.push_back(T * Eigen::Vector3f(p.x, p.y, p.z));
-  // The mirror at zero pitch; it moves by a few centimetres while pitching, which shifts the
+  // The file's sensor origin where it records one (a converted real scan: the scanner itself),
+  // else the mirror at zero pitch; it moves by a few centimetres while pitching, which shifts the
   // clearance rays' ends (the last few metres) by well under a centimetre.
   const sensors::MountConfig mount;
-  c.sensor_origin = T * (mount.t_base_mount_m + mount.t_mount_laser_m).cast<float>();
+  c.sensor_origin =
+      T * scan->sensor_origin.value_or(mount.t_base_mount_m + mount.t_mount_laser_m).cast<float>();
   return c;
 }
 
