@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_args.hpp"
+#include "cloud_input.hpp"
 #include "commands.hpp"
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
@@ -34,8 +35,8 @@ std::string DefaultClearance() {
 
 CliArgs MapArgs() {
   CliArgs args("map",
-               "Builds an elevation map from point clouds (PCD; points moved into the world by\n"
-               "each file's VIEWPOINT pose) and writes DIR/map.plem (lossless), DIR/elevation.asc\n"
+               "Builds an elevation map from point clouds (any format sensors read: PCD, 3DTK\n"
+               ".3d, PLY, XYZ; points moved into the world by each file's pose) and writes DIR/map.plem (lossless), DIR/elevation.asc\n"
                "+ .prj (georeferenced raster), DIR/elevation.png and DIR/map.json. With --world,\n"
                "the map is georeferenced and scored against the world's true surface.\n"
                "\n"
@@ -53,7 +54,8 @@ CliArgs MapArgs() {
                "its distance higher. Points on a surface the laser saw from below (a ceiling, a\n"
                "desk's underside) are never ground. Cells whose only points were those stay\n"
                "unknown.");
-  args.Positionals("CLOUD.pcd", "one or more clouds", 1, 1000)
+  args.Positionals("CLOUD", "one or more clouds, any format below", 1, 1000)
+      .Option("sensor-origin", "x,y,z", kSensorOriginHelp)
       .Option("cell", "METRES", "cell size [m]", "0.1")
       .Option("out", "DIR", "output folder (created)")
       .Option("area", "xmin,ymin,xmax,ymax", "map area [m] (default: the clouds' extent)")
@@ -79,20 +81,17 @@ struct LoadedCloud {
   Eigen::Vector3f sensor_origin;        // approximate laser position in the world
 };
 
-LoadedCloud LoadCloud(const std::string& path) {
-  Result<sensors::Scan3D> scan = sensors::ReadScanPcd(path);
-  if (!scan) throw std::runtime_error(scan.error().message);
+LoadedCloud LoadCloud(const std::string& path, const std::optional<Eigen::Vector3d>& origin) {
+  const sensors::Scan3D scan = LoadInputCloud(path, origin);  // any format; origin always set
   LoadedCloud c;
-  const Eigen::Isometry3f T = scan->T_world_base.cast<float>();
-  c.points.reserve(scan->points.size());
-  for (const sensors::ScanPoint& p : scan->points)
+  const Eigen::Isometry3f T = scan.T_world_base.cast<float>();
+  c.points.reserve(scan.points.size());
+  for (const sensors::ScanPoint& p : scan.points)
     c.points.push_back(T * Eigen::Vector3f(p.x, p.y, p.z));
-  // The file's sensor origin where it records one (a converted real scan: the scanner itself),
-  // else the mirror at zero pitch; it moves by a few centimetres while pitching, which shifts the
-  // clearance rays' ends (the last few metres) by well under a centimetre.
-  const sensors::MountConfig mount;
-  c.sensor_origin =
-      T * scan->sensor_origin.value_or(mount.t_base_mount_m + mount.t_mount_laser_m).cast<float>();
+  // The sensor where the file (or --sensor-origin) puts it: for pitchlab's own scans the mirror
+  // at zero pitch, which moves by a few centimetres while pitching and shifts the clearance rays'
+  // ends (the last few metres) by well under a centimetre.
+  c.sensor_origin = T * scan.sensor_origin->cast<float>();
   return c;
 }
 
@@ -125,11 +124,12 @@ int RunMap(int argc, char** argv) {
   if (!(insert.max_height_m > 0)) throw CliError("--max-height must be positive (or inf)");
   const auto wall_start = std::chrono::steady_clock::now();
 
+  const std::optional<Eigen::Vector3d> sensor_origin = SensorOriginOption(args);
   std::vector<LoadedCloud> clouds;
   Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
   std::size_t total_points = 0;
   for (const std::string& path : args.positionals()) {
-    clouds.push_back(LoadCloud(path));
+    clouds.push_back(LoadCloud(path, sensor_origin));
     for (const Eigen::Vector3f& p : clouds.back().points) {
       lo = lo.cwiseMin(p.head<2>().cast<double>());
       hi = hi.cwiseMax(p.head<2>().cast<double>());

@@ -10,8 +10,10 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_args.hpp"
+#include "cloud_input.hpp"
 #include "commands.hpp"
 #include "pitchlab/mapping/map_builder.hpp"
+#include "pitchlab/sensors/cloud_file.hpp"
 #include "pitchlab/sensors/scan_pcd.hpp"
 
 namespace pitchlab::apps {
@@ -23,14 +25,19 @@ CliArgs MergeArgs() {
       "Registers each scan against the map built from the scans before it (scan-to-map),\n"
       "merges the ones that register, and writes the voxel-downsampled map (in the first\n"
       "scan's base_link) and the trajectory CSV. Scans that fail are reported and left out.\n"
-      "Exit 0 when every scan merged, 1 when some did not (map still written), 2 on bad\n"
-      "arguments.");
-  args.Positionals("SCANS.pcd...", "scans in acquisition order", 1, 100000)
+      "Scans that carry an odometry pose (a 3DTK scan's .pose) give each registration its\n"
+      "prior; --prior-error bounds it. Exit 0 when every scan merged, 1 when some did not\n"
+      "(map still written), 2 on bad arguments.\n\n" +
+          std::string(sensors::CloudFormatsHelp()));
+  args.Positionals("SCANS...", "scans in acquisition order (any format below)", 1, 100000)
       .Option("out", "MAP.pcd", "where to write the map")
       .Option("trajectory", "FILE.csv",
               "where to write the trajectory (default: MAP_trajectory.csv)")
       .Option("config", "FILE.yaml", "registration settings in its 'registration:' section")
       .Option("voxel", "METRES", "map voxel edge", "0.1")
+      .Option("prior-error", "metres,degrees",
+              "how far each scan's odometry pose may be off since the last merged scan")
+      .Option("sensor-origin", "x,y,z", kSensorOriginHelp)
       .Flag("json", "print the per-scan results as JSON on stdout");
   return args;
 }
@@ -70,20 +77,39 @@ int RunMerge(int argc, char** argv) {
   if (args.Has("config")) config.registration = mapping::LoadRegistrationConfig(args.Get("config"));
   config.map_voxel_m = args.GetNumbers("voxel", 1)[0];
   if (!(config.map_voxel_m > 0)) throw CliError("--voxel must be > 0");
-  mapping::MapBuilder builder(config);
+  std::optional<mapping::GuessUncertainty> bound;
+  if (args.Has("prior-error")) {
+    const std::vector<double> e = args.GetNumbers("prior-error", 2);
+    if (!(e[0] >= 0 && e[1] >= 0 && std::isfinite(e[0]) && std::isfinite(e[1]))) {
+      throw CliError("--prior-error: metres and degrees must be finite and >= 0");
+    }
+    bound = mapping::GuessUncertainty{e[0], e[1]};
+  }
+  const std::optional<Eigen::Vector3d> origin = SensorOriginOption(args);
 
   const std::vector<std::string>& files = args.positionals();
   nlohmann::json steps = nlohmann::json::array();
   std::size_t failed = 0;
   std::optional<Eigen::Isometry3d> T_world_first;  // ground truth of simulated scans, if any
+  std::optional<Eigen::Isometry3d> T_odom_first;   // odometry of the first scan, if it has one
+  std::optional<mapping::MapBuilder> builder;
   for (const std::string& file : files) {
-    Result<sensors::Scan3D> scan = sensors::ReadScanPcd(file);
-    if (!scan) throw std::runtime_error(scan.error().message);
-    Result<mapping::MergeStep> step = builder.Add(mapping::CloudFromScan(*scan));
+    const sensors::Scan3D scan_read = LoadInputCloud(file, origin);
+    const sensors::Scan3D* scan = &scan_read;
+    if (!builder) {  // one sensor for the sequence: where the first scan says it sits
+      config.sensor_base = scan->sensor_origin->cast<float>();
+      builder.emplace(config);
+      if (scan->has_odometry) T_odom_first = scan->T_world_base;
+    }
+    std::optional<Eigen::Isometry3d> odometry;
+    if (T_odom_first && scan->has_odometry) odometry = T_odom_first->inverse() * scan->T_world_base;
+    Result<mapping::MergeStep> step = builder->Add(mapping::CloudFromScan(*scan), odometry,
+                                                   odometry ? bound : std::nullopt);
     if (!step) throw std::runtime_error(file + ": " + step.error().message);
     failed += step->merged ? 0 : 1;
     nlohmann::json s = {{"file", file},
                         {"merged", step->merged},
+                        {"outcome", mapping::ToString(step->registration.outcome)},
                         {"reason", step->registration.reason},
                         {"path", mapping::ToString(step->registration.path)},
                         {"inlier_ratio", step->registration.inlier_ratio},
@@ -102,7 +128,7 @@ int RunMerge(int argc, char** argv) {
     }
   }
   sensors::Scan3D map;
-  for (const Eigen::Vector3f& p : builder.MapCloud()) {
+  for (const Eigen::Vector3f& p : builder->MapCloud()) {
     sensors::ScanPoint sp;
     sp.x = p.x(), sp.y = p.y(), sp.z = p.z();
     sp.range_m = p.norm();
@@ -112,7 +138,7 @@ int RunMerge(int argc, char** argv) {
     throw std::runtime_error(written.error().message);
   }
   const std::string trajectory_path = TrajectoryPath(args, out);
-  WriteTrajectory(trajectory_path, files, builder.trajectory());
+  WriteTrajectory(trajectory_path, files, builder->trajectory());
   if (args.Flagged("json")) {
     std::cout << nlohmann::json{{"map", out},
                                 {"map_points", map.points.size()},
