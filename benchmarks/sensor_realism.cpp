@@ -76,13 +76,14 @@ struct RangeGrid {
   std::string name;
   int lines = 0, beams = 0;
   std::vector<Cell> cell;
-  std::vector<float> range;              // [m], valid cells only
-  std::vector<Eigen::Vector3d> point;    // valid cells only
-  std::vector<Eigen::Vector3d> origin;   // per line
+  std::vector<float> range;             // [m], valid cells only
+  std::vector<Eigen::Vector3d> point;   // valid cells only
+  std::vector<Eigen::Vector3d> origin;  // per line
   std::size_t Index(int l, int b) const { return static_cast<std::size_t>(l) * beams + b; }
 };
 
-// --- readers ---------------------------------------------------------------------------------------
+// --- readers
+// ---------------------------------------------------------------------------------------
 
 // A 3DTK "uos" scan: one reading a line `x y z` in cm in 3DTK's left-handed frame (x right, y up,
 // z forward), the scanner at the origin; REP-103 is x = z3, y = -x3, z = y3 (SOURCES.md). Lines of
@@ -116,8 +117,8 @@ RangeGrid ReadUos(const std::string& path) {
     }
   }
   if (p.size() % beams != 0) {
-    throw std::runtime_error(path + ": " + std::to_string(p.size()) + " readings are not whole lines of " +
-                             std::to_string(beams));
+    throw std::runtime_error(path + ": " + std::to_string(p.size()) +
+                             " readings are not whole lines of " + std::to_string(beams));
   }
   g.beams = beams;
   g.lines = static_cast<int>(p.size() / beams);
@@ -127,7 +128,7 @@ RangeGrid ReadUos(const std::string& path) {
   g.origin.assign(g.lines, Eigen::Vector3d::Zero());
   for (std::size_t i = 0; i < p.size(); ++i) {
     const double r = p[i].norm();
-    g.cell[i] = r >= kRealNoReturn_m ? Cell::kNoReturn
+    g.cell[i] = r >= kRealNoReturn_m   ? Cell::kNoReturn
                 : r <= kRealMinRange_m ? Cell::kExcluded
                                        : Cell::kValid;
     g.range[i] = static_cast<float>(r);
@@ -164,7 +165,8 @@ RangeGrid FromScan(const sensors::Scan3D& scan, const sensors::MountConfig& moun
   return g;
 }
 
-// --- statistics ------------------------------------------------------------------------------------
+// --- statistics
+// ------------------------------------------------------------------------------------
 
 int Bin(const std::vector<double>& edges, double v) {
   for (std::size_t k = 0; k + 1 < edges.size(); ++k) {
@@ -212,8 +214,7 @@ struct Accumulator {
   // Mixed pixels.
   double edges = 0, mixed = 0, line_checked = 0;
   // Floor.
-  std::vector<double> floor_tilt_deg, floor_roll_deg, floor_pitch_deg, floor_sigma_m,
-      floor_rms_m;
+  std::vector<double> floor_tilt_deg, floor_roll_deg, floor_pitch_deg, floor_sigma_m, floor_rms_m;
   std::vector<double> floor_points;
 };
 
@@ -382,9 +383,8 @@ void FloorStats(const RangeGrid& g, const std::vector<PatchFit>& fits, Accumulat
   if (cand.size() < 100) return;
   std::map<long, int> bins;
   for (const auto& p : cand) ++bins[std::lround(std::floor(p.z() / kFloorBin_m))];
-  const auto mode = std::max_element(bins.begin(), bins.end(), [](auto& a, auto& b) {
-    return a.second < b.second;
-  });
+  const auto mode = std::max_element(bins.begin(), bins.end(),
+                                     [](auto& a, auto& b) { return a.second < b.second; });
   Eigen::Vector3d n = Eigen::Vector3d::UnitZ();
   double d0 = -(mode->first + 0.5) * kFloorBin_m;  // plane n.p + d0 = 0
   std::vector<double> resid;
@@ -499,7 +499,8 @@ struct Options {
          "               [--seed S] [--sensor FILE.yaml] [--legacy]\n"
          "Prints JSON: the same statistics of the real scans (3DTK uos .3d, cm, left-handed)\n"
          "and of N simulated scans of the world (default corridor; scan k at the default start\n"
-         "moved k x 4 m along +x or the next free spot, LMS200 seed S + k), with the ratio sim / real.\n"
+         "moved k x 4 m along +x or the next free spot, LMS200 seed S + k), with the ratio sim / "
+         "real.\n"
          "--sensor: lms200/pitch_unit/scan/mount sections over the defaults.\n"
          "--legacy: the pre-issue-16 LMS200 model (constant noise, no mixed pixels, no dropouts,\n"
          "perfect mount).\n";
@@ -518,13 +519,20 @@ Options Parse(int argc, char** argv) {
       return argv[++i];
     };
     try {
-      if (a == "--real") o.real.push_back(value());
-      else if (a == "--world") o.world = value();
-      else if (a == "--sensor") o.sensor_yaml = value();
-      else if (a == "--sim-scans") o.sim_scans = std::stoi(value());
-      else if (a == "--seed") o.seed = std::stoull(value());
-      else if (a == "--legacy") o.legacy = true;
-      else if (a == "--help") Usage(0);
+      if (a == "--real")
+        o.real.push_back(value());
+      else if (a == "--world")
+        o.world = value();
+      else if (a == "--sensor")
+        o.sensor_yaml = value();
+      else if (a == "--sim-scans")
+        o.sim_scans = std::stoi(value());
+      else if (a == "--seed")
+        o.seed = std::stoull(value());
+      else if (a == "--legacy")
+        o.legacy = true;
+      else if (a == "--help")
+        Usage(0);
       else {
         std::cerr << "sensor_realism: unknown option " << a << "\n";
         Usage(2);
@@ -596,8 +604,8 @@ int main(int argc, char** argv) {
       const double sv = s.at(name);
       json row = {{"real", std::isfinite(rv) ? json(rv) : json()},
                   {"sim", std::isfinite(sv) ? json(sv) : json()}};
-      row["sim_over_real"] = (std::isfinite(rv) && std::isfinite(sv) && rv != 0) ? json(sv / rv)
-                                                                                 : json();
+      row["sim_over_real"] =
+          (std::isfinite(rv) && std::isfinite(sv) && rv != 0) ? json(sv / rv) : json();
       stats[name] = row;
     }
     json out;
