@@ -428,7 +428,6 @@ void Measure(const RangeGrid& g, Accumulator& acc) {
   DropoutStats(g, fits, acc);
   MixedPixelStats(g, acc);
   FloorStats(g, fits, acc);
-  // Returns per bin for the dropout rates are the fitted points (those that located a bin).
 }
 
 double Mean(const std::vector<double>& v) {
@@ -445,6 +444,7 @@ std::map<std::string, double> Summarize(const Accumulator& a) {
     const std::string bin = BinName(kRangeBins_m, static_cast<int>(k), "m");
     s["plane_sigma_m.range_" + bin] = RobustSigma(a.by_range[k]);
     s["plane_sigma_m.incidence_0-45deg.range_" + bin] = RobustSigma(a.by_range_low_incidence[k]);
+    // Dropout rates per bin: of the returns that located a bin (those with a plane fit).
     const double n = static_cast<double>(a.by_range[k].size());
     s["dropout_rate.range_" + bin] = a.dropouts_by_range[k] / (n + a.dropouts_by_range[k]);
   }
