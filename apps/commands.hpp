@@ -6,6 +6,8 @@ namespace pitchlab::apps {
 
 /// `pitchlab scan`: one full 3D scan of a world written as PCD.
 int RunScan(int argc, char** argv);
+/// `pitchlab convert`: a point cloud (PCD, 3DTK, PLY, XYZ) written as pitchlab's PCD.
+int RunConvert(int argc, char** argv);
 /// `pitchlab register`: Algorithm 1 on two scans.
 int RunRegister(int argc, char** argv);
 /// `pitchlab merge`: scan-to-map merging of a scan sequence.

@@ -21,6 +21,7 @@ constexpr Command kCommands[] = {
     {"run", pitchlab::apps::RunRun, "closed-loop stop-scan-go mission, scored, with a report"},
     {"bench", pitchlab::apps::RunBench, "sweep of runs over worlds x seeds: isolated, sharded, summarized"},
     {"scan", pitchlab::apps::RunScan, "one full 3D scan of a world, written as PCD"},
+    {"convert", pitchlab::apps::RunConvert, "a point cloud (PCD, 3DTK .3d, PLY, XYZ) as pitchlab's PCD"},
     {"register", pitchlab::apps::RunRegister, "align two scans (Algorithm 1), result as JSON"},
     {"merge", pitchlab::apps::RunMerge, "merge a scan sequence into one map cloud + trajectory"},
     {"map", pitchlab::apps::RunMap, "elevation map from point clouds (Eq. 2-3)"},

@@ -121,6 +121,12 @@ std::size_t FillUnknown(mapping::ElevationMap& map, const std::vector<Eigen::Vec
   return filled;
 }
 
+// The scan-to-map settings with the laser where the mount puts it (its mirror at zero pitch).
+mapping::MapConfig WithSensor(mapping::MapConfig map, const sensors::MountConfig& mount) {
+  map.sensor_base = mount.BaseToLaser(0.0).translation().cast<float>();
+  return map;
+}
+
 class Mission {
  public:
   Mission(sensors::ScanSource& source, sensors::MobileBase& base, const MissionConfig& config,
@@ -130,7 +136,7 @@ class Mission {
         config_(config),
         probes_(probes),
         observer_(observer),
-        builder_(config.registration) {}
+        builder_(WithSensor(config.registration, config.mount)) {}
 
   MissionResult Run(const Eigen::Isometry3d& T_world_start);
 

@@ -427,8 +427,15 @@ double ThreadCpuSeconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-json RunPair(const Pair& p, const mapping::RegistrationPrior& prior,
+// The simulated laser's mirror at zero pitch, in base_link: where every scan of the sample was
+// taken from.
+Eigen::Vector3f LaserInBase() {
+  return sensors::MountConfig{}.BaseToLaser(0.0).translation().cast<float>();
+}
+
+json RunPair(const Pair& p, mapping::RegistrationPrior prior,
              const mapping::RegistrationConfig& config) {
+  prior.source_sensor = prior.target_sensor = LaserInBase();
   const double cpu_start = ThreadCpuSeconds();
   Result<mapping::RegistrationResult> r =
       mapping::Register(p.target.cloud, p.source.cloud, prior, config);
@@ -440,6 +447,12 @@ json RunPair(const Pair& p, const mapping::RegistrationPrior& prior,
                       e.translation_m <= kTargetTranslation_m;
   const bool wrong = e.rotation_deg > kWrongRotation_deg || e.translation_m > kWrongTranslation_m;
   return {{"success", r->success},
+          {"outcome", mapping::ToString(r->outcome)},
+          {"length_scale", r->settings.length_scale},
+          {"noise_m", {r->target_statistics.noise_m, r->source_statistics.noise_m}},
+          {"median_range_m",
+           {r->target_statistics.median_range_m, r->source_statistics.median_range_m}},
+          {"inlier_distance_m", r->settings.inlier_distance_m},
           {"within_target", within},
           {"false_success", r->success && wrong},
           {"reason", r->reason},
@@ -545,7 +558,9 @@ json FalseSuccesses(const json& pairs, const char* key) {
 json Sequence(const std::string& world, int scans, std::mt19937_64& rng,
               const sensors::Lms200Config& lms200) {
   ScanFactory factory(world, 0.005, rng(), lms200);
-  mapping::MapBuilder builder{mapping::MapConfig{}};
+  mapping::MapConfig map_config;
+  map_config.sensor_base = LaserInBase();
+  mapping::MapBuilder builder{map_config};
   std::optional<Eigen::Isometry3d> T_world_first;
   Eigen::Vector3d last_xy(0, 0, 0);
   double heading = 0, travelled = 0, x = 0, y = 0;

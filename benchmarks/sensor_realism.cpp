@@ -25,6 +25,7 @@
 #include <Eigen/Eigenvalues>
 #include <nlohmann/json.hpp>
 
+#include "pitchlab/sensors/cloud_file.hpp"
 #include "pitchlab/sensors/sensor_config.hpp"
 #include "pitchlab/sim/sim_rig.hpp"
 
@@ -85,9 +86,10 @@ struct RangeGrid {
 // --- readers
 // ---------------------------------------------------------------------------------------
 
-// A 3DTK "uos" scan: one reading a line `x y z` in cm in 3DTK's left-handed frame (x right, y up,
-// z forward), the scanner at the origin; REP-103 is x = z3, y = -x3, z = y3 (SOURCES.md). Lines of
-// the pitch sweep are found where the beam's azimuth jumps back to the start of the fan; every line
+// A 3DTK "uos" scan in reading order: one reading a line `x y z` in cm in 3DTK's left-handed frame,
+// the scanner at the origin, converted to REP-103 metres by sensors::PointFrom3dtk. Not
+// sensors::Read3dtkScan: that keeps the returns only, and these statistics need every reading in
+// its place on the grid, no-returns and the robot's own body included. Lines of the pitch sweep are found where the beam's azimuth jumps back to the start of the fan; every line
 // must have as many readings as the first.
 RangeGrid ReadUos(const std::string& path) {
   std::ifstream in(path);
@@ -101,7 +103,7 @@ RangeGrid ReadUos(const std::string& path) {
     if (!(ls >> x3 >> y3 >> z3) || !std::isfinite(x3 + y3 + z3)) {
       throw std::runtime_error(path + ":" + std::to_string(line_no) + ": not 'x y z'");
     }
-    p.emplace_back(z3 / 100.0, -x3 / 100.0, y3 / 100.0);
+    p.push_back(sensors::PointFrom3dtk(Eigen::Vector3d(x3, y3, z3)));
     azimuth.push_back(std::atan2(p.back().y(), std::hypot(p.back().x(), p.back().z())));
   }
   if (p.empty()) throw std::runtime_error(path + ": no readings");

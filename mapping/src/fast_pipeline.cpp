@@ -309,7 +309,8 @@ IcpResult PointToPlaneLm(const IcpTarget& target, const PointCloud& source,
   for (int iter = 0; iter < config.icp_max_iterations; ++iter) {
     FindPairs(target, source, result.T_target_source, static_cast<float>(gate), pairs);
     if (pairs.size() < 6) break;
-    const double huber = std::max(0.02, gate / 5);
+    // 2 cm at the robot's scale: above the LMS200's range noise, so correct pairs keep full weight.
+    const double huber = std::max(0.02 * config.length_scale, gate / 5);
     auto weight = [huber](double r) { return std::fabs(r) <= huber ? 1.0 : huber / std::fabs(r); };
     Matrix6d H = Matrix6d::Zero();
     Vector6d g = Vector6d::Zero();
@@ -359,6 +360,8 @@ IcpResult PointToPlaneLm(const IcpTarget& target, const PointCloud& source,
   result.fitness_m2 = score.fitness_m2;
   result.inlier_ratio = score.inlier_ratio;
   result.degeneracy = score.degeneracy;
+  result.hessian = score.hessian;
+  result.inliers = score.inliers;
   return result;
 }
 
@@ -377,7 +380,11 @@ std::pair<Eigen::Matrix3d, Eigen::Matrix3d> ScorePairs(const IcpTarget& target,
   for (const Pair& q : pairs) centroid += q.p;
   if (!pairs.empty()) centroid /= static_cast<double>(pairs.size());
   double sq_plane = 0, sq_point = 0;
+  out.hessian.setZero();
   for (const Pair& q : pairs) {
+    Eigen::Matrix<double, 6, 1> J;
+    J << q.p.cross(q.n), q.n;
+    out.hessian += J * J.transpose();
     const double r = q.n.dot(q.p - q.t);
     sq_plane += r * r;
     sq_point += (q.p - q.t).squaredNorm();
@@ -386,6 +393,7 @@ std::pair<Eigen::Matrix3d, Eigen::Matrix3d> ScorePairs(const IcpTarget& target,
     Cr += m * m.transpose();
   }
   out.T_target_source = T;
+  out.inliers = static_cast<int>(pairs.size());
   out.inlier_ratio = source.empty() ? 0.0 : static_cast<double>(pairs.size()) / source.size();
   out.rmse_m = pairs.empty() ? 0.0 : std::sqrt(sq_plane / pairs.size());
   out.fitness_m2 = pairs.empty() ? 0.0 : sq_point / pairs.size();

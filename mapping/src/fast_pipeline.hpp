@@ -80,6 +80,12 @@ struct IcpResult {
   Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();
   int iterations = 0;
   double rmse_m = 0, fitness_m2 = 0, inlier_ratio = 0, degeneracy = 0;
+  /// Sum of J J^T over the inlier pairs, J = d(residual)/d(omega, v) = (p x n, n): the
+  /// point-to-plane Gauss-Newton Hessian of a perturbation T <- Exp(omega, v) T in the target
+  /// frame (rotation first) [unitless / m / m^2 blocks]; divided by the residual's variance it is
+  /// the pose's information.
+  Eigen::Matrix<double, 6, 6> hessian = Eigen::Matrix<double, 6, 6>::Zero();
+  int inliers = 0;  ///< inlier pairs the scores were computed over [1]
 };
 
 /// Directions the scene constrains weakly (orthonormal unit vectors in the target frame, weakest

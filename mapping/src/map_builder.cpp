@@ -68,6 +68,7 @@ Result<MergeStep> MapBuilder::Add(const PointCloud& cloud_base,
     trajectory_.push_back({step.scan_index, Eigen::Isometry3d::Identity()});
     step.merged = true;
     step.registration.success = true;
+    step.registration.outcome = RegistrationOutcome::kSuccess;
     step.registration.reason = "first scan: defines the map frame";
     return step;
   }
@@ -81,6 +82,7 @@ Result<MergeStep> MapBuilder::Add(const PointCloud& cloud_base,
   }
   prior.previous_motion = last_motion_ ? *last_motion_ : Eigen::Isometry3d::Identity();
   prior.target_scan = &last_scan_;  // the map was seen from many places; free space from one
+  prior.source_sensor = prior.target_sensor = config_.sensor_base;  // target: the last base_link
   Result<RegistrationResult> r =
       Register(LocalTarget(T_map_last), cloud_base, prior, config_.registration);
   if (!r) return tl::make_unexpected(r.error());

@@ -1,10 +1,13 @@
 #include "pitchlab/mapping/registration_config.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <functional>
 #include <map>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
 #include <yaml-cpp/yaml.h>
 
@@ -34,9 +37,16 @@ std::string FeatureName(FeatureKind f) {
   return "?";
 }
 
+// The settings that may be `auto` (kAuto).
+bool MayBeAuto(const std::string& key) {
+  return key == "length_scale" || key == "inlier_distance_m" || key == "max_rmse_m" ||
+         key == "free_space_margin_m";
+}
+
 // One handler per key; visits every field of the config (so reading and writing cannot diverge).
 template <typename Visitor>
 void VisitFields(RegistrationConfig& c, Visitor&& v) {
+  v("length_scale", c.length_scale);
   v("icp_voxel_m", c.icp_voxel_m);
   v("feature_voxel_m", c.feature_voxel_m);
   v("normal_radius_m", c.normal_radius_m);
@@ -74,7 +84,31 @@ void VisitFields(RegistrationConfig& c, Visitor&& v) {
   v("inlier_distance_m", c.inlier_distance_m);
   v("min_inlier_ratio", c.min_inlier_ratio);
   v("max_rmse_m", c.max_rmse_m);
+  v("free_space_margin_m", c.free_space_margin_m);
 }
+
+// The length settings (metres), all multiplied by length_scale.
+template <typename Visitor>
+void VisitLengths(RegistrationConfig& c, Visitor&& v) {
+  for (double* length :
+       {&c.icp_voxel_m, &c.feature_voxel_m, &c.normal_radius_m, &c.icp_normal_radius_m,
+        &c.feature_radius_m, &c.narf_noise_level_m, &c.narf_support_m, &c.sac_inlier_m,
+        &c.degeneracy_probe_m, &c.degeneracy_search_m, &c.guess_search_m, &c.carry_max_m,
+        &c.icp_max_distance_m, &c.icp_min_distance_m, &c.constraint_translation_m,
+        &c.inlier_distance_m, &c.max_rmse_m, &c.free_space_margin_m}) {
+    v(*length);
+  }
+}
+
+// The data the defaults were set on (see RegistrationConfig::length_scale): their noise as
+// MeasureCloud measures it [m] and their median range [m], each the geometric middle of what
+// simulated and real LMS scans measure.
+constexpr double kReferenceNoise_m = 0.0034;
+constexpr double kReferenceRange_m = 2.0;
+// Noise below this fraction of the median range is a float's rounding, not a sensor's: synthetic.
+constexpr double kNoiseFloor = 1e-4;
+
+double Decade(double ratio) { return std::pow(10.0, std::round(std::log10(ratio))); }
 
 void ReadEnums(const std::string& key, const YAML::Node& n, RegistrationConfig& c,
                const std::string& source) {
@@ -108,6 +142,13 @@ void RegistrationConfig::Validate() const {
       throw std::invalid_argument(os.str());
     }
   };
+  auto positive_or_auto = [&](double v, const char* field) {
+    require(std::isnan(v) || (v > 0 && std::isfinite(v)), field, v, "must be > 0 or auto");
+  };
+  positive_or_auto(length_scale, "length_scale");
+  positive_or_auto(inlier_distance_m, "inlier_distance_m");
+  positive_or_auto(max_rmse_m, "max_rmse_m");
+  positive_or_auto(free_space_margin_m, "free_space_margin_m");
   require(icp_voxel_m > 0, "icp_voxel_m", icp_voxel_m, "must be > 0");
   require(feature_voxel_m > 0, "feature_voxel_m", feature_voxel_m, "must be > 0");
   require(normal_radius_m > 0, "normal_radius_m", normal_radius_m, "must be > 0");
@@ -154,10 +195,33 @@ void RegistrationConfig::Validate() const {
           "must be > 0");
   require(constraint_rotation_deg > 0 && constraint_rotation_deg <= 180, "constraint_rotation_deg",
           constraint_rotation_deg, "must be in (0, 180]");
-  require(inlier_distance_m > 0, "inlier_distance_m", inlier_distance_m, "must be > 0");
   require(min_inlier_ratio >= 0 && min_inlier_ratio <= 1, "min_inlier_ratio", min_inlier_ratio,
           "must be in [0, 1]");
-  require(max_rmse_m > 0, "max_rmse_m", max_rmse_m, "must be > 0");
+}
+
+RegistrationConfig RegistrationConfig::Resolve(const CloudStatistics& source,
+                                               const CloudStatistics& target) const {
+  RegistrationConfig r = *this;
+  if (std::isnan(r.length_scale)) {
+    if (source.noise_m > kNoiseFloor * source.median_range_m) {
+      r.length_scale = Decade(std::sqrt(source.noise_m / kReferenceNoise_m *
+                                        source.median_range_m / kReferenceRange_m));
+    } else if (source.median_range_m > 0) {
+      r.length_scale = Decade(source.median_range_m / kReferenceRange_m);
+    } else {
+      r.length_scale = 1.0;
+    }
+  }
+  VisitLengths(r, [&](double& length) {
+    if (!std::isnan(length)) length *= r.length_scale;
+  });
+  const double noise = std::hypot(source.noise_m, target.noise_m);
+  if (std::isnan(r.inlier_distance_m)) r.inlier_distance_m = std::max(r.icp_voxel_m, 3 * noise);
+  if (std::isnan(r.max_rmse_m)) r.max_rmse_m = r.inlier_distance_m / std::sqrt(3.0);
+  if (std::isnan(r.free_space_margin_m)) {
+    r.free_space_margin_m = std::max(0.1 * r.length_scale, 3 * noise);
+  }
+  return r;
 }
 
 RegistrationConfig ParseRegistrationConfig(const std::string& yaml_text,
@@ -176,8 +240,16 @@ RegistrationConfig ParseRegistrationConfig(const std::string& yaml_text,
   std::map<std::string, std::function<void(const YAML::Node&)>> handlers;
   VisitFields(config, [&](const char* key, auto& field) {
     handlers[key] = [&field, key, &source](const YAML::Node& n) {
+      using Field = std::decay_t<decltype(field)>;
+      if constexpr (std::is_same_v<Field, double>) {
+        if (n.IsScalar() && n.Scalar() == "auto") {
+          if (!MayBeAuto(key)) Throw(source, key, "cannot be auto");
+          field = kAuto;
+          return;
+        }
+      }
       try {
-        field = n.as<std::decay_t<decltype(field)>>();
+        field = n.as<Field>();
       } catch (const YAML::Exception&) {
         Throw(source, key,
               "has the wrong type ('" + (n.IsScalar() ? n.Scalar() : "<non-scalar>") + "')");
@@ -217,8 +289,16 @@ std::string RegistrationConfigToYaml(const RegistrationConfig& config) {
   out << YAML::Key << "backend" << YAML::Value << BackendName(config.backend);
   out << YAML::Key << "features" << YAML::Value << FeatureName(config.features);
   RegistrationConfig copy = config;
-  VisitFields(
-      copy, [&](const char* key, auto& field) { out << YAML::Key << key << YAML::Value << field; });
+  VisitFields(copy, [&](const char* key, auto& field) {
+    out << YAML::Key << key << YAML::Value;
+    if constexpr (std::is_same_v<std::decay_t<decltype(field)>, double>) {
+      if (std::isnan(field)) {
+        out << "auto";
+        return;
+      }
+    }
+    out << field;
+  });
   out << YAML::EndMap << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }

@@ -10,8 +10,10 @@ constexpr float kPi = 3.14159265358979323846f;
 constexpr float kNone = std::numeric_limits<float>::infinity();
 }  // namespace
 
-SeenSpace::SeenSpace(const PointCloud& scan, const Eigen::Vector3f& sensor, double bin_deg)
+SeenSpace::SeenSpace(const PointCloud& scan, const Eigen::Vector3f& sensor, double bin_deg,
+                     const SeenMargins& margins)
     : sensor_(sensor),
+      margins_(margins),
       bin_rad_(static_cast<float>(bin_deg) * kPi / 180.0f),
       rows_(static_cast<int>(std::ceil(kPi / bin_rad_))),
       cols_(static_cast<int>(std::ceil(2 * kPi / bin_rad_))),
@@ -43,7 +45,7 @@ int SeenSpace::Violations(const PointCloud& cloud, const Eigen::Isometry3d& T_sc
     const float r = d.norm();
     int row = 0, col = 0;
     // The poles' rows have no neighbours above or below: they say nothing.
-    if (r < kMinRange_m || !Bin(d, row, col) || row == 0 || row == rows_ - 1) continue;
+    if (r < margins_.min_range_m || !Bin(d, row, col) || row == 0 || row == rows_ - 1) continue;
     float nearest = kNone;
     bool seen = true;
     for (int dr = -1; dr <= 1 && seen; ++dr) {
@@ -54,7 +56,7 @@ int SeenSpace::Violations(const PointCloud& cloud, const Eigen::Isometry3d& T_sc
         nearest = std::min(nearest, n);
       }
     }
-    if (seen && r < nearest - kMargin_m - kMarginFraction * r) ++violations;
+    if (seen && r < nearest - margins_.margin_m - margins_.margin_fraction * r) ++violations;
   }
   return violations;
 }

@@ -50,6 +50,9 @@ Scan3D AssembleScan(std::vector<LaserLine> lines, const MountConfig& mount,
   Scan3D scan;
   scan.deskewed = !attitudes.empty();
   scan.deskew_max_rad = MaxTurnToLast(attitudes);
+  // The mirror at zero pitch: as the laser nods it swings on its arm from the pitch axis (9 cm by
+  // default, so a few cm over the sweep), negligible against ray lengths of metres.
+  scan.sensor_origin = mount.t_base_mount_m + mount.t_mount_laser_m;
   if (!lines.empty()) {
     scan.stamp_s = lines.front().stamp_s;
     const LaserLine& last = lines.back();

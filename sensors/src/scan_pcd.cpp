@@ -6,9 +6,16 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <locale>
+#include <optional>
+#include <sstream>
 
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/io/pcd_io.h>
+
+#include "cloud_text.hpp"
+#include "pitchlab/sensors/cloud_file.hpp"
 
 namespace pitchlab::sensors {
 namespace {
@@ -55,6 +62,54 @@ pcl::PCLPointCloud2 ToCloud2(const Scan3D& scan) {
   return cloud;
 }
 
+// pitchlab's header comments (PCL's reader skips lines starting with '#'): where the sensor stood
+// and what the VIEWPOINT pose is.
+constexpr const char* kOriginKey = "# sensor_origin";
+constexpr const char* kPoseKey = "# pose";
+
+std::string HeaderComments(const Scan3D& scan) {
+  std::ostringstream os;
+  os.imbue(std::locale::classic());
+  os.precision(17);  // doubles round-trip
+  if (scan.sensor_origin) {
+    const Eigen::Vector3d& o = *scan.sensor_origin;
+    os << kOriginKey << ' ' << o.x() << ' ' << o.y() << ' ' << o.z() << '\n';
+  }
+  const char* pose = scan.has_truth ? "truth" : scan.has_odometry ? "odometry" : "unknown";
+  os << kPoseKey << ' ' << pose << '\n';
+  return os.str();
+}
+
+struct Comments {
+  std::optional<Eigen::Vector3d> sensor_origin;
+  std::optional<std::string> pose;
+};
+
+// Our comment lines among the header's (up to the DATA line).
+Result<Comments> ReadComments(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  Comments c;
+  for (std::string line; std::getline(in, line) && line.rfind("DATA", 0) != 0;) {
+    const std::vector<std::string_view> f = detail::SplitFields(line);
+    if (line.rfind(kOriginKey, 0) == 0 && f.size() >= 2 && f[1] == "sensor_origin") {
+      Eigen::Vector3d o;
+      for (int i = 0; i < 3; ++i) {
+        const std::optional<double> v =
+            f.size() == 5 ? detail::ParseNumber(f[2 + i]) : std::nullopt;
+        if (!v || !std::isfinite(*v)) {
+          return Fail(Error::Code::kInvalidArgument,
+                      "PCD '" + path + "': '" + line + "' is not 'sensor_origin x y z' [m]");
+        }
+        o[i] = *v;
+      }
+      c.sensor_origin = o;
+    } else if (line.rfind(kPoseKey, 0) == 0 && f.size() == 3 && f[1] == "pose") {
+      c.pose = std::string(f[2]);
+    }
+  }
+  return c;
+}
+
 }  // namespace
 
 Result<void> WriteScanPcd(const Scan3D& scan, const std::string& path) {
@@ -65,11 +120,22 @@ Result<void> WriteScanPcd(const Scan3D& scan, const std::string& path) {
   const Eigen::Vector3d t = scan.T_world_base.translation();
   const Eigen::Quaterniond q(scan.T_world_base.rotation());
   const Eigen::Vector4f origin(float(t.x()), float(t.y()), float(t.z()), 0.0f);
-  pcl::PCDWriter writer;
-  if (writer.writeBinary(tmp.string(), ToCloud2(scan), origin, q.cast<float>()) != 0) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    return Fail(Error::Code::kFailed, "cannot write PCD '" + path + "'");
+  const pcl::PCLPointCloud2 cloud = ToCloud2(scan);
+  // PCL's writer has no place for comments: its header, our lines after its first (comment) line.
+  std::string header = pcl::PCDWriter().generateHeaderBinary(cloud, origin, q.cast<float>());
+  header.insert(header.find('\n') + 1, HeaderComments(scan));
+  header += "DATA binary\n";  // generateHeaderBinary stops before it, as writeBinary adds it
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out.write(header.data(), static_cast<std::streamsize>(header.size()));
+    out.write(reinterpret_cast<const char*>(cloud.data.data()),
+              static_cast<std::streamsize>(cloud.data.size()));
+    out.close();
+    if (!out) {
+      std::error_code ignored;
+      fs::remove(tmp, ignored);
+      return Fail(Error::Code::kFailed, "cannot write PCD '" + path + "'");
+    }
   }
   std::error_code ec;
   fs::rename(tmp, target, ec);
@@ -147,7 +213,24 @@ Result<Scan3D> ReadScanPcd(const std::string& path) {
   scan.T_world_base = Eigen::Isometry3d::Identity();
   scan.T_world_base.translate(origin.head<3>().cast<double>());
   scan.T_world_base.rotate(orientation.cast<double>().normalized());
-  scan.has_truth = !scan.T_world_base.isApprox(Eigen::Isometry3d::Identity());
+  Result<Comments> comments = ReadComments(path);
+  if (!comments) return tl::make_unexpected(comments.error());
+  if (comments->pose) {
+    scan.has_truth = *comments->pose == "truth";
+    scan.has_odometry = *comments->pose == "odometry";
+  } else {  // a PCD from elsewhere (or from pitchlab before the comment): simulation's convention
+    scan.has_truth = !scan.T_world_base.isApprox(Eigen::Isometry3d::Identity());
+  }
+  if (comments->sensor_origin) {
+    scan.sensor_origin = comments->sensor_origin;
+  } else if (!comments->pose) {
+    // A PCD from elsewhere: the PCD convention, VIEWPOINT is the acquisition viewpoint, so the
+    // sensor stood at the origin of the points' frame.
+    scan.sensor_origin = Eigen::Vector3d::Zero();
+  }  // else ours, written without an origin (a merged map): it stays unknown
+  // Ranges stay as the scanner measured them (from the mirror as it pitched); a file without a
+  // range field gets each point's distance from the sensor.
+  if (orange < 0 && scan.sensor_origin) SetSensorOrigin(scan, *scan.sensor_origin);
   return scan;
 }
 

@@ -12,6 +12,13 @@ namespace {
 using testing::SimulatedScan;
 
 constexpr double kMaxRotationError_deg = 0.5;
+
+// Scan-to-map settings with the simulated laser where the default mount puts it.
+MapConfig SimConfig() {
+  MapConfig config;
+  config.sensor_base = sensors::MountConfig{}.BaseToLaser(0.0).translation().cast<float>();
+  return config;
+}
 constexpr double kMaxTranslationError_m = 0.03;
 
 struct Pose2 {
@@ -21,7 +28,7 @@ const Pose2 kOfficePath[] = {
     {-8, 0, 0}, {-7.4, 0.2, 8}, {-6.8, 0.3, 15}, {-6.2, 0.2, 10}, {-5.6, 0.0, 0}};
 
 TEST(MapBuilder, AnOfficeSequenceFollowsTheGroundTruthAndGrowsTheMap) {
-  MapBuilder builder{MapConfig{}};
+  MapBuilder builder{SimConfig()};
   std::vector<sensors::Scan3D> scans;
   std::size_t map_points = 0;
   for (std::size_t i = 0; i < std::size(kOfficePath); ++i) {
@@ -53,7 +60,7 @@ TEST(MapBuilder, AMeasuredTiltGivenInTheMapFrameHoldsNoCorrectResult) {
   const Eigen::Isometry3d tilts[] = {PoseFromXyzRpyDeg(0, 0, 0, 0, 8, 0),
                                      PoseFromXyzRpyDeg(0, 0, 0, 8, 0, 0),
                                      PoseFromXyzRpyDeg(0, 0, 0, -5, -4, 0)};
-  MapBuilder builder{MapConfig{}};
+  MapBuilder builder{SimConfig()};
   std::vector<Eigen::Isometry3d> truths;  // T_world_base of each tilted scan
   Eigen::Vector3d up_map = Eigen::Vector3d::UnitZ();
   for (std::size_t i = 0; i < std::size(tilts); ++i) {
@@ -83,7 +90,7 @@ TEST(MapBuilder, AMeasuredTiltGivenInTheMapFrameHoldsNoCorrectResult) {
 }
 
 TEST(MapBuilder, AScanFromAnotherWorldIsReportedAndNotMerged) {
-  MapBuilder builder{MapConfig{}};
+  MapBuilder builder{SimConfig()};
   ASSERT_TRUE(builder.Add(CloudFromScan(SimulatedScan("office", -8, 0, 0, 10))));
   const std::size_t before = builder.MapCloud().size();
   Result<MergeStep> step = builder.Add(CloudFromScan(SimulatedScan("terrain", 0, 0, 0)));
@@ -97,7 +104,7 @@ TEST(MapBuilder, AScanFromAnotherWorldIsReportedAndNotMerged) {
 }
 
 TEST(MapBuilder, AnEmptyFirstScanIsAnError) {
-  MapBuilder builder{MapConfig{}};
+  MapBuilder builder{SimConfig()};
   Result<MergeStep> step = builder.Add({});
   ASSERT_FALSE(step);
   EXPECT_EQ(step.error().code, Error::Code::kInvalidArgument);

@@ -37,7 +37,7 @@ TEST(SeenSpace, OnTheWallBehindItOrWithinTheMarginIsNoViolation) {
   const SeenSpace seen(TwoWalls(), Eigen::Vector3f::Zero(), kBin_deg);
   EXPECT_EQ(ViolationsOf(seen, {5.0f, 0.0f, 0.5f}), 0);  // on the wall
   EXPECT_EQ(ViolationsOf(seen, {7.0f, 0.0f, 0.5f}), 0);  // occluded by it
-  // Within kMargin_m + kMarginFraction x range (0.1 + 0.03 x 4.8 m) of the wall.
+  // Within the default margin_m + margin_fraction x range (0.1 + 0.03 x 4.8 m) of the wall.
   EXPECT_EQ(ViolationsOf(seen, {4.8f, 0.0f, 0.5f}), 0);
   EXPECT_EQ(ViolationsOf(seen, {4.7f, 0.0f, 0.5f}), 1);
 }
@@ -49,7 +49,7 @@ TEST(SeenSpace, WhereTheScanSawNothingOrTooNearItSaysNothing) {
   // Towards the wall's top edge: the bin has a return, the one above does not.
   EXPECT_EQ(ViolationsOf(seen, {2.5f, 0.0f, 0.995f}), 0);
   EXPECT_EQ(ViolationsOf(seen, {2.5f, 0.0f, 0.9f}), 1);
-  EXPECT_EQ(ViolationsOf(seen, {1.2f, 0.0f, 0.1f}), 0);  // nearer than kMinRange_m
+  EXPECT_EQ(ViolationsOf(seen, {1.2f, 0.0f, 0.1f}), 0);  // nearer than the default min_range_m
   EXPECT_EQ(ViolationsOf(seen, {0.0f, 0.0f, 0.0f}), 0);  // the sensor itself
 }
 

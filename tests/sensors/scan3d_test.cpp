@@ -138,6 +138,14 @@ TEST(AssembleScan, DeskewedByTheSensedAttitudeFlatGroundIsFlat) {
   EXPECT_LT(deskewed_worst_m, 1e-5);  // float ranges and points
 }
 
+TEST(AssembleScan, SensorOriginIsTheMirrorAtZeroPitch) {
+  // SeedMount: pitch axis at (0.10, 0, 0.45), mirror 0.09 above it: where a zero-pitch beam starts.
+  const Scan3D scan = AssembleScan({}, SeedMount());
+  ASSERT_TRUE(scan.sensor_origin);
+  EXPECT_TRUE(scan.sensor_origin->isApprox(Eigen::Vector3d(0.10, 0.0, 0.54), kPointTolerance_m));
+  EXPECT_TRUE(BeamPointInBase(0.0, 0.0, 0.0, SeedMount()).isApprox(*scan.sensor_origin));
+}
+
 TEST(AssembleScan, RejectsAttitudesThatAreNotOnePerLine) {
   const MountConfig mount = SeedMount();
   RockedSweep sweep = SweepFlatGroundWhileRocking(mount);

@@ -6,8 +6,10 @@
 #include <optional>
 #include <string>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
+#include "pitchlab/mapping/cloud_statistics.hpp"
 #include "pitchlab/mapping/point_cloud.hpp"
 #include "pitchlab/mapping/registration_config.hpp"
 #include "pitchlab/sensors/result.hpp"
@@ -23,6 +25,16 @@ enum class RegistrationPath {
 
 /// "features", "odometry", "fallback".
 const char* ToString(RegistrationPath path);
+
+/// What a registration concluded.
+enum class RegistrationOutcome {
+  kSuccess,    ///< one pose, determined by the scans (or a trusted guess along what they leave free)
+  kAmbiguous,  ///< the scans fit distinct poses comparably (a corridor's axis) and nothing decides
+  kFailure,    ///< no acceptable fit (no overlap, constraint or tilt violated, bad fit)
+};
+
+/// "success", "ambiguous", "failure".
+const char* ToString(RegistrationOutcome outcome);
 
 /// How far a guess may be off the true motion at most (e.g. odometry's drift over the step).
 struct GuessUncertainty {
@@ -51,6 +63,9 @@ struct RegistrationPrior {
   /// more than tolerance_deg from it is re-run with roll and pitch held at the guess's (x, y, z
   /// and the turn about up stay free), and the result says so; any result beyond it is rejected.
   std::optional<MeasuredTilt> tilt;
+  /// Where each cloud's sensor (the laser's mirror) stood, in that cloud's frame [m]: normals face
+  /// it, and free space is what lies between it and a return. Unset: at the frame's origin.
+  std::optional<Eigen::Vector3f> source_sensor, target_sensor;
   /// The one scan the target's sensor took at the target frame's origin, in that frame, when the
   /// target is not that scan itself (a map built from many, whose points were seen from elsewhere).
   /// Where fits cannot decide along a weakly constrained direction (a street, the heading on a
@@ -65,10 +80,13 @@ struct StageTimings {
          total_s = 0;
 };
 
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
 /// Outcome of one registration. `success` false means: do not merge; `reason` says why.
 struct RegistrationResult {
   Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();  ///< maps source into target
-  bool success = false;
+  bool success = false;  ///< outcome == kSuccess
+  RegistrationOutcome outcome = RegistrationOutcome::kFailure;
   std::string reason;  ///< why it failed, or how it succeeded ("features", notes)
   RegistrationPath path = RegistrationPath::kFeatures;
   double fitness_m2 = 0;    ///< mean squared distance of inlier pairs (PCL's fitness) [m^2]
@@ -78,6 +96,20 @@ struct RegistrationResult {
   int sac_inliers = 0;      ///< correspondences agreeing with the initial alignment [1]
   int iterations = 0;       ///< ICP iterations run [1]
   StageTimings timings;
+
+  /// Observability of T_target_source, for a perturbation T <- Exp(omega, v) T applied in the
+  /// target frame, ordered (omega_x, omega_y, omega_z [rad], v_x, v_y, v_z [m]). `information`:
+  /// the final ICP's point-to-plane Gauss-Newton Hessian over its inlier pairs divided by the
+  /// residual's variance (rmse_m^2). `covariance`: its inverse, where a direction the scans leave
+  /// (nearly) free, or that was kept at a guess, takes the guess's bound instead (the prior's error
+  /// bound, else the geometric constraint's limit): a pose taken from a guess is only as good as
+  /// the guess. Both are zero when no ICP result was scored.
+  Matrix6d information = Matrix6d::Zero();
+  Matrix6d covariance = Matrix6d::Zero();
+  /// What the clouds measured (scale, spacing, noise) and the settings they resolved to: every
+  /// `auto` of the config replaced by its value (RegistrationConfig::Resolve).
+  CloudStatistics source_statistics, target_statistics;
+  RegistrationConfig settings;
 };
 
 /// Aligns `source` to `target` (both [m], each in its own base_link). Bad input (empty, non-finite

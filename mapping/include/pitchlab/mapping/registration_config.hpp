@@ -2,9 +2,16 @@
 // Settings of the registration pipeline (Algorithm 1), one plain aggregate loadable from the YAML
 // section `registration:`. Lengths in metres, angles in degrees (user boundary), as named.
 
+#include <limits>
 #include <string>
 
+#include "pitchlab/mapping/cloud_statistics.hpp"
+
 namespace pitchlab::mapping {
+
+/// The value of a setting left to the data (`auto` in YAML): Register() derives it from what the
+/// clouds measure (RegistrationConfig::Resolve) and reports the value it used.
+inline constexpr double kAuto = std::numeric_limits<double>::quiet_NaN();
 
 /// Which implementation runs the feature, initial-alignment and ICP stages.
 enum class RegistrationBackend {
@@ -20,9 +27,26 @@ enum class FeatureKind {
 };
 
 /// Every knob of Register(); defaults suit a 72k-point LMS200 scan indoors and outdoors.
+///
+/// Lengths [m] are given for a ground robot's laser scan (an LMS200's: noise about 3 mm) and
+/// multiplied by `length_scale`, which `auto` derives from the data: a scene an order of
+/// magnitude smaller or larger (an object on a turntable, a scaled model) scales every length
+/// with it. The acceptance gates left `auto` follow the measured noise (mapping/README.md).
 struct RegistrationConfig {
   RegistrationBackend backend = RegistrationBackend::kFast;
   FeatureKind features = FeatureKind::kFpfh;
+
+  /// Multiplies every length setting below [1]. auto: 10^round(log10(sqrt(n / 3.4 mm x R / 2 m))),
+  /// n the noise and R the median range the source measures (CloudStatistics): two independent
+  /// estimates of the data's scale, the sensor's and the scene's. Either alone varies too much
+  /// within one sensor's data: simulated LMS200 scans measure n = 2.0-5.8 mm (5 and 10 mm range
+  /// noise, taken normal to the surface) and R = 0.4 m (facing a wall) to 3.8 m (a street), a
+  /// smeared scan n = 40 mm; real nodding-SICK scans n = 3.0-3.3 mm, R = 1.45-1.87 m. Their
+  /// geometric mean keeps all of these within a factor of 3 of 1, so they resolve to 1, and only
+  /// data a decade off change scale (a scene scaled by 0.01 or 10 resolves to exactly 0.01 or 10;
+  /// a 0.15 m object scanned to 0.3 mm, to 0.1). A cloud without noise (below 1e-4 of R:
+  /// synthetic) is scaled by R / 2 m alone.
+  double length_scale = kAuto;
 
   // Voxel grid (paper: downsampling factor 5-10).
   double icp_voxel_m = 0.1;      ///< voxel edge of the clouds ICP aligns [m]
@@ -103,17 +127,33 @@ struct RegistrationConfig {
   double constraint_translation_m = 2.5;   ///< result within this of the prior, when given [m]
   double constraint_rotation_deg = 35.0;   ///< ... and within this rotation of it [deg]
   bool constant_velocity_fallback = true;  ///< use the previous motion when alignment fails
-  double inlier_distance_m = 0.1;  ///< a source point is an inlier within this of the target [m]
+  /// A source point is an inlier within this of the target [m]. auto: the larger of icp_voxel_m
+  /// (two samplings of one surface, each reduced to a centroid per voxel, lie up to a voxel apart)
+  /// and three standard deviations of the pair's measured noise (CloudStatistics::noise_m of
+  /// both clouds, in quadrature).
+  double inlier_distance_m = kAuto;
   double min_inlier_ratio = 0.3;   ///< fewer inliers: failure (no overlap / misaligned) [1]
-  /// Inlier RMS point-to-plane error above this: failure (the scans do not fit together). In
-  /// registration_eval (--targets 25: 1000 runs, 5 and 10 mm range noise) the 885 correct
-  /// alignments measured 7 mm median, 23 mm at most; the 11 wrong poses that passed 8-16 mm (they
-  /// are left to the degeneracy checks and the constraint). 17 mm rejected 4 correct target pairs
-  /// and no wrong pose there [m].
-  double max_rmse_m = 0.03;
+  /// Inlier RMS point-to-plane error above this: failure (the scans do not fit together) [m].
+  /// auto: inlier_distance_m / sqrt(3), the RMS of residuals spread evenly across the inlier band:
+  /// a fit no better than chance. Why not tighter: the residual does not tell a wrong pose from
+  /// the truth (registration_eval, 5 and 10 mm noise: correct alignments 7 mm median, 23 mm at
+  /// most; wrong poses that passed 8-16 mm), and real scans that fit at the reference pose leave
+  /// 24-34 mm where their local noise is 3 mm: a nodding scanner's calibration bends each scan a
+  /// little differently, which no noise measured within one scan shows (mapping/README.md).
+  double max_rmse_m = kAuto;
+  /// A point another pose puts this much nearer its sensor than the target scan saw in that
+  /// direction (plus 3 % of its range) lies where the target saw through [m]. auto: the larger
+  /// of 0.1 m (the LMS200's 9 cm mirror offset from the pitch axis moves a ray's origin by that
+  /// much) and three standard deviations of the pair's noise.
+  double free_space_margin_m = kAuto;
 
-  /// Throws std::invalid_argument naming the field and value.
+  /// Throws std::invalid_argument naming the field and value (kAuto is valid where allowed).
   void Validate() const;
+
+  /// The settings for one pair: length_scale resolved from `source` (else kept), every length
+  /// multiplied by it, and the gates left auto derived from both clouds' noise. Nothing of the
+  /// result is kAuto.
+  RegistrationConfig Resolve(const CloudStatistics& source, const CloudStatistics& target) const;
 };
 
 /// Reads the section `registration` of a YAML document over the defaults (other sections are left

@@ -2,6 +2,7 @@
 // A 3D scan from one pitch sweep, and Eq. 1: how a reading becomes a point in base_link.
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -53,9 +54,14 @@ struct Scan3D {
   /// The largest rotation of the base between a line and the last one an attitude sensor sensed,
   /// also when it was too small to correct (PitchingScanSource); 0 without a sensor [rad].
   double deskew_max_rad = 0.0;
-  bool has_truth = false;  ///< T_world_base below is the simulator's ground truth
-  /// Pose of the points' frame: base_link when the scan started (at its end when deskewed).
+  bool has_truth = false;     ///< T_world_base below is the simulator's ground truth
+  bool has_odometry = false;  ///< T_world_base below is the robot's odometry (e.g. a 3DTK .pose)
+  /// Pose of the points' frame: base_link when the scan started (at its end when deskewed). Known
+  /// when has_truth or has_odometry; otherwise whatever the file held (identity when nothing).
   Eigen::Isometry3d T_world_base = Eigen::Isometry3d::Identity();
+  /// Where the sensor (the laser's mirror centre) stood, in the points' frame [m]; unset when the
+  /// source does not say (a foreign PLY or XYZ file). Free-space carving casts rays from it.
+  std::optional<Eigen::Vector3d> sensor_origin;
 };
 
 /// The largest rotation between any of `attitudes` and the last one [rad]; 0 when empty.
