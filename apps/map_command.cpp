@@ -14,6 +14,7 @@
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/elevation_map.hpp"
 #include "pitchlab/mapping/elevation_truth.hpp"
+#include "pitchlab/mapping/ground_level.hpp"
 #include "pitchlab/sensors/ray_caster.hpp"
 #include "pitchlab/sensors/scan_pcd.hpp"
 #include "pitchlab/sim/simulation.hpp"
@@ -36,7 +37,22 @@ CliArgs MapArgs() {
                "Builds an elevation map from point clouds (PCD; points moved into the world by\n"
                "each file's VIEWPOINT pose) and writes DIR/map.plem (lossless), DIR/elevation.asc\n"
                "+ .prj (georeferenced raster), DIR/elevation.png and DIR/map.json. With --world,\n"
-               "the map is georeferenced and scored against the world's true surface.");
+               "the map is georeferenced and scored against the world's true surface.\n"
+               "\n"
+               "Levelling: without --world (whose frame is the simulator's, z up) nothing tells\n"
+               "where gravity points, and a scanner mounted a few degrees off tilts the whole map\n"
+               "(a flat floor reads as a slope). The map frame is then turned about its origin so\n"
+               "that the floor under the first cloud's sensor is level: a robust plane fit of the\n"
+               "points below the sensor within 0.5-4 m of it. It assumes the first scan stood on\n"
+               "level ground; map.json reports the plane (normal, tilt removed, residual, points).\n"
+               "--no-level keeps the clouds' frame (their poses came levelled by an IMU).\n"
+               "\n"
+               "Height band: points higher than --max-height above the ground under the sensor\n"
+               "that saw them are not ground (a ceiling, a canopy), unless the laser saw their\n"
+               "surface from above: terrain rising ahead may climb 35 % (the P3-AT's grade) of\n"
+               "its distance higher. Points on a surface the laser saw from below (a ceiling, a\n"
+               "desk's underside) are never ground. Cells whose only points were those stay\n"
+               "unknown.");
   args.Positionals("CLOUD.pcd", "one or more clouds", 1, 1000)
       .Option("cell", "METRES", "cell size [m]", "0.1")
       .Option("out", "DIR", "output folder (created)")
@@ -48,6 +64,12 @@ CliArgs MapArgs() {
       .Option("clearance", "METRES",
               "ray length behind each hit that marks free space (drops, overhangs); 0 disables",
               DefaultClearance())
+      .Option("max-height", "METRES",
+              "height band above the ground under the sensor: the robot with its laser is "
+              "0.6 m tall, plus 0.4 m for the ground's unevenness and the pose's tilt error; "
+              "'inf' disables",
+              "1.0")
+      .Flag("no-level", "keep the clouds' frame; do not level it by the first cloud's floor")
       .Flag("json", "print the summary as JSON on stdout");
   return args;
 }
@@ -65,10 +87,12 @@ LoadedCloud LoadCloud(const std::string& path) {
   c.points.reserve(scan->points.size());
   for (const sensors::ScanPoint& p : scan->points)
     c.points.push_back(T * Eigen::Vector3f(p.x, p.y, p.z));
-  // The mirror at zero pitch; it moves by a few centimetres while pitching, which shifts the
+  // The file's sensor origin where it records one (a converted real scan: the scanner itself),
+  // else the mirror at zero pitch; it moves by a few centimetres while pitching, which shifts the
   // clearance rays' ends (the last few metres) by well under a centimetre.
   const sensors::MountConfig mount;
-  c.sensor_origin = T * (mount.t_base_mount_m + mount.t_mount_laser_m).cast<float>();
+  c.sensor_origin =
+      T * scan->sensor_origin.value_or(mount.t_base_mount_m + mount.t_mount_laser_m).cast<float>();
   return c;
 }
 
@@ -97,6 +121,8 @@ int RunMap(int argc, char** argv) {
   if (!(cell > 0)) throw CliError("--cell must be positive");
   mapping::InsertConfig insert;
   insert.clearance_length_m = args.GetNumbers("clearance", 1)[0];
+  insert.max_height_m = args.GetNumbers("max-height", 1)[0];
+  if (!(insert.max_height_m > 0)) throw CliError("--max-height must be positive (or inf)");
   const auto wall_start = std::chrono::steady_clock::now();
 
   std::vector<LoadedCloud> clouds;
@@ -109,6 +135,39 @@ int RunMap(int argc, char** argv) {
       hi = hi.cwiseMax(p.head<2>().cast<double>());
     }
     total_points += clouds.back().points.size();
+  }
+  // Levelling by the first cloud's floor (see --help), before the grid is laid over the points.
+  nlohmann::json levelling;
+  if (args.Has("world")) {
+    levelling = {{"method", "none: --world's frame is the simulator's, z up"}};
+  } else if (args.Flagged("no-level")) {
+    levelling = {{"method", "none: --no-level"}};
+  } else if (!clouds.empty()) {
+    Result<mapping::GroundLevel> level =
+        mapping::FitGroundLevel(clouds.front().points, clouds.front().sensor_origin);
+    if (!level) {
+      throw std::runtime_error(args.positionals().front() + ": " + level.error().message +
+                               "; give --no-level to map the clouds' frame as it is");
+    }
+    const Eigen::Matrix3f R = level->R_level.cast<float>();
+    lo = Eigen::Vector2d(1e300, 1e300), hi = Eigen::Vector2d(-1e300, -1e300);
+    for (LoadedCloud& c : clouds) {
+      for (Eigen::Vector3f& p : c.points) {
+        p = R * p;
+        lo = lo.cwiseMin(p.head<2>().cast<double>());
+        hi = hi.cwiseMax(p.head<2>().cast<double>());
+      }
+      c.sensor_origin = R * c.sensor_origin;
+    }
+    insert.sensor_height_m = level->sensor_height_m;
+    levelling = {{"method", "ground plane of the first cloud"},
+                 {"normal", {level->normal.x(), level->normal.y(), level->normal.z()}},
+                 {"tilt_removed_deg", level->tilt_rad * 180 / M_PI},
+                 {"residual_m", level->residual_m},
+                 {"inlier_threshold_m", level->threshold_m},
+                 {"points", level->inliers},
+                 {"candidates", level->candidates},
+                 {"sensor_height_m", level->sensor_height_m}};
   }
   mapping::GridGeometry geometry;
   if (args.Has("area")) {
@@ -139,6 +198,9 @@ int RunMap(int argc, char** argv) {
     stats.inserted += s.inserted;
     stats.outside += s.outside;
     stats.non_finite += s.non_finite;
+    stats.overhang += s.overhang;
+    stats.above_band += s.above_band;
+    stats.underside += s.underside;
   }
   const double insert_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - insert_start).count();
@@ -171,6 +233,12 @@ int RunMap(int argc, char** argv) {
       {"inserted", stats.inserted},
       {"outside", stats.outside},
       {"non_finite", stats.non_finite},
+      {"overhang", stats.overhang},
+      {"above_band", stats.above_band},
+      {"underside", stats.underside},
+      {"max_height_m", insert.max_height_m},
+      {"sensor_height_m", insert.sensor_height_m},
+      {"levelling", levelling},
       {"known_cells", known},
       {"drop_cells", drops},
       {"insert_time_s", insert_s},
@@ -200,6 +268,13 @@ int RunMap(int argc, char** argv) {
       "map.json}\n",
       geometry.size_x, geometry.size_y, cell, stats.inserted, total_points, known, drops,
       out.string().c_str());
+  if (levelling.contains("tilt_removed_deg")) {
+    std::printf("levelled by the first cloud's floor: %.2f deg of tilt removed (floor plane "
+                "residual %.4f m over %zu points, sensor %.3f m above it)\n",
+                levelling["tilt_removed_deg"].get<double>(), levelling["residual_m"].get<double>(),
+                levelling["points"].get<std::size_t>(),
+                levelling["sensor_height_m"].get<double>());
+  }
   if (summary.contains("truth")) {
     const auto& t = summary["truth"];
     std::printf(

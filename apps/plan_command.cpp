@@ -10,12 +10,13 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_args.hpp"
-#include "run_folder.hpp"
 #include "commands.hpp"
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/planning/path_io.hpp"
 #include "pitchlab/planning/planner.hpp"
 #include "pitchlab/planning/traversability.hpp"
+#include "run_folder.hpp"
+#include "traversability_image.hpp"
 
 namespace pitchlab::apps {
 namespace {
@@ -28,7 +29,10 @@ CliArgs PlanArgs() {
       "Plans the least-cost path (Eq. 5: W_T*T + W_P*P + W_phix*phi_x + W_phiy*phi_y per\n"
       "edge, 8-connected cells) on an elevation map written by `pitchlab map`, and writes\n"
       "DIR/path.csv, DIR/path.geojson (when the map is georeferenced), DIR/path.png and\n"
-      "DIR/plan.json. No path: the reason is printed, the exit code is 1 and no DIR is made.");
+      "DIR/plan.json, and always DIR/traversability.png (what the robot may enter and why\n"
+      "not) and DIR/elevation.png. No path: the reason is printed and the exit code is 1;\n"
+      "when start and goal lie on the map, DIR still gets the two pictures and plan.json\n"
+      "(found: false), to show why; otherwise no DIR is made.");
   args.Positionals("MAP.plem", "elevation map", 1, 1)
       .Option("start", "x,y", "start in the map frame [m]")
       .Option("goal", "x,y", "goal in the map frame [m]")
@@ -100,21 +104,48 @@ int RunPlan(int argc, char** argv) {
   summary["goal"] = goal;
   summary["traversability_time_s"] = std::chrono::duration<double>(t1 - t0).count();
   summary["search_time_s"] = std::chrono::duration<double>(t2 - t1).count();
+  const auto check = [](Result<void> r) {
+    if (!r) throw std::runtime_error(r.error().message);
+  };
+  // The pictures of the map and of what the planner may enter, with or without a path: they
+  // show why the path went where it did, or why there is none.
+  const auto write_pictures = [&](const StagedFolder& folder, const planning::Path* path) {
+    mapping::RgbImage elevation = mapping::RenderElevationImage(layers);
+    check(mapping::WritePng(elevation, (folder / "elevation.png").string()));
+    mapping::RgbImage traversability = RenderTraversability(grid);
+    if (path) planning::DrawPath(*path, map->geometry(), traversability);
+    check(mapping::WritePng(traversability, (folder / "traversability.png").string()));
+    summary["traversability_legend"] = TraversabilityLegend();
+  };
   if (!result) {
-    // No path: the reason on stderr (and stdout with --json), exit 1, no output folder.
+    // No path: the reason on stderr (and stdout with --json), exit 1. Start and goal on the map:
+    // the pictures and plan.json are written so the user can see what blocks the way; a start
+    // or goal off the map is a mistake in the command, and leaves no folder.
+    const planning::NoPath::Reason reason = result.error().reason;
+    const bool on_map = reason != planning::NoPath::Reason::kStartOutsideMap &&
+                        reason != planning::NoPath::Reason::kGoalOutsideMap;
     summary.update({{"found", false},
-                    {"reason", planning::ToString(result.error().reason)},
+                    {"reason", planning::ToString(reason)},
                     {"message", result.error().message}});
+    if (on_map) {
+      const StagedFolder folder(out);
+      write_pictures(folder, nullptr);
+      summary["files"] = {"traversability.png", "elevation.png", "plan.json"};
+      WriteTextFile(folder / "plan.json", summary.dump(2) + "\n");
+      folder.Commit();
+    }
     if (args.Flagged("json")) std::cout << summary.dump(2) << "\n";
-    std::cerr << "pitchlab plan: no path (" << planning::ToString(result.error().reason)
+    std::cerr << "pitchlab plan: no path (" << planning::ToString(reason)
               << "): " << result.error().message << "\n";
+    if (on_map) {
+      std::cerr << "wrote " << out.string()
+                << "/{traversability.png, elevation.png, plan.json}: traversability.png shows what "
+                   "blocks the way (red step, orange too steep, magenta drop, checkered unknown)\n";
+    }
     return 1;
   }
   summary.update(PathJson(*result));
   const StagedFolder folder(out);
-  const auto check = [](Result<void> r) {
-    if (!r) throw std::runtime_error(r.error().message);
-  };
   check(planning::WritePathCsv(*result, (folder / "path.csv").string()));
   if (map->geodetic_origin()) {
     check(planning::WritePathGeoJson(*result, map->geodetic_origin(),
@@ -125,6 +156,7 @@ int RunPlan(int argc, char** argv) {
   mapping::RgbImage image = mapping::RenderElevationImage(layers);
   planning::DrawPath(*result, map->geometry(), image);
   check(mapping::WritePng(image, (folder / "path.png").string()));
+  write_pictures(folder, &*result);
   WriteTextFile(folder / "plan.json", summary.dump(2) + "\n");
   folder.Commit();
   if (args.Flagged("json")) {
@@ -133,7 +165,8 @@ int RunPlan(int argc, char** argv) {
     std::printf(
         "path (%s): cost %.4f (roughness %.4f, length %.4f, incl. x %.4f, incl. y %.4f, "
         "unknown %.4f), %.2f m, %zu waypoints, max step %.3f m, max inclination %.1f deg\n"
-        "wrote %s/{path.csv, path.geojson, path.png, plan.json}\n",
+        "wrote %s/{path.csv, path.geojson, path.png, traversability.png, elevation.png, "
+        "plan.json}\n",
         planning::ToString(algorithm), result->cost, result->parts.roughness, result->parts.length,
         result->parts.inclination_x, result->parts.inclination_y, result->parts.unknown,
         result->length_m, result->waypoints.size(), result->max_step_m,

@@ -19,6 +19,7 @@ struct Moments {
   // Chan's combination with a cell (or a single point when c_* are zero) at offset (ox, oy).
   void Add(double nb, double bx, double by, double bz, double bxx, double bxy, double bxz,
            double byy, double byz) {
+    if (nb <= 0) return;
     const double n_new = n + nb;
     const double dx = bx - mx, dy = by - my, dz = bz - mz, w = n * nb / n_new;
     xx += bxx + dx * dx * w;
@@ -43,6 +44,17 @@ struct Moments {
     *b = (yy * xz - xy * yz) / det;
     *c = (xx * yz - xy * xz) / det;
     return true;
+  }
+
+  // Standard error of the fitted slope along its worst-determined horizontal direction, for
+  // heights of standard deviation sigma: sigma / sqrt(smallest eigenvalue of the xy co-moment
+  // sums) [1].
+  double SlopeError(double sigma) const {
+    const double det = xx * yy - xy * xy;
+    const double tr = xx + yy;
+    const double lambda_min = 0.5 * (tr - std::sqrt(std::max(0.0, tr * tr - 4.0 * det)));
+    return lambda_min > 0 ? sigma / std::sqrt(lambda_min)
+                          : std::numeric_limits<double>::infinity();
   }
 };
 
@@ -77,8 +89,15 @@ void Inclination(const ElevationMap& map, int ci, int cj, const LayerConfig& con
       centres.Add(1, ox, oy, c.mean_z, 0, 0, 0, 0, 0);
     }
   }
+  // Support: the slope counts only when the scan determined it, its standard error at the
+  // sensor's height noise below max_slope_error (LayerConfig). The centres' heights are cell
+  // means, each as uncertain as one point where a cell holds one or two (far floor).
+  const double sigma = config.height_noise_m;
   double b = 0, c = 0;
-  if (points.Slopes(config.min_spread_m, &b, &c) || centres.Slopes(0.25 * g.cell_m, &b, &c)) {
+  if ((points.Slopes(config.min_spread_m, &b, &c) &&
+       points.SlopeError(sigma) <= config.max_slope_error) ||
+      (centres.Slopes(0.25 * g.cell_m, &b, &c) &&
+       centres.SlopeError(sigma) <= config.max_slope_error)) {
     *phi_x = static_cast<float>(std::atan(b));
     *phi_y = static_cast<float>(std::atan(c));
   } else {
@@ -86,8 +105,8 @@ void Inclination(const ElevationMap& map, int ci, int cj, const LayerConfig& con
   }
 }
 
-// Unknown cells whose clearance is below the lowest point of every observed neighbour by more than
-// drop_depth become drops (seeds); grown breadth-first from them, below the same reference, up to
+// Unknown cells beside a rim (IsRim) whose clearance is below the lowest point of every observed
+// neighbour by more than drop_depth become drops (seeds); grown breadth-first from them, below the same reference, up to
 // drop_flood_m, so a ditch is marked across and a sunken court along its rim. A neighbour a ray
 // passed under (a desk top, a car's body, a canopy: its points hang over free space) is not ground
 // at its lowest point but at most at that ray: rays under an office desk read the floor between
@@ -107,6 +126,31 @@ float LowestObservedNeighbour(const ElevationLayers& L, const CellIndex& c) {
   return ref;
 }
 
+// A rim a drop can start from: observed ground the scan supports, a surface and not a few points
+// of something standing on it. Its inclination is known (a supported fit, LayerConfig's support
+// rule) and within the step rule's 60 deg, and its points span less height than a drop is deep.
+// A far cell holding one or two points of a wall, a door frame or a table (the real corridor's
+// sparse far cells) is none: rays to the floor beyond passed below those points, and the cells
+// between, whose floor the scan did not reach, became drops across the corridor.
+bool IsRim(const ElevationLayers& L, std::size_t k, const LayerConfig& config) {
+  if (L.state[k] != CellState::kObserved || !std::isfinite(L.phi_x[k]) ||
+      !std::isfinite(L.phi_y[k]))
+    return false;
+  const double tx = std::tan(L.phi_x[k]), ty = std::tan(L.phi_y[k]);
+  return tx * tx + ty * ty <= config.max_fit_slope * config.max_fit_slope &&
+         L.max_z[k] - L.min_z[k] <= config.drop_depth_m;
+}
+
+bool HasRimNeighbour(const ElevationLayers& L, const CellIndex& c, const LayerConfig& config) {
+  const GridGeometry& g = L.geometry;
+  for (int dj = -1; dj <= 1; ++dj)
+    for (int di = -1; di <= 1; ++di) {
+      const CellIndex nb{c.i + di, c.j + dj};
+      if (g.Contains(nb) && IsRim(L, g.Linear(nb), config)) return true;
+    }
+  return false;
+}
+
 void MarkDrops(ElevationLayers& L, const LayerConfig& config) {
   const GridGeometry& g = L.geometry;
   std::vector<float> reference(g.cell_count(), std::numeric_limits<float>::infinity());
@@ -122,7 +166,8 @@ void MarkDrops(ElevationLayers& L, const LayerConfig& config) {
   for (std::size_t k = 0; k < g.cell_count(); ++k) {
     if (!unknown_with_ray(k)) continue;
     const float ref = LowestObservedNeighbour(L, g.FromLinear(k));
-    if (std::isfinite(ref) && L.clearance_z[k] < ref - config.drop_depth_m) {
+    if (std::isfinite(ref) && L.clearance_z[k] < ref - config.drop_depth_m &&
+        HasRimNeighbour(L, g.FromLinear(k), config)) {
       L.state[k] = CellState::kDrop;
       reference[k] = ref;
       queue.push_back(k);

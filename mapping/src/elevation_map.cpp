@@ -4,6 +4,9 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
+
+#include <Eigen/Eigenvalues>
 
 namespace pitchlab::mapping {
 namespace {
@@ -119,6 +122,79 @@ inline bool CellOf(const FastGrid& g, const Eigen::Vector3f& p, float z_lo, floa
   return true;
 }
 
+// Running sums of a set of points: count, sum and sum of outer products (double).
+struct PointSums {
+  double n = 0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+  void Add(const Eigen::Vector3d& p) {
+    n += 1;
+    sum += p;
+    outer += p * p.transpose();
+  }
+  void Add(const PointSums& o) {
+    n += o.n;
+    sum += o.sum;
+    outer += o.outer;
+  }
+};
+
+// Which side of its surface each of the scan's rising points (above the sensor) was seen from.
+enum class Facing : std::uint8_t { kUndecided, kBelow, kAbove };
+
+// InsertConfig::drop_undersides and the band: the side each rising point's surface was seen from. Per cell holding such points, the plane through the rising points of
+// its 3 x 3 cells (points relative to the sensor, so float sums keep millimetres); a plane within
+// 60 deg of level (the same limit as the layers' step rule, tan 60 deg) that the point's ray met
+// from underneath marks the point. Too few points, or points along one line (a thin pole, a
+// single scan line: their plane is not determined), give no verdict and the point is kept.
+std::vector<Facing> SeenFrom(const FastGrid& g, const Eigen::Vector3f* points, std::size_t count,
+                             const Eigen::Vector3f& origin, float z_lo, float z_hi) {
+  std::vector<Facing> facing(count, Facing::kUndecided);
+  std::unordered_map<std::int64_t, PointSums> cells;
+  const auto key = [&](int i, int j) { return static_cast<std::int64_t>(j) * g.sx + i; };
+  for (std::size_t k = 0; k < count; ++k) {
+    const Eigen::Vector3f& p = points[k];
+    int i, j;
+    if (!p.allFinite() || !(p.z() > origin.z()) || !CellOf(g, p, z_lo, z_hi, &i, &j)) continue;
+    cells[key(i, j)].Add((p - origin).cast<double>());
+  }
+  // A plane needs its points spread across both horizontal axes: a quarter cell (std dev) each.
+  const double min_spread = 0.25 * g.cell;
+  const double cos_max_tilt = 0.5;  // cos 60 deg
+  std::unordered_map<std::int64_t, Eigen::Vector3d> normal;  // up normal; zero: no verdict
+  for (const auto& [k, own] : cells) {
+    const int i = static_cast<int>(k % g.sx), j = static_cast<int>(k / g.sx);
+    PointSums pooled;
+    for (int dj = -1; dj <= 1; ++dj)
+      for (int di = -1; di <= 1; ++di) {
+        const auto it = cells.find(key(i + di, j + dj));
+        if (it != cells.end() && i + di >= 0 && i + di < g.sx) pooled.Add(it->second);
+      }
+    Eigen::Vector3d n = Eigen::Vector3d::Zero();
+    if (pooled.n >= 3) {
+      const Eigen::Vector3d mean = pooled.sum / pooled.n;
+      const Eigen::Matrix3d cov = pooled.outer / pooled.n - mean * mean.transpose();
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+      if (eig.eigenvalues()(1) > min_spread * min_spread) {
+        n = eig.eigenvectors().col(0);
+        if (n.z() < 0) n = -n;
+        if (n.z() < cos_max_tilt) n.setZero();  // a wall, not a ceiling
+      }
+    }
+    normal.emplace(k, n);
+  }
+  for (std::size_t k = 0; k < count; ++k) {
+    const Eigen::Vector3f& p = points[k];
+    int i, j;
+    if (!p.allFinite() || !(p.z() > origin.z()) || !CellOf(g, p, z_lo, z_hi, &i, &j)) continue;
+    const Eigen::Vector3d& n = normal.at(key(i, j));
+    if (n.z() <= 0) continue;
+    // The ray travels up through the plane: it met the surface's lower face.
+    facing[k] = (p - origin).cast<double>().dot(n) > 0 ? Facing::kBelow : Facing::kAbove;
+  }
+  return facing;
+}
+
 InsertStats InsertPointsImpl(const GridGeometry& geometry, std::vector<CellStats>& cells,
                              const Eigen::Vector3f* points, std::size_t count,
                              const InsertConfig& config) {
@@ -168,6 +244,14 @@ InsertStats InsertScanImpl(const GridGeometry& geometry, std::vector<CellStats>&
       stats.clearance_cells += TraceClearance(g, cells, from, p);
     }
   }
+  const bool band = std::isfinite(config.max_height_m);
+  const std::vector<Facing> facing = config.drop_undersides || band
+                                         ? SeenFrom(g, points, count, origin, z_lo, z_hi)
+                                         : std::vector<Facing>(count, Facing::kUndecided);
+  // The height band's top at the sensor (see InsertConfig::max_height_m).
+  const float band_top = static_cast<float>(origin.z() - config.sensor_height_m +
+                                            config.max_height_m);
+  const float grade = static_cast<float>(config.band_grade);
   for (std::size_t k = 0; k < count; ++k) {
     const Eigen::Vector3f& p = points[k];
     if (!p.allFinite()) {
@@ -177,6 +261,17 @@ InsertStats InsertScanImpl(const GridGeometry& geometry, std::vector<CellStats>&
     int i, j;
     if (!CellOf(g, p, z_lo, z_hi, &i, &j)) {
       ++stats.outside;
+      continue;
+    }
+    if (config.drop_undersides && facing[k] == Facing::kBelow) {
+      ++stats.underside;
+      continue;
+    }
+    // Above the band's top at the sensor, only ground seen from above may rise further, by the
+    // grade per metre (a hill); a single far scan line, whose side nothing decides, may not.
+    if (band && p.z() > band_top &&
+        (facing[k] != Facing::kAbove || p.z() > band_top + grade * (p - origin).head<2>().norm())) {
+      ++stats.above_band;
       continue;
     }
     CellStats& c = cells[static_cast<std::size_t>(j) * g.sx + i];

@@ -62,6 +62,9 @@ TEST_F(MapPlanCli, ScanMapPlanWritesFilesThatParse) {
   const nlohmann::json map = nlohmann::json::parse(map_run_.out);
   EXPECT_GT(map["known_cells"].get<int>(), 100);
   EXPECT_TRUE(map.contains("truth"));
+  // --world's frame is the simulator's, z up: nothing to level.
+  EXPECT_NE(map["levelling"]["method"].get<std::string>().find("--world"), std::string::npos);
+  EXPECT_EQ(map["max_height_m"].get<double>(), 1.0);
   EXPECT_EQ(nlohmann::json::parse(Slurp(dir_ / "map" / "map.json"))["cell_m"], 0.1);
   const auto loaded = mapping::LoadElevationMap((dir_ / "map" / "map.plem").string());
   ASSERT_TRUE(loaded) << loaded.error().message;
@@ -103,7 +106,7 @@ TEST_F(MapPlanCli, ScanMapPlanWritesFilesThatParse) {
     EXPECT_EQ(e.path().filename().string().find(".partial"), std::string::npos) << e.path();
 }
 
-TEST_F(MapPlanCli, BadInputGivesAClearErrorANonZeroExitAndNoFolder) {
+TEST_F(MapPlanCli, BadInputOrNoPathGivesAClearErrorANonZeroExitAndPicturesOnlyForNoPath) {
   ASSERT_EQ(map_run_.exit_code, 0) << map_run_.err;
   const std::string map = (dir_ / "map" / "map.plem").string();
   const std::string start = Point(start_x_, start_y_);
@@ -121,10 +124,23 @@ TEST_F(MapPlanCli, BadInputGivesAClearErrorANonZeroExitAndNoFolder) {
   };
   for (const auto& c : cases) {
     const fs::path out = dir_ / "bad_plan";
+    fs::remove_all(out);
     const CliResult run = Run("plan " + c.args + " --out " + out.string());
-    EXPECT_NE(run.exit_code, 0) << c.args;
+    EXPECT_EQ(run.exit_code, 1) << c.args;
     EXPECT_NE(run.err.find(c.message), std::string::npos) << c.args << "\n" << run.err;
-    EXPECT_FALSE(fs::exists(out)) << c.args;
+    // Start and goal on the map but no path: the pictures and plan.json show why. A missing map
+    // or a point off it is a mistake in the command: no folder.
+    const bool on_map = c.message == "goal_blocked" || c.message == "disconnected";
+    EXPECT_EQ(fs::exists(out / "traversability.png"), on_map) << c.args;
+    EXPECT_EQ(fs::exists(out / "elevation.png"), on_map) << c.args;
+    EXPECT_EQ(fs::exists(out / "path.csv"), false) << c.args;
+    if (on_map) {
+      EXPECT_EQ(Slurp(out / "traversability.png").substr(0, 8), "\x89PNG\r\n\x1a\n");
+      EXPECT_NE(Slurp(out / "plan.json").find("\"found\": false"), std::string::npos);
+      EXPECT_NE(run.err.find("traversability.png"), std::string::npos) << run.err;
+    } else {
+      EXPECT_FALSE(fs::exists(out)) << c.args;
+    }
   }
 }
 

@@ -225,7 +225,8 @@ TEST(ElevationMap, MergeOfUnknownCellsLeavesSeenGroundAsItWas) {
   }
   ElevationMap map(g), shifted(g);
   (void)map.InsertPoints(seen.data(), seen.size());
-  (void)shifted.InsertScan(view.data(), view.size(), Eigen::Vector3f(1.0f, 0.5f, 0.0f));
+  // Seen from above (from below, drop_undersides would leave the view's points out).
+  (void)shifted.InsertScan(view.data(), view.size(), Eigen::Vector3f(1.0f, 0.5f, 0.8f));
   const ElevationMap before = map;
   const auto merged = map.Merge(shifted, ElevationMap::MergeCells::kUnknown);
   ASSERT_TRUE(merged) << merged.error().message;
@@ -282,22 +283,23 @@ TEST(ElevationMap, DitchShowsAsDropNotAsUnknown) {
 }
 
 TEST(ElevationMap, ADropSeededBySomethingTallDoesNotFloodTheWholeShadow) {
-  // Ground z = 0 up to x = 3, a fence seen only at its 0.8 m top in the cell [3.0, 3.1), then a
-  // shadow up to a far wall at x = 7.95, seen from beyond the fence 0.55 m up and hit 0.5 m up:
-  // those rays cross the shadow at about 0.5 m, 0.3 m under the fence top. The cell beside the
-  // fence is a drop by the rule (its only observed neighbour is the fence); the flood from it
-  // stops after drop_flood_m instead of running over the whole shadow, which is flat ground the
-  // laser merely did not see.
+  // Ground z = 0 up to x = 2.9, a wall 0.2 m thick seen only on its flat 0.8 m top in the cells
+  // [2.9, 3.1) (a rim), then a shadow up to a far wall at x = 7.95, seen from beyond the wall
+  // 0.55 m up and hit 0.5 m up: those rays cross the shadow at about 0.5 m, 0.3 m under the wall
+  // top. The cell beside the wall is a drop by the rule (its only observed neighbour is the wall
+  // top); the flood from it stops after drop_flood_m instead of running over the whole shadow,
+  // which is flat ground the laser merely did not see.
   const Eigen::Vector3f sensor(0.0f, 0.0f, 0.55f), beyond(3.15f, 0.0f, 0.55f);
-  std::vector<Eigen::Vector3f> pts, far;
+  std::vector<Eigen::Vector3f> pts, top, far;
   for (double y = -0.5; y < 0.5; y += 0.05) {
-    for (double x = 0.52; x < 3.0; x += 0.05) pts.emplace_back(float(x), float(y), 0.0f);
-    pts.emplace_back(3.05f, float(y), 0.8f);
+    for (double x = 0.52; x < 2.9; x += 0.05) pts.emplace_back(float(x), float(y), 0.0f);
+    for (double x = 2.92; x < 3.1; x += 0.04) top.emplace_back(float(x), float(y), 0.8f);
     far.emplace_back(7.95f, float(y), 0.5f);
   }
   const GridGeometry g = GridGeometry::FromArea(0, -0.5, 8, 1, 0.1);
   ElevationMap map(g);
   (void)map.InsertScan(pts.data(), pts.size(), sensor);
+  (void)map.InsertPoints(top.data(), top.size());  // seen from above (a laser 0.55 m up cannot)
   (void)map.InsertScan(far.data(), far.size(), beyond);
   const ElevationLayers L = ComputeLayers(map);
   const auto state = [&](double x) { return L.state[g.Linear(g.IndexOf(x, 0.05))]; };
@@ -347,7 +349,13 @@ TEST(ElevationMap, SignOverOpenGroundIsLeftOutOfTheGroundCells) {
   const GridGeometry g = GridGeometry::FromArea(0, -0.5, 6, 1, 0.1);
   ElevationMap map(g);
   const InsertStats s = map.InsertScan(pts.data(), pts.size(), sensor);
-  EXPECT_EQ(s.overhang, 10u * 20u);  // every plate point: 10 along x, 20 along y
+  // Every plate point, 10 along x, 20 along y: seen from below (drop_undersides) or, with that
+  // rule off, over a lower ray.
+  EXPECT_EQ(s.underside, 10u * 20u);
+  InsertConfig rays_only;
+  rays_only.drop_undersides = false;
+  ElevationMap by_rays(g);
+  EXPECT_EQ(by_rays.InsertScan(pts.data(), pts.size(), sensor, rays_only).overhang, 10u * 20u);
   const ElevationLayers L = ComputeLayers(map);
   const std::size_t under = g.Linear(g.IndexOf(3.25, 0.05));
   EXPECT_NEAR(L.mean_z[under], 0.0, kHeightTolM);
@@ -355,6 +363,7 @@ TEST(ElevationMap, SignOverOpenGroundIsLeftOutOfTheGroundCells) {
   // With the filter off the plate is averaged into the ground, as Eq. 2 alone would do.
   InsertConfig keep_all;
   keep_all.overhang_headroom_m = 0;
+  keep_all.drop_undersides = false;
   ElevationMap raw(g);
   EXPECT_EQ(raw.InsertScan(pts.data(), pts.size(), sensor, keep_all).overhang, 0u);
   EXPECT_GT(ComputeLayers(raw).mean_z[under], 1.0);

@@ -38,7 +38,12 @@ ElevationLayers MakeLayers(int sx, int sy, double cell, const std::function<doub
       pts.emplace_back(float(c.x()), float(c.y()), float(h));
     }
   (void)map.InsertPoints(pts.data(), pts.size());
-  return mapping::ComputeLayers(map);
+  // Exact heights: the inclination's support is judged against a noise the data do not have
+  // (LayerConfig::height_noise_m is a real laser's), which would leave the grid's edge rows,
+  // fitted over two rows of cells only, without an inclination.
+  mapping::LayerConfig exact;
+  exact.height_noise_m = 1e-4;
+  return mapping::ComputeLayers(map, exact);
 }
 
 PlannerConfig PointRobot() {

@@ -9,7 +9,8 @@
 // cells of the region at their mean heights; with fewer than 3 non-collinear known cells the
 // inclination is unknown (NaN). A neighbour whose mean differs from the cell's by more than
 // max_fit_slope times their centre distance is a step, not part of the slope, and is left out, so
-// the ground beside a wall keeps its own inclination.
+// the ground beside a wall keeps its own inclination. A fit the scan does not support (its slope's
+// standard error above LayerConfig::max_slope_error) leaves the inclination unknown.
 
 #include <cstdint>
 #include <vector>
@@ -23,7 +24,9 @@ enum class CellState : std::uint8_t {
   kUnknown = 0,   ///< no point fell in it and no ray proves a drop
   kObserved = 1,  ///< at least one point
   kDrop = 2,      ///< no point, but rays passed lower than the lowest point of every observed
-                  ///< neighbour by more than drop_depth_m (or within drop_flood_m of such a drop
+                  ///< neighbour by more than drop_depth_m, one of them a rim (ground with a
+                  ///< supported inclination whose points span less than drop_depth_m: not a
+                  ///< few points of a wall), or within drop_flood_m of such a drop
               ///< cell, below the same reference): a negative hazard (ditch, stairs down, cliff)
 };
 
@@ -45,6 +48,22 @@ struct LayerConfig {
   /// Neighbours steeper than this from the cell (|dz| / centre distance) are steps, excluded
   /// from the inclination fit [1]; tan(60 deg).
   double max_fit_slope = 1.7320508;
+  /// Support of the inclination: a fit counts only when its slope's standard error, for heights
+  /// of `height_noise_m`, is at most `max_slope_error`; else the inclination is unknown (NaN) and
+  /// the cell is no slope hazard. What the scan supports follows from the sensor: the LMS200's
+  /// 0.5 deg beams lie r * 8.7 mm apart along a line, and a nodding scan's lines (0.45 deg pitch
+  /// steps) meet a floor h = 0.5 m below the laser r^2 * 0.0079 / h apart: 0.14 m at 3 m, 0.57 m
+  /// at 6 m. Beyond ~4.5 m a 3 x 3 region of 0.1 m cells holds one line, whose points span no
+  /// plane across it (a single line's noise set the far floor's "slopes": one-cell steep stripes
+  /// across office corridors and a real corridor). 3 x 3 full cells of one point each: error
+  /// 0.02 / sqrt(6 * 0.01) = 0.08, supported; two rows of them: 0.16, not.
+  /// Height noise of one point [m]: real LMS scans 1-3 cm (the 3DTK corridor's floor fits a
+  /// plane to 2 cm RMS), more than the datasheet's 5 mm range noise because the pose's and
+  /// the pitch encoder's angle errors grow with range.
+  double height_noise_m = 0.02;
+  /// [1] A third of the P3-AT's 35 % grade: flat ground reads as too steep by chance less than
+  /// a 3-sigma event.
+  double max_slope_error = 0.35 / 3;
 };
 
 /// Dense per-cell layers over the map's geometry (index as GridGeometry::Linear).

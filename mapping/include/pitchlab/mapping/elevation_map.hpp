@@ -119,6 +119,26 @@ struct InsertConfig {
   /// range noise put over the cell edge; it is left out of the cell [m]. The P3 with its laser
   /// is ~0.6 m tall (as TruthConfig::min_headroom_m). 0 or less keeps every point.
   double overhang_headroom_m = 0.6;
+  /// InsertScan's height band: a point higher than `max_height_m` above the ground under the
+  /// sensor that saw it (the sensor's z minus `sensor_height_m`) is not ground (a ceiling, a
+  /// canopy, a tree's crown) and is left out (InsertStats::above_band), unless its surface was
+  /// seen from above (the plane of this scan's points in the 3 x 3 cells around it, see
+  /// drop_undersides): that is terrain rising ahead, kept up to `band_grade` per metre of
+  /// horizontal distance higher (the P3-AT climbs 35 %), so a hill the robot could drive up stays
+  /// ground however high it is. A far ceiling's single scan line, whose side no plane decides, is
+  /// left out. +inf: no band.
+  double max_height_m = std::numeric_limits<double>::infinity();
+  /// The laser above the ground the robot stands on: the P3's mount (MountConfig: pitch axis
+  /// 0.45 m over base_link, mirror 0.09 m above it; base_link on the ground) [m].
+  double sensor_height_m = 0.54;
+  double band_grade = 0.35;  ///< see max_height_m; P3-AT datasheet: 35 % grade [1]
+  /// InsertScan: points a ray rose to that lie on a surface seen from below (the plane through
+  /// this scan's rising points in the 3 x 3 cells around them is within 60 deg of level, and the
+  /// ray met it from its underside: a ceiling, the underside of a desk, a bridge or a canopy) are
+  /// left out (InsertStats::underside): ground is always seen from above, whatever its height (a
+  /// hill ahead rises away from the ray that meets it). Left in, a corridor's ceiling became the
+  /// ground of every cell whose floor the scan did not reach.
+  bool drop_undersides = true;
 };
 
 /// What one insertion did.
@@ -129,6 +149,8 @@ struct InsertStats {
   std::size_t clearance_cells = 0;  ///< cell updates by ray clearance
   std::size_t overhang =
       0;  ///< points left out over a lower ray (InsertConfig::overhang_headroom_m)
+  std::size_t above_band = 0;  ///< points above the height band (InsertConfig::max_height_m)
+  std::size_t underside = 0;   ///< points on surfaces seen from below (drop_undersides)
 };
 
 /// The elevation grid: geometry, georeference and one CellStats per cell.
