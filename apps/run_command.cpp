@@ -10,6 +10,7 @@
 #include <ctime>
 #include <iostream>
 #include <random>
+#include <sstream>
 
 #include "app_config.hpp"
 #include "cli_args.hpp"
@@ -208,7 +209,15 @@ int RunRun(int argc, char** argv) {
   context.start = start;
   context.goal = goal;
   context.geodetic_origin = origin;
-  context.config_yaml = AppConfigToYaml(config) + RunSettingsToYaml(settings);
+  // The mount error the simulator drew from the seed (lms200.mount_error_sigma_deg): truth the
+  // pipeline never saw, so a comment, not a setting read back.
+  const Eigen::Vector3d mount_error_deg = rig.mount_error_rpy_rad() * 180.0 / M_PI;
+  std::ostringstream truth;
+  truth.precision(6);
+  truth << "# sim truth: scanner mount error drawn for this run, roll/pitch/yaw [deg]: ["
+        << mount_error_deg.x() << ", " << mount_error_deg.y() << ", " << mount_error_deg.z()
+        << "]\n";
+  context.config_yaml = AppConfigToYaml(config) + RunSettingsToYaml(settings) + truth.str();
   context.planner = MissionPlanner(mission);
   context.layers = mission.layers;
   context.wall_time_s =

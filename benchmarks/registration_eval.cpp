@@ -36,6 +36,7 @@
 
 #include "pitchlab/mapping/map_builder.hpp"
 #include "pitchlab/mapping/registration.hpp"
+#include "pitchlab/sensors/sensor_config.hpp"
 #include "pitchlab/sim/robot_model.hpp"
 #include "pitchlab/sim/sim_rig.hpp"
 
@@ -77,6 +78,7 @@ struct Options {
   std::string paper_table;                         // JSON with the paper's Table 1, if given
   std::string pair_cache;                          // directory of simulated pairs, if given
   std::string config;                              // YAML over our defaults, if given
+  std::string sensor;                              // YAML of the lms200 section, if given
   std::set<int> only_pairs;                        // register only these pair ids (all if empty)
   std::set<std::string> near_start = {"terrain"};  // worlds sampled around their start only
   double near_start_radius_m = 3.0;
@@ -115,6 +117,8 @@ Options ParseOptions(int argc, char** argv) {
       o.pair_cache = value();
     else if (a == "--config")
       o.config = value();
+    else if (a == "--sensor")
+      o.sensor = value();
     else if (a == "--only-pairs") {
       for (const std::string& id : Split(value(), ',')) o.only_pairs.insert(std::stoi(id));
     } else if (a == "--near-start") {
@@ -137,7 +141,9 @@ Options ParseOptions(int argc, char** argv) {
           << "registration_eval [--worlds a,b] [--targets N] [--levels m:deg,...] "
              "[--noise s,...] [--baseline-pairs N] [--table1-pairs N] [--sequence-scans N] "
              "[--seed S] [--paper-table FILE.json] [--near-start w1,w2] [--near-start-radius M] "
-             "[--pair-cache DIR] [--config FILE.yaml] [--only-pairs id,...]\n";
+             "[--pair-cache DIR] [--config FILE.yaml] [--sensor FILE.yaml] [--only-pairs id,...]\n"
+             "--sensor: the simulated LMS200 (its lms200 section) over the defaults; --noise\n"
+             "sets its noise_sigma_m.\n";
       std::exit(0);
     } else {
       throw std::invalid_argument("unknown option " + a);
@@ -174,8 +180,10 @@ KeepOut FootprintKeepOut(const sim::SimRigConfig& config) {
 // One rig per world and noise level; scans at requested poses with their truth checked.
 class ScanFactory {
  public:
-  ScanFactory(const std::string& world, double noise_m, std::uint64_t seed) {
+  ScanFactory(const std::string& world, double noise_m, std::uint64_t seed,
+              const sensors::Lms200Config& lms200) {
     sim::SimRigConfig config;
+    config.lms200 = lms200;
     config.lms200.noise_sigma_m = noise_m;
     config.lms200.seed = seed;
     rig_ = std::make_unique<sim::SimRig>(std::string(PITCHLAB_WORLDS_DIR) + "/" + world + ".xml",
@@ -266,9 +274,19 @@ double Overlap(const mapping::PointCloud& target, const mapping::PointCloud& sou
   return seen.empty() ? 0.0 : static_cast<double>(hit) / seen.size();
 }
 
+// The simulated LMS200: the defaults, or --sensor's lms200 section over them.
+sensors::Lms200Config SensorModel(const Options& o) {
+  if (o.sensor.empty()) return {};
+  std::ifstream in(o.sensor);
+  if (!in) throw std::invalid_argument(o.sensor + ": cannot be opened");
+  std::stringstream text;
+  text << in.rdbuf();
+  return sensors::ParseSensorConfig(text.str(), o.sensor).lms200;
+}
+
 std::vector<Pair> MakePairs(const Options& o, const std::string& world, double noise_m,
                             std::mt19937_64& rng, json& stats) {
-  ScanFactory factory(world, noise_m, rng());
+  ScanFactory factory(world, noise_m, rng(), SensorModel(o));
   const double radius_m = o.near_start.count(world) ? o.near_start_radius_m : 0.0;
   const Eigen::Vector4d b = factory.bounds(radius_m);
   stats["target_region"] = {b[0], b[1], b[2], b[3]};
@@ -311,7 +329,8 @@ std::string CachePath(const Options& o, const std::string& world, double noise_m
   std::ostringstream key;
   key << rng << " " << world << " " << noise_m << " " << o.targets << " "
       << (o.near_start.count(world) ? o.near_start_radius_m : 0.0) << " climb " << kMaxClimb_m
-      << " keep-out disc " << kPlannerSafetyMargin_m << " " << kObstacleMin_m;
+      << " keep-out disc " << kPlannerSafetyMargin_m << " " << kObstacleMin_m << " sensor "
+      << sensors::SensorConfigToYaml({SensorModel(o), {}, {}, {}});
   std::ostringstream name;
   name << o.pair_cache << "/" << world << "_" << noise_m << "_" << std::hex
        << std::hash<std::string>{}(key.str()) << ".bin";
@@ -536,8 +555,9 @@ json FalseSuccesses(const json& pairs, const char* key) {
   return {{"runs", runs}, {"count", list.size()}, {"cases", list}};
 }
 
-json Sequence(const std::string& world, int scans, std::mt19937_64& rng) {
-  ScanFactory factory(world, 0.005, rng());
+json Sequence(const std::string& world, int scans, std::mt19937_64& rng,
+              const sensors::Lms200Config& lms200) {
+  ScanFactory factory(world, 0.005, rng(), lms200);
   mapping::MapConfig map_config;
   map_config.sensor_base = LaserInBase();
   mapping::MapBuilder builder{map_config};
@@ -629,6 +649,7 @@ int main(int argc, char** argv) {
 
     json out = {{"seed", o.seed},
                 {"config", mapping::RegistrationConfigToYaml(ours)},
+                {"sensor", sensors::SensorConfigToYaml({SensorModel(o), {}, {}, {}})},
                 {"baseline_config", mapping::RegistrationConfigToYaml(pcl_default)},
                 {"targets",
                  {{"rotation_deg", kTargetRotation_deg}, {"translation_m", kTargetTranslation_m}}}};
@@ -833,7 +854,7 @@ int main(int argc, char** argv) {
 
     if (o.sequence_scans > 0) {
       std::fprintf(stderr, "urban sequence of %d scans\n", o.sequence_scans);
-      out["sequences"] = json::array({Sequence("urban", o.sequence_scans, rng)});
+      out["sequences"] = json::array({Sequence("urban", o.sequence_scans, rng, SensorModel(o))});
     }
     std::cout << out.dump(2) << "\n";
     return 0;

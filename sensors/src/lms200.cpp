@@ -22,6 +22,15 @@ constexpr int kBitsPerByte = 8 + 2;
 // Depth jump across one beam's footprint above which the return is a mixed pixel [m].
 constexpr double kMixedPixelJump_m = 0.05;
 
+// Seeds of the dropout and the mount streams: the run's seed with fixed bits flipped, so the range
+// noise keeps its draws whichever effects are on (any constants do; these are the first digits of
+// pi and e in hexadecimal).
+constexpr std::uint64_t kEffectsStream = 0x243F6A8885A308D3ULL;
+constexpr std::uint64_t kMountStream = 0xB7E151628AED2A6BULL;
+// Beyond this incidence tan() grows without bound while the footprint stops being a patch: the
+// footprint-depth term holds its 85 deg value (tan 85 deg = 11.4).
+constexpr double kMaxFootprintIncidence_rad = 85.0 * kDegToRad;
+
 bool Near(double a, double b) { return std::abs(a - b) < 1e-9; }
 
 [[noreturn]] void Invalid(const char* field, double value, const char* allowed) {
@@ -44,7 +53,27 @@ void Lms200Config::Validate() const {
   if (!(noise_sigma_m >= 0.0) || !std::isfinite(noise_sigma_m)) {
     Invalid("noise_sigma_m", noise_sigma_m, ">= 0");
   }
+  if (!(noise_per_m >= 0.0 && noise_per_m < 0.1)) Invalid("noise_per_m", noise_per_m, "0 .. 0.1");
+  if (!(incidence_noise_gain >= 0.0 && incidence_noise_gain <= 10.0)) {
+    Invalid("incidence_noise_gain", incidence_noise_gain, "0 .. 10");
+  }
   if (!std::isfinite(range_bias_m)) Invalid("range_bias_m", range_bias_m, "a finite number");
+  if (!(dropout_grazing_deg >= 0.0 && dropout_grazing_deg < 90.0)) {
+    Invalid("dropout_grazing_deg", dropout_grazing_deg, "0 .. < 90");
+  }
+  if (!(dropout_grazing_at_90 >= 0.0 && dropout_grazing_at_90 <= 1.0)) {
+    Invalid("dropout_grazing_at_90", dropout_grazing_at_90, "0 .. 1");
+  }
+  if (!(dropout_far_m >= 0.0) || !std::isfinite(dropout_far_m)) {
+    Invalid("dropout_far_m", dropout_far_m, ">= 0");
+  }
+  if (!(dropout_far_per_m >= 0.0 && dropout_far_per_m <= 1.0)) {
+    Invalid("dropout_far_per_m", dropout_far_per_m, "0 .. 1");
+  }
+  // A mount more than 10 deg off is a mounting fault, not a calibration residual.
+  if (!(mount_error_sigma_deg >= 0.0 && mount_error_sigma_deg <= 10.0)) {
+    Invalid("mount_error_sigma_deg", mount_error_sigma_deg, "0 .. 10");
+  }
   if (!(beam_divergence_deg >= 0.0 && beam_divergence_deg < 5.0)) {
     Invalid("beam_divergence_deg", beam_divergence_deg, "0 .. 5");
   }
@@ -53,7 +82,29 @@ void Lms200Config::Validate() const {
   }
 }
 
-Lms200Model::Lms200Model(const Lms200Config& config) : config_(config), rng_(config.seed) {
+Lms200Config Lms200Config::Legacy() {
+  Lms200Config c;
+  c.noise_sigma_m = 0.005;
+  c.noise_per_m = 0.0;
+  c.incidence_noise_gain = 0.0;
+  c.mixed_pixels = false;
+  c.dropout_grazing_at_90 = 0.0;
+  c.dropout_far_per_m = 0.0;
+  c.mount_error_sigma_deg = 0.0;
+  return c;
+}
+
+std::array<double, 3> DrawMountErrorRpyRad(const Lms200Config& config) {
+  std::array<double, 3> rpy = {0.0, 0.0, 0.0};
+  if (config.mount_error_sigma_deg <= 0.0) return rpy;
+  std::mt19937_64 rng(config.seed ^ kMountStream);
+  std::normal_distribution<double> normal(0.0, config.mount_error_sigma_deg * kDegToRad);
+  for (double& a : rpy) a = normal(rng);
+  return rpy;
+}
+
+Lms200Model::Lms200Model(const Lms200Config& config)
+    : config_(config), rng_(config.seed), effects_(config.seed ^ kEffectsStream) {
   config_.Validate();
   readings_ = static_cast<int>(std::lround(config_.fov_deg / config_.resolution_deg)) + 1;
 }
@@ -85,8 +136,28 @@ double Lms200Model::line_period_s() const {
   return interlaced_sweeps() / kMirrorRate_hz + transfer_time_s();
 }
 
+double Lms200Model::NoiseSigma(double range_m, double incidence_rad) const {
+  if (config_.noise_sigma_m <= 0.0) return 0.0;  // the ideal sensor
+  const double r = std::max(range_m, 0.0);
+  const double grow = config_.noise_per_m * r;
+  const double tilt = std::tan(std::clamp(incidence_rad, 0.0, kMaxFootprintIncidence_rad));
+  const double footprint =
+      config_.incidence_noise_gain * r * config_.beam_divergence_deg * kDegToRad * tilt;
+  return std::sqrt(config_.noise_sigma_m * config_.noise_sigma_m + grow * grow +
+                   footprint * footprint);
+}
+
+double Lms200Model::DropoutProbability(double range_m, double incidence_rad) const {
+  if (config_.noise_sigma_m <= 0.0) return 0.0;  // the ideal sensor
+  const double start = config_.dropout_grazing_deg * kDegToRad;
+  const double grazing = config_.dropout_grazing_at_90 *
+                         std::clamp((incidence_rad - start) / (0.5 * kPi - start), 0.0, 1.0);
+  const double far = config_.dropout_far_per_m * std::max(range_m - config_.dropout_far_m, 0.0);
+  return std::min(grazing + far, 1.0);
+}
+
 void Lms200Model::Measure(const float* true_ranges, const float* edge_lo, const float* edge_hi,
-                          LaserLine& line) {
+                          LaserLine& line, const float* cos_incidence) {
   const auto n = static_cast<std::size_t>(readings_);
   line.angle_min_rad = angle_min_rad();
   line.angle_increment_rad = angle_increment_rad();
@@ -98,15 +169,21 @@ void Lms200Model::Measure(const float* true_ranges, const float* edge_lo, const 
   const double max_range = max_range_m();
   for (std::size_t i = 0; i < n; ++i) {
     double range = true_ranges[i];
-    if (mix && std::isfinite(edge_lo[i]) && std::isfinite(edge_hi[i]) && std::isfinite(range)) {
+    if (!std::isfinite(range)) continue;  // nothing hit: no return
+    // A dropout draw for every hit, whatever its probability, so that switching an effect keeps
+    // the draws of the others.
+    const double u_drop = uniform_(effects_);
+    if (mix && std::isfinite(edge_lo[i]) && std::isfinite(edge_hi[i])) {
       const double lo = std::min({range, double(edge_lo[i]), double(edge_hi[i])});
       const double hi = std::max({range, double(edge_lo[i]), double(edge_hi[i])});
       // A beam straddling a depth edge returns a blend of both surfaces.
       if (hi - lo > kMixedPixelJump_m) range = (range + edge_lo[i] + edge_hi[i]) / 3.0;
     }
-    if (!std::isfinite(range)) continue;  // nothing hit: no return
+    const double incidence =
+        cos_incidence ? std::acos(std::clamp(double(cos_incidence[i]), 0.0, 1.0)) : 0.0;
     // Draw noise for every hit so the stream of draws does not depend on the range mode.
-    const double noisy = range + config_.range_bias_m + config_.noise_sigma_m * noise_(rng_);
+    const double noisy = range + config_.range_bias_m + NoiseSigma(range, incidence) * noise_(rng_);
+    if (u_drop < DropoutProbability(range, incidence)) continue;  // no return
     if (range > max_range) {
       line.status[i] = ReadingStatus::kOverRange;
       continue;

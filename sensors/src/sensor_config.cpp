@@ -115,9 +115,16 @@ SensorConfig ParseSensorConfig(const std::string& yaml_text, const std::string& 
       .Field("resolution_deg", l.resolution_deg)
       .Field("range_mode", l.range_mode)
       .Field("noise_sigma_m", l.noise_sigma_m)
+      .Field("noise_per_m", l.noise_per_m)
+      .Field("incidence_noise_gain", l.incidence_noise_gain)
       .Field("range_bias_m", l.range_bias_m)
       .Field("mixed_pixels", l.mixed_pixels)
       .Field("beam_divergence_deg", l.beam_divergence_deg)
+      .Field("dropout_grazing_deg", l.dropout_grazing_deg)
+      .Field("dropout_grazing_at_90", l.dropout_grazing_at_90)
+      .Field("dropout_far_m", l.dropout_far_m)
+      .Field("dropout_far_per_m", l.dropout_far_per_m)
+      .Field("mount_error_sigma_deg", l.mount_error_sigma_deg)
       .Field("baud", l.baud)
       .Field("seed", seed)
       .Read();
@@ -174,9 +181,16 @@ std::string SensorConfigToYaml(const SensorConfig& c) {
      << "  resolution_deg: " << l.resolution_deg << "\n"
      << "  range_mode: " << (l.range_mode == Lms200RangeMode::kCm ? "cm" : "mm") << "\n"
      << "  noise_sigma_m: " << l.noise_sigma_m << "\n"
+     << "  noise_per_m: " << l.noise_per_m << "\n"
+     << "  incidence_noise_gain: " << l.incidence_noise_gain << "\n"
      << "  range_bias_m: " << l.range_bias_m << "\n"
      << "  mixed_pixels: " << (l.mixed_pixels ? "true" : "false") << "\n"
      << "  beam_divergence_deg: " << l.beam_divergence_deg << "\n"
+     << "  dropout_grazing_deg: " << l.dropout_grazing_deg << "\n"
+     << "  dropout_grazing_at_90: " << l.dropout_grazing_at_90 << "\n"
+     << "  dropout_far_m: " << l.dropout_far_m << "\n"
+     << "  dropout_far_per_m: " << l.dropout_far_per_m << "\n"
+     << "  mount_error_sigma_deg: " << l.mount_error_sigma_deg << "\n"
      << "  baud: " << l.baud << "\n"
      << "  seed: " << l.seed << "\n";
   const auto& p = c.pitch_unit;

@@ -12,9 +12,10 @@ float SimLineScanner::cast_range_m() const {
   return static_cast<float>(model_.max_range_m() * 1.05);
 }
 
-// One ray per beam: direction = R_world_laser [cos(theta + offset), sin(theta + offset), 0].
+// One ray per beam: direction = R_world_laser [cos(theta + offset), sin(theta + offset), 0], tipped
+// out of the scan plane by `tip_rad` (towards the laser's +z).
 void SimLineScanner::CastAt(const Eigen::Isometry3d& T_world_laser, double offset_rad,
-                            std::vector<float>& out) {
+                            std::vector<float>& out, double tip_rad) {
   const int n = model_.readings();
   origins_.resize(3 * n);
   directions_.resize(3 * n);
@@ -23,13 +24,43 @@ void SimLineScanner::CastAt(const Eigen::Isometry3d& T_world_laser, double offse
   for (int i = 0; i < n; ++i) {
     const double theta = model_.angle_min_rad() + i * model_.angle_increment_rad() + offset_rad;
     const Eigen::Vector3d d =
-        T_world_laser.linear() * Eigen::Vector3d(std::cos(theta), std::sin(theta), 0.0);
+        T_world_laser.linear() * Eigen::Vector3d(std::cos(tip_rad) * std::cos(theta),
+                                                 std::cos(tip_rad) * std::sin(theta),
+                                                 std::sin(tip_rad));
     for (int k = 0; k < 3; ++k) {
       origins_[3 * i + k] = static_cast<float>(o[k]);
       directions_[3 * i + k] = static_cast<float>(d[k]);
     }
   }
   caster_.Cast(origins_.data(), directions_.data(), n, cast_range_m(), out.data(), nullptr);
+}
+
+// The surface normal at each beam's hit from two more rays a tenth of a beam step away, one along
+// the scan line and one across it: the three hits span the surface. A tenth of a step keeps all
+// three on one surface except within a tenth of a step of an edge (the ray caster reports no
+// normal, so the hit points must give it). A beam whose neighbours missed counts as meeting its
+// surface head on.
+void SimLineScanner::CastIncidence(const Eigen::Isometry3d& T_world_laser) {
+  const int n = model_.readings();
+  const double delta = 0.1 * model_.angle_increment_rad();
+  CastAt(T_world_laser, delta, along_);
+  CastAt(T_world_laser, 0.0, across_, delta);
+  cos_incidence_.assign(n, 1.0f);
+  for (int i = 0; i < n; ++i) {
+    if (!std::isfinite(ranges_[i]) || !std::isfinite(along_[i]) || !std::isfinite(across_[i])) {
+      continue;
+    }
+    const double theta = model_.angle_min_rad() + i * model_.angle_increment_rad();
+    // In the laser frame (the incidence does not depend on the frame).
+    const Eigen::Vector3d d0(std::cos(theta), std::sin(theta), 0.0);
+    const Eigen::Vector3d d1(std::cos(theta + delta), std::sin(theta + delta), 0.0);
+    const Eigen::Vector3d d2(std::cos(delta) * std::cos(theta), std::cos(delta) * std::sin(theta),
+                             std::sin(delta));
+    const Eigen::Vector3d p0 = ranges_[i] * d0;
+    const Eigen::Vector3d normal = (along_[i] * d1 - p0).cross(across_[i] * d2 - p0);
+    if (normal.norm() <= 0.0) continue;
+    cos_incidence_[i] = static_cast<float>(std::abs(normal.normalized().dot(d0)));
+  }
 }
 
 Result<sensors::LaserLine> SimLineScanner::NextLine(std::chrono::milliseconds timeout) {
@@ -50,8 +81,11 @@ Result<sensors::LaserLine> SimLineScanner::NextLine(std::chrono::milliseconds ti
     CastAt(T_world_laser, -half_div, edge_lo_);
     CastAt(T_world_laser, +half_div, edge_hi_);
   }
+  const bool incidence = model_.config().UsesIncidence();
+  if (incidence) CastIncidence(T_world_laser);
   model_.Measure(ranges_.data(), mixed ? edge_lo_.data() : nullptr,
-                 mixed ? edge_hi_.data() : nullptr, line);
+                 mixed ? edge_hi_.data() : nullptr, line,
+                 incidence ? cos_incidence_.data() : nullptr);
   line.stamp_s = sim_.time_s();
   line.pitch_rad = 0.0;  // the caller fills it from the encoder
   sim_.StepFor(period_s);

@@ -1,21 +1,37 @@
 #include "pitchlab/sim/sim_rig.hpp"
 
+#include <array>
 #include <cmath>
 
 namespace pitchlab::sim {
+namespace {
+
+// The robot as built: the scanner sits on its mount turned by the run's drawn mount error (added
+// to the nominal misalignment's roll, pitch and yaw). Only the simulation gets it; the scan source
+// assembles with the nominal mount, as a pipeline that was never told would.
+RobotConfig TrueRobot(const SimRigConfig& config) {
+  RobotConfig robot = config.robot;
+  const std::array<double, 3> e = sensors::DrawMountErrorRpyRad(config.lms200);
+  robot.mount.misalignment_rpy_rad += Eigen::Vector3d(e[0], e[1], e[2]);
+  return robot;
+}
+
+}  // namespace
 
 SimRig::SimRig(const std::string& world_path, const SimRigConfig& config)
-    : SimRig(std::make_unique<Simulation>(world_path, config.robot), config) {}
+    : SimRig(std::make_unique<Simulation>(world_path, TrueRobot(config)), config) {}
 
 std::unique_ptr<SimRig> SimRig::FromString(const std::string& world_xml,
                                            const std::string& base_dir,
                                            const SimRigConfig& config) {
   return std::unique_ptr<SimRig>(
-      new SimRig(Simulation::FromString(world_xml, base_dir, config.robot), config));
+      new SimRig(Simulation::FromString(world_xml, base_dir, TrueRobot(config)), config));
 }
 
 SimRig::SimRig(std::unique_ptr<Simulation> sim, const SimRigConfig& config)
     : config_(config), sim_(std::move(sim)) {
+  const std::array<double, 3> e = sensors::DrawMountErrorRpyRad(config_.lms200);
+  mount_error_rpy_rad_ = Eigen::Vector3d(e[0], e[1], e[2]);
   sensors::RayCasterOptions options;
   options.exclude_subtree_of_body = kRobotBody;
   caster_ = config_.caster == CasterKind::kEmbree

@@ -42,7 +42,14 @@ class ScanCli : public ::testing::Test {
 
 TEST_F(ScanCli, WritesAFullSeedScanAndAJsonSummaryWithTheTruePose) {
   const fs::path pcd = dir_ / "office.pcd";
-  const CliResult run = Run("scan --world office --json --quiet --out " + pcd.string());
+  // The LMS200 as it was before issue 16 (5 mm noise, a perfect mount): the surface tolerance
+  // below rests on it. The default model's mount error tilts the floor by design.
+  const fs::path config = dir_ / "legacy_lms200.yaml";
+  std::ofstream(config) << "lms200: {noise_sigma_m: 0.005, noise_per_m: 0, "
+                           "incidence_noise_gain: 0, dropout_far_per_m: 0, "
+                           "mount_error_sigma_deg: 0}\n";
+  const CliResult run = Run("scan --world office --json --quiet --config " + config.string() +
+                            " --out " + pcd.string());
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const nlohmann::json summary = nlohmann::json::parse(run.out);
   EXPECT_EQ(summary["lines"], 200);

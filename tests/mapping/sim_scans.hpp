@@ -35,6 +35,11 @@ inline sensors::Scan3D SimulatedScan(const std::string& world, double x_m, doubl
     if (cached) return *cached;
   }
   sim::SimRigConfig config;
+  // The LMS200 these tests' tolerances were measured with (constant noise, perfect mount), until
+  // the registration gates are set relative to the issue-16 model's noise. That model fails 7 of
+  // them (benchmarks/README.md), 2 of those by the mount error alone: each scan here has a seed
+  // of its own, so a mount error of its own, unlike the scans of one robot.
+  config.lms200 = sensors::Lms200Config::Legacy();
   config.lms200.seed = seed;
   config.lms200.noise_sigma_m = noise_sigma_m;
   sim::SimRig rig(std::string(PITCHLAB_WORLDS_DIR) + "/" + world + ".xml", config);

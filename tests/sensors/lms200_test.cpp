@@ -93,7 +93,7 @@ TEST(Lms200, NothingHitIsFlaggedNoReturn) {
 }
 
 TEST(Lms200, NoiseHasTheConfiguredMeanAndSigma) {
-  Lms200Config config;
+  Lms200Config config = Lms200Config::Legacy();  // constant noise, no dropouts
   config.range_mode = Lms200RangeMode::kMm;  // 1 mm unit: quantization adds 0.29 mm sigma
   config.noise_sigma_m = 0.005;
   config.range_bias_m = 0.002;

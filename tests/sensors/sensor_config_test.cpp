@@ -63,5 +63,41 @@ TEST(SensorConfig, WrittenYamlReadsBackTheSame) {
   EXPECT_EQ(SensorConfigToYaml(back), SensorConfigToYaml(c));
 }
 
+TEST(SensorConfig, TheRealismKeysReadBackAndAreChecked) {
+  const SensorConfig c = ParseSensorConfig(
+      "lms200:\n  noise_per_m: 0.003\n  incidence_noise_gain: 0.7\n"
+      "  dropout_grazing_deg: 70\n  dropout_grazing_at_90: 0.2\n  dropout_far_m: 5\n"
+      "  dropout_far_per_m: 0.004\n  mount_error_sigma_deg: 1.5\n",
+      "realism.yaml");
+  EXPECT_DOUBLE_EQ(c.lms200.noise_per_m, 0.003);
+  EXPECT_DOUBLE_EQ(c.lms200.incidence_noise_gain, 0.7);
+  EXPECT_DOUBLE_EQ(c.lms200.dropout_grazing_deg, 70.0);
+  EXPECT_DOUBLE_EQ(c.lms200.dropout_grazing_at_90, 0.2);
+  EXPECT_DOUBLE_EQ(c.lms200.dropout_far_m, 5.0);
+  EXPECT_DOUBLE_EQ(c.lms200.dropout_far_per_m, 0.004);
+  EXPECT_DOUBLE_EQ(c.lms200.mount_error_sigma_deg, 1.5);
+  const SensorConfig back = ParseSensorConfig(SensorConfigToYaml(c), "roundtrip");
+  EXPECT_EQ(SensorConfigToYaml(back), SensorConfigToYaml(c));
+  EXPECT_DOUBLE_EQ(back.lms200.mount_error_sigma_deg, 1.5);
+  auto message = [](const std::string& yaml) {
+    try {
+      ParseSensorConfig(yaml, "bad.yaml");
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  for (const char* bad : {"noise_per_m: -1", "incidence_noise_gain: 11", "dropout_grazing_deg: 95",
+                          "dropout_grazing_at_90: 2", "dropout_far_m: -3", "dropout_far_per_m: 1.5",
+                          "mount_error_sigma_deg: 20"}) {
+    const std::string text = std::string("lms200: {") + bad + "}";
+    const std::string key = std::string(bad).substr(0, std::string(bad).find(':'));
+    const std::string m = message(text);
+    EXPECT_NE(m.find("bad.yaml"), std::string::npos) << bad << ": " << m;
+    EXPECT_NE(m.find("lms200." + key), std::string::npos) << bad << ": " << m;
+  }
+  EXPECT_NE(message("lms200: {mount_error_sigma_deg: lots}").find("wrong type"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace pitchlab::sensors

@@ -1,6 +1,8 @@
 // SimPitchAxis, SimLineScanner and SimRig against tiny inline worlds with known answers.
 
+#include <array>
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -20,6 +22,7 @@ SimRigConfig QuietConfig(CasterKind caster = CasterKind::kEmbree) {
   SimRigConfig c;
   c.robot.model = P3Model::kP3AT;
   c.lms200.noise_sigma_m = 0.0;
+  c.lms200.mount_error_sigma_deg = 0.0;  // the scanner exactly where the mount says
   c.caster = caster;
   c.pattern.pitch_start_deg = -10.0;
   c.pattern.pitch_end_deg = 10.0;
@@ -147,6 +150,86 @@ TEST(SimRig, TheSeedPatternTakesItsLinePeriodsPlusServoMovesOfSimulatedTime) {
   }
   EXPECT_GT(scan->duration_s, bound_s - 0.1);
   EXPECT_LT(scan->duration_s, 1.4 * bound_s);  // settling to half an encoder count costs < 40 %
+}
+
+TEST(SimRig, TheScannerSitsOffTheNominalMountByTheDrawnErrorUnknownToTheScan) {
+  SimRigConfig config = QuietConfig();
+  config.lms200.mount_error_sigma_deg = 2.0;
+  config.lms200.seed = 5;
+  config.pattern.pitch_start_deg = 20.0;  // nose down: the floor in view
+  config.pattern.pitch_end_deg = 40.0;
+  auto rig = MakeRig(config);
+  const std::array<double, 3> e = sensors::DrawMountErrorRpyRad(config.lms200);
+  ASSERT_GT(std::hypot(e[0], e[1], e[2]), 0.5 * kDeg);  // this seed draws a visible error
+  EXPECT_TRUE(rig->mount_error_rpy_rad().isApprox(Eigen::Vector3d(e[0], e[1], e[2])));
+  // The nominal mount the pipeline assembles with is untouched.
+  EXPECT_TRUE(rig->config().robot.mount.misalignment_rpy_rad.isZero());
+  // The simulated laser is the nominal one turned by roll, pitch, yaw = e.
+  Result<double> encoder = rig->pitch_axis().MoveTo(30.0 * kDeg, kTimeout);
+  ASSERT_TRUE(encoder) << encoder.error().message;
+  const Eigen::Matrix3d nominal =
+      (rig->sim().T_world_base() * rig->config().robot.mount.BaseToLaser(*encoder)).rotation();
+  const Eigen::Matrix3d drawn = (Eigen::AngleAxisd(e[2], Eigen::Vector3d::UnitZ()) *
+                                 Eigen::AngleAxisd(e[1], Eigen::Vector3d::UnitY()) *
+                                 Eigen::AngleAxisd(e[0], Eigen::Vector3d::UnitX()))
+                                    .toRotationMatrix();
+  const Eigen::AngleAxisd off(drawn.transpose() * nominal.transpose() *
+                              rig->sim().T_world_laser().rotation());
+  EXPECT_LT(off.angle(), 0.02 * kDeg);  // the servo holds within half an encoder count
+  // The same scan without the error differs: its floor readings sit elsewhere.
+  SimRigConfig level = config;
+  level.lms200.mount_error_sigma_deg = 0.0;
+  auto level_rig = MakeRig(level);
+  Result<sensors::Scan3D> tilted = rig->Acquire(), flat = level_rig->Acquire();
+  ASSERT_TRUE(tilted && flat);
+  int moved = 0, compared = 0;
+  for (std::size_t k = 0; k < flat->lines.size(); ++k) {
+    for (std::size_t i = 0; i < flat->lines[k].ranges_m.size(); ++i) {
+      if (flat->lines[k].status[i] != sensors::ReadingStatus::kValid ||
+          tilted->lines[k].status[i] != sensors::ReadingStatus::kValid) {
+        continue;
+      }
+      ++compared;
+      moved += std::abs(flat->lines[k].ranges_m[i] - tilted->lines[k].ranges_m[i]) > 0.02;
+    }
+  }
+  ASSERT_GT(compared, 500);
+  EXPECT_GT(moved, compared / 2);
+}
+
+// The incidence the scanner derives from its extra rays, seen through grazing dropouts whose
+// probability is the incidence / 90 deg: a level line on the wall at x = 3 m meets it at |theta|.
+TEST(SimLineScanner, IncidenceFromTheHitsIsTheWallsGeometry) {
+  SimRigConfig config = QuietConfig();
+  config.lms200.noise_sigma_m = 0.001;  // not the ideal sensor: dropouts on
+  config.lms200.noise_per_m = 0.0;
+  config.lms200.incidence_noise_gain = 0.0;
+  config.lms200.dropout_far_per_m = 0.0;
+  config.lms200.dropout_grazing_deg = 0.0;
+  config.lms200.dropout_grazing_at_90 = 1.0;
+  auto rig = MakeRig(config);
+  ASSERT_TRUE(rig->pitch_axis().MoveTo(0.0, kTimeout));
+  // The same level line again and again; per centre angle, the beams within 2 deg of it.
+  const std::vector<double> centres_deg = {-40.0, 10.0, 30.0, 50.0};
+  std::vector<double> dropped(centres_deg.size(), 0.0), total(centres_deg.size(), 0.0),
+      expected(centres_deg.size(), 0.0);
+  for (int k = 0; k < 150; ++k) {
+    Result<sensors::LaserLine> line = rig->scanner().NextLine(kTimeout);
+    ASSERT_TRUE(line) << line.error().message;
+    for (std::size_t c = 0; c < centres_deg.size(); ++c) {
+      for (double d = -2.0; d <= 2.0; d += 0.5) {
+        const double theta = centres_deg[c] + d;
+        const auto i = static_cast<std::size_t>(std::lround((theta + 90.0) / 0.5));
+        dropped[c] += line->status[i] == sensors::ReadingStatus::kNoReturn;
+        total[c] += 1;
+        expected[c] += std::abs(theta) / 90.0;
+      }
+    }
+  }
+  for (std::size_t c = 0; c < centres_deg.size(); ++c) {
+    // 1350 draws: the binomial sigma is at most 0.014; 0.04 is about 3 of them.
+    EXPECT_NEAR(dropped[c] / total[c], expected[c] / total[c], 0.04) << centres_deg[c] << " deg";
+  }
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #pragma once
 // SICK LMS200 measurement model: beam layout, range modes, quantization, flags, noise and timing.
 
+#include <array>
 #include <cstdint>
 #include <random>
 
@@ -18,16 +19,69 @@ struct Lms200Config {
   double fov_deg = 180.0;          ///< 100 or 180 [deg]
   double resolution_deg = 0.5;     ///< 1, 0.5 or 0.25 (0.25 only with 100) [deg]
   Lms200RangeMode range_mode = Lms200RangeMode::kCm;
-  double noise_sigma_m = 0.005;    ///< Gaussian range noise, 0 = off [m]
+  // Range noise: Gaussian, sigma^2 = noise_sigma_m^2 + (noise_per_m x range)^2
+  //   + (incidence_noise_gain x range x beam divergence x tan(incidence))^2.
+  // The last term is the depth the beam's footprint spans on a surface it meets obliquely (a
+  // footprint range x divergence wide, tilted by the incidence; tan held at its 85 deg value
+  // beyond): the echo's time spreads over it. The defaults rest on two real scans of a pitching
+  // SICK LMS2xx in a corridor (3DTK, benchmarks/sensor_realism, table in benchmarks/README.md):
+  //  - noise_sigma_m 2 mm: their local plane-fit residual within 45 deg of head-on at 0-2 m is
+  //    3.2 mm (robust sigma), cm-mode quantization alone 2.9 mm; 2 mm gives the sim 3.6 mm.
+  //  - noise_per_m 1.5 mm/m: that residual grows to 6.7 / 9.7 / 11.7 mm at 2-4 / 4-8 / 8-16 m,
+  //    about 1.5 mm per metre (SICK's LMS200 technical description quotes ~1 cm sigma at
+  //    1-20 m in cm mode: this gives 1 cm at 7 m). It also takes the nodding servo's
+  //    line-to-line jitter, which a plane fit cannot tell from range noise.
+  //  - incidence_noise_gain 0.4: with it the residual over all incidences at 2-4 / 4-8 m is
+  //    0.78 / 0.96 of the real one (corridor world); 1/sqrt(12) = 0.29, a uniform spread over the
+  //    footprint, gives 0.61 / 0.71, none 0.31 / 0.13.
+  // noise_sigma_m = 0 is the ideal sensor: no range noise of any term and no dropouts (what the
+  // tests and the emulator's flat wall rely on).
+  double noise_sigma_m = 0.002;    ///< range noise at 0 m and normal incidence [m]
+  double noise_per_m = 0.0015;     ///< range noise growth per metre of range (quadrature) [m/m]
+  double incidence_noise_gain = 0.4;  ///< footprint-depth noise gain, 0 = off [1]
   double range_bias_m = 0.0;       ///< systematic offset added to every range [m]
-  bool mixed_pixels = false;       ///< average foreground and background at depth edges
-  double beam_divergence_deg = 0.25;  ///< full beam width used for mixed pixels [deg]
+  /// Average foreground and background at depth edges. Off: the real scans show 0.11 single
+  /// returns between two surfaces per depth edge, the simulated cluttered world 0.16 without
+  /// any blending (geometry and noise) and 0.31 with it; the data show no blending to add.
+  bool mixed_pixels = false;
+  double beam_divergence_deg = 0.25;  ///< full beam width: mixed pixels, footprint depth [deg]
+  // Dropouts: a return is lost with probability p = grazing + far (capped at 1), each a ramp:
+  //   grazing = dropout_grazing_at_90 x (incidence - start) / (90 deg - start),
+  //             start = dropout_grazing_deg
+  //   far     = dropout_far_per_m x (range - dropout_far_m)          (each 0 below its onset)
+  // The real scans' no-returns among agreeing returns (located dropouts) are 0.02 / 0.13 / 0.54 /
+  // 0.81 % of the returns at 0-2 / 2-4 / 4-8 / 8-16 m: 0.1 % per metre beyond 2 m. By incidence
+  // they are 0.16 / 0.11 / 0.10 / 0.23 % at 0-30 / 30-60 / 60-75 / 75+ deg, and the range ramp
+  // alone gives the simulated corridor 0.23 % at 75+ deg (grazing surfaces are far ones there):
+  // no grazing dropouts beyond range's, so the grazing ramp is off by default.
+  double dropout_grazing_deg = 75.0;  ///< incidence where grazing dropouts begin [deg]
+  double dropout_grazing_at_90 = 0.0;  ///< dropout probability at 90 deg incidence, 0 = off [1]
+  double dropout_far_m = 2.0;      ///< range where long-range dropouts begin [m]
+  double dropout_far_per_m = 0.001;  ///< dropout probability added per metre beyond it [1/m]
+  // The true scanner pose on the robot differs from the nominal MountConfig by a rotation drawn
+  // once per run (roll, pitch, yaw each N(0, sigma), added to the nominal misalignment): the
+  // simulator scans with it, the pipeline assembles with the nominal mount and never learns it
+  // (sim::SimRig). The real scanner, never calibrated, sits 3.0 and 4.3 deg off the floor in its
+  // two scans (sigma 3 deg reproduces that). A pitchlab robot is calibrated by a floor-plane fit
+  // (roll and pitch): that fit's normal is good to ~0.01 deg over thousands of floor points, so
+  // what remains is the calibration floor's own slope under the robot, which we assume flat to
+  // ~4 mm over the ~1 m the robot spans (a finished indoor floor): 0.25 deg. Yaw, unseen by a
+  // floor, is taken as well set as the mount's machining allows, the same 0.25 deg.
+  double mount_error_sigma_deg = 0.25;  ///< per-axis sigma of the drawn rotation, 0 = off [deg]
   int baud = 500000;               ///< serial rate: 9600, 19200, 38400 or 500000 [bit/s]
-  std::uint64_t seed = 1;          ///< noise seed
+  std::uint64_t seed = 1;          ///< noise seed (also draws the dropouts and the mount error)
 
   /// Throws std::invalid_argument naming the field and value when the LMS200 has no such mode.
   void Validate() const;
+  /// The model before issue 16: constant 5 mm noise, no mixed pixels, no dropouts, perfect mount.
+  static Lms200Config Legacy();
+  /// True when Measure needs the incidence of each beam (incidence noise or grazing dropouts).
+  bool UsesIncidence() const { return incidence_noise_gain > 0.0 || dropout_grazing_at_90 > 0.0; }
 };
+
+/// The mount rotation error of a run: roll, pitch, yaw [rad], each N(0, mount_error_sigma_deg),
+/// drawn from `config.seed` on a stream of its own (all zero when the sigma is 0).
+std::array<double, 3> DrawMountErrorRpyRad(const Lms200Config& config);
 
 /// Turns true ranges into LMS200 readings. Deterministic for a given seed and call sequence.
 class Lms200Model {
@@ -48,15 +102,23 @@ class Lms200Model {
 
   /// Fills `line` (ranges, status, angles, duration) from true ranges along each beam [m],
   /// +inf where nothing was hit. With mixed pixels on, `edge_lo`/`edge_hi` are the true ranges at
-  /// the two edges of each beam (else ignored, may be null). Stamp and pitch are left to the caller.
+  /// the two edges of each beam (else ignored, may be null). `cos_incidence` is each beam's
+  /// |cos| of the angle to the surface normal where it hit (null: normal incidence, no incidence
+  /// effects). Stamp and pitch are left to the caller.
   void Measure(const float* true_ranges, const float* edge_lo, const float* edge_hi,
-               LaserLine& line);
+               LaserLine& line, const float* cos_incidence = nullptr);
+  /// The range noise sigma at `range_m` and incidence `incidence_rad` (the formula above) [m].
+  double NoiseSigma(double range_m, double incidence_rad) const;
+  /// The dropout probability at `range_m` and incidence `incidence_rad` (the formula above).
+  double DropoutProbability(double range_m, double incidence_rad) const;
 
  private:
   Lms200Config config_;
   int readings_ = 0;
-  std::mt19937_64 rng_;
+  std::mt19937_64 rng_;      // range noise: the same draws whatever the other effects
+  std::mt19937_64 effects_;  // dropouts, on a stream of their own
   std::normal_distribution<double> noise_{0.0, 1.0};
+  std::uniform_real_distribution<double> uniform_{0.0, 1.0};
 };
 
 }  // namespace pitchlab::sensors

@@ -24,12 +24,15 @@ class SimLineScanner final : public sensors::LineScanner {
   float cast_range_m() const;
 
  private:
-  void CastAt(const Eigen::Isometry3d& T_world_laser, double offset_rad, std::vector<float>& out);
+  void CastAt(const Eigen::Isometry3d& T_world_laser, double offset_rad, std::vector<float>& out,
+              double tip_rad = 0.0);
+  void CastIncidence(const Eigen::Isometry3d& T_world_laser);
 
   Simulation& sim_;
   sensors::RayCaster& caster_;
   sensors::Lms200Model model_;
-  std::vector<float> origins_, directions_, ranges_, edge_lo_, edge_hi_;
+  std::vector<float> origins_, directions_, ranges_, edge_lo_, edge_hi_, along_, across_,
+      cos_incidence_;
 };
 
 }  // namespace pitchlab::sim

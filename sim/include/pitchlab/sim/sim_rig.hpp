@@ -64,11 +64,16 @@ class SimRig final : public sensors::ScanSource {
   sensors::RayCaster& caster() { return *caster_; }
   sensors::PitchingScanSource& scan_source() { return *source_; }
   const SimRigConfig& config() const { return config_; }
+  /// The scanner's true mount minus the nominal one (config().robot.mount), roll/pitch/yaw [rad]:
+  /// drawn from config().lms200 (sensors::DrawMountErrorRpyRad); the scans are assembled with
+  /// the nominal mount, so it shows in them as an uncalibrated scanner would.
+  const Eigen::Vector3d& mount_error_rpy_rad() const { return mount_error_rpy_rad_; }
 
  private:
   SimRig(std::unique_ptr<Simulation> sim, const SimRigConfig& config);
 
   SimRigConfig config_;
+  Eigen::Vector3d mount_error_rpy_rad_ = Eigen::Vector3d::Zero();
   std::unique_ptr<Simulation> sim_;
   std::unique_ptr<sensors::RayCaster> caster_;
   std::unique_ptr<SimBase> base_;
