@@ -503,9 +503,10 @@ struct Options {
          "and of N simulated scans of the world (default corridor; scan k at the default start\n"
          "moved k x 4 m along +x or the next free spot, LMS200 seed S + k), with the ratio sim / "
          "real.\n"
-         "--sensor: lms200/pitch_unit/scan/mount sections over the defaults.\n"
-         "--legacy: the pre-issue-16 LMS200 model (constant noise, no mixed pixels, no dropouts,\n"
-         "perfect mount).\n";
+         "The simulated LMS200 is Lms200Config::Measured() (the model fitted to real scans).\n"
+         "--sensor: lms200/pitch_unit/scan/mount sections over the defaults instead.\n"
+         "--legacy: the default (pre-issue-16) LMS200 model (constant noise, no mixed pixels,\n"
+         "no dropouts, perfect mount).\n";
   std::exit(code);
 }
 
@@ -570,7 +571,9 @@ int main(int argc, char** argv) {
       text << in.rdbuf();
       sensor = sensors::ParseSensorConfig(text.str(), o.sensor_yaml);
     }
-    if (o.legacy) sensor.lms200 = sensors::Lms200Config::Legacy();
+    if (o.sensor_yaml.empty()) {  // the measured model unless asked for the default (legacy) one
+      sensor.lms200 = o.legacy ? sensors::Lms200Config::Legacy() : sensors::Lms200Config::Measured();
+    }
     std::vector<std::string> sim_names;
     json drawn = json::array();
     for (int k = 0; k < o.sim_scans; ++k) {

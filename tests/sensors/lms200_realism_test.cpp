@@ -17,7 +17,7 @@ constexpr int kLines = 200;  // 361 x 200 = 72,200 readings per case: one seed-p
 
 // Only the effect under test: mm mode (1 mm quantization), no dropouts.
 Lms200Config NoiseOnly() {
-  Lms200Config c;
+  Lms200Config c = Lms200Config::Measured();
   c.range_mode = Lms200RangeMode::kMm;
   c.dropout_grazing_at_90 = 0.0;
   c.dropout_far_per_m = 0.0;
@@ -130,7 +130,7 @@ TEST(Lms200Realism, FarDropoutsFollowTheirRamp) {
 }
 
 TEST(Lms200Realism, TheIdealSensorDropsNothing) {
-  Lms200Config c;
+  Lms200Config c = Lms200Config::Measured();
   c.noise_sigma_m = 0.0;
   c.dropout_far_per_m = 0.5;
   c.dropout_grazing_at_90 = 1.0;
@@ -165,7 +165,7 @@ bool SameBytes(const std::vector<LaserLine>& a, const std::vector<LaserLine>& b)
 }
 
 TEST(Lms200Realism, TheSameSeedGivesTheSameBytesAnotherSeedOthers) {
-  Lms200Config c;
+  Lms200Config c = Lms200Config::Measured();
   c.dropout_grazing_at_90 = 0.3;
   c.seed = 42;
   EXPECT_TRUE(SameBytes(Lines(c), Lines(c)));
@@ -198,7 +198,7 @@ TEST(Lms200Realism, DropoutsRemoveReadingsWithoutChangingTheOthersNoise) {
 }
 
 TEST(Lms200Realism, TheMountErrorDrawIsNormalPerAxisAndFixedBySeed) {
-  Lms200Config c;
+  Lms200Config c = Lms200Config::Measured();
   c.mount_error_sigma_deg = 0.5;
   const int n = 4000;
   double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
@@ -234,7 +234,7 @@ TEST(Lms200Realism, LegacyIsTheConstantNoiseModel) {
 
 TEST(Lms200Realism, RejectsOutOfRangeSettingsNamingTheField) {
   auto message = [](void (*set)(Lms200Config&)) -> std::string {
-    Lms200Config c;
+    Lms200Config c = Lms200Config::Measured();
     set(c);
     try {
       c.Validate();
