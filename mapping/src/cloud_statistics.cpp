@@ -13,9 +13,9 @@ namespace pitchlab::mapping {
 namespace {
 
 constexpr std::size_t kMinPoints = 20;
-// Points measured per statistic: the medians of 2000 samples are good to a few per cent, and
+// Points measured per statistic: the medians of 1000 samples are good to a few per cent, and
 // the cost stays far below one ICP run.
-constexpr int kSamples = 2000;
+constexpr int kSamples = 1000;
 
 double Median(std::vector<double> v) {
   if (v.empty()) return 0;
