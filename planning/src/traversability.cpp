@@ -387,6 +387,13 @@ TraversabilityGrid BuildTraversability(const ElevationLayers& L, const PlannerCo
         T.blocked[k] = Blocked::kTooSteep;
       } else if (HasStep(L, i, j, config.robot.step_max_m)) {
         T.blocked[k] = Blocked::kStep;
+      } else if (!incl_known) {
+        // Seen, but the scan did not determine its slope (one or two far points, grazing lines:
+        // LayerConfig's support rule): as steep as anything for all we know, so the unknown
+        // policy decides, as for a cell never seen (terrain seed 12 tipped over at 33.8 deg where
+        // such cells had counted as level).
+        if (config.unknown == UnknownPolicy::kForbid) T.blocked[k] = Blocked::kUnknown;
+        T.enter_cost[k] += static_cast<float>(config.unknown_penalty);
       }
     }
   const std::vector<std::size_t> border = HazardBorder(T);
