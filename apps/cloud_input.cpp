@@ -53,4 +53,13 @@ std::optional<Eigen::Vector3d> SensorOriginOption(const CliArgs& args) {
   return ParseSensorOrigin(args.Get("sensor-origin"));
 }
 
+std::optional<std::pair<double, double>> PriorErrorOption(const CliArgs& args) {
+  if (!args.Has("prior-error")) return std::nullopt;
+  const std::vector<double> e = args.GetNumbers("prior-error", 2);
+  if (!(e[0] >= 0 && e[1] >= 0 && std::isfinite(e[0]) && std::isfinite(e[1]))) {
+    throw CliError("--prior-error: metres and degrees must be finite and >= 0");
+  }
+  return std::pair{e[0], e[1]};
+}
+
 }  // namespace pitchlab::apps

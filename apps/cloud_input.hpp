@@ -4,6 +4,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 
 #include <Eigen/Core>
 
@@ -25,6 +26,10 @@ sensors::Scan3D LoadInputCloud(const std::string& path,
 
 /// "0.1,0,0.54" -> (0.1, 0, 0.54) [m]; CliError naming --sensor-origin unless three finite numbers.
 Eigen::Vector3d ParseSensorOrigin(const std::string& text);
+
+/// --prior-error's "metres,degrees" when given, else nullopt; CliError unless both are finite and
+/// >= 0.
+std::optional<std::pair<double, double>> PriorErrorOption(const CliArgs& args);
 
 /// --sensor-origin's value when given (ParseSensorOrigin), else nullopt.
 std::optional<Eigen::Vector3d> SensorOriginOption(const CliArgs& args);

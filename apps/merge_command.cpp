@@ -78,13 +78,7 @@ int RunMerge(int argc, char** argv) {
   config.map_voxel_m = args.GetNumbers("voxel", 1)[0];
   if (!(config.map_voxel_m > 0)) throw CliError("--voxel must be > 0");
   std::optional<mapping::GuessUncertainty> bound;
-  if (args.Has("prior-error")) {
-    const std::vector<double> e = args.GetNumbers("prior-error", 2);
-    if (!(e[0] >= 0 && e[1] >= 0 && std::isfinite(e[0]) && std::isfinite(e[1]))) {
-      throw CliError("--prior-error: metres and degrees must be finite and >= 0");
-    }
-    bound = mapping::GuessUncertainty{e[0], e[1]};
-  }
+  if (const auto e = PriorErrorOption(args)) bound = mapping::GuessUncertainty{e->first, e->second};
   const std::optional<Eigen::Vector3d> origin = SensorOriginOption(args);
 
   const std::vector<std::string>& files = args.positionals();

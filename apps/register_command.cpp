@@ -134,13 +134,9 @@ int RunRegister(int argc, char** argv) {
   mapping::RegistrationPrior prior;
   const bool prior_from_files = args.Has("prior") && args.Get("prior") == "files";
   if (args.Has("prior") && !prior_from_files) prior.odometry = PoseOption(args, "prior");
-  if (args.Has("prior-error")) {
-    const std::vector<double> e = args.GetNumbers("prior-error", 2);
-    if (!(e[0] >= 0 && e[1] >= 0 && std::isfinite(e[0]) && std::isfinite(e[1]))) {
-      throw CliError("--prior-error: metres and degrees must be finite and >= 0");
-    }
+  if (const auto e = PriorErrorOption(args)) {
     if (!args.Has("prior")) throw CliError("--prior-error bounds a --prior; give one");
-    prior.odometry_uncertainty = mapping::GuessUncertainty{e[0], e[1]};
+    prior.odometry_uncertainty = mapping::GuessUncertainty{e->first, e->second};
   }
   if (args.Has("previous")) prior.previous_motion = PoseOption(args, "previous");
 

@@ -54,17 +54,8 @@ double MedianSpacing(const PointCloud& cloud, const std::vector<int>& samples, d
 // takes up one direction of the noise) with the second eigenvalue under a tenth of the first.
 double PlaneResidual(const PointCloud& cloud, const std::vector<int>& nn) {
   if (nn.size() < 10) return NAN;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (int j : nn) mean += cloud[j].cast<double>();
-  mean /= static_cast<double>(nn.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (int j : nn) {
-    const Eigen::Vector3d d = cloud[j].cast<double>() - mean;
-    cov += d * d.transpose();
-  }
-  cov /= static_cast<double>(nn.size());
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-  eig.computeDirect(cov, Eigen::EigenvaluesOnly);
+  eig.computeDirect(Scatter(cloud, nn) / static_cast<double>(nn.size()), Eigen::EigenvaluesOnly);
   const Eigen::Vector3d ev = eig.eigenvalues();  // ascending
   if (!(ev(1) >= 0.1 * ev(2))) return NAN;
   return std::sqrt(std::max(0.0, ev(0)));

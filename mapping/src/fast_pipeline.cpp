@@ -109,6 +109,18 @@ bool PriorRegion::Contains(const Eigen::Isometry3d& T) const {
          Eigen::AngleAxisd(d.linear()).angle() <= rotation_rad;
 }
 
+Eigen::Matrix3d Scatter(const PointCloud& cloud, const std::vector<int>& indices) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int j : indices) mean += cloud[j].cast<double>();
+  mean /= static_cast<double>(std::max<std::size_t>(1, indices.size()));
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (int j : indices) {
+    const Eigen::Vector3d d = cloud[j].cast<double>() - mean;
+    scatter += d * d.transpose();
+  }
+  return scatter;
+}
+
 Normals EstimateNormals(const PointCloud& cloud, const VoxelHashIndex& index, float radius_m,
                         const Eigen::Vector3f& viewpoint) {
   Normals normals(cloud.size(), Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()));
@@ -117,16 +129,8 @@ Normals EstimateNormals(const PointCloud& cloud, const VoxelHashIndex& index, fl
     nn.clear();
     index.Radius(cloud[i], radius_m, nn);
     if (nn.size() < 5) continue;
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (int j : nn) mean += cloud[j].cast<double>();
-    mean /= static_cast<double>(nn.size());
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (int j : nn) {
-      const Eigen::Vector3d d = cloud[j].cast<double>() - mean;
-      cov += d * d.transpose();
-    }
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-    eig.computeDirect(cov);
+    eig.computeDirect(Scatter(cloud, nn));
     Eigen::Vector3f n = eig.eigenvectors().col(0).cast<float>();
     if (n.dot(viewpoint - cloud[i]) < 0) n = -n;
     normals[i] = n;

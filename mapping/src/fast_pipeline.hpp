@@ -18,6 +18,9 @@ class LazySeenSpace;
 using Normals = std::vector<Eigen::Vector3f>;  // NaN where a point has too few neighbours
 using FeatureMatrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
+/// Scatter matrix (sum of outer products about their mean) of the points `indices` of `cloud`.
+Eigen::Matrix3d Scatter(const PointCloud& cloud, const std::vector<int>& indices);
+
 /// PCA normals over `radius_m`, oriented towards `viewpoint` (the sensor, in the cloud's frame).
 Normals EstimateNormals(const PointCloud& cloud, const VoxelHashIndex& index, float radius_m,
                         const Eigen::Vector3f& viewpoint);
