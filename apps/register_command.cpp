@@ -61,16 +61,6 @@ Eigen::Isometry3d PriorFromFiles(const sensors::Scan3D& source, const std::strin
   return target.T_world_base.inverse() * source.T_world_base;
 }
 
-nlohmann::json Matrix6Json(const mapping::Matrix6d& m) {
-  nlohmann::json rows = nlohmann::json::array();
-  for (int r = 0; r < 6; ++r) {
-    nlohmann::json row = nlohmann::json::array();
-    for (int c = 0; c < 6; ++c) row.push_back(m(r, c));
-    rows.push_back(row);
-  }
-  return rows;
-}
-
 nlohmann::json StatisticsJson(const mapping::CloudStatistics& s) {
   return {{"points", s.points},
           {"median_range_m", s.median_range_m},

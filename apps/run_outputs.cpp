@@ -144,7 +144,8 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
       {"timings_s", StageTimingsJson(reg.timings)},
       {"T_map_base", matrix},
       {"estimate", PoseJson(stop.T_world_base)},
-      {"odometry", PoseJson(stop.T_world_base_odom)}};
+      {"odometry", PoseJson(stop.T_world_base_odom)},
+      {"observability", ObservabilityJson(reg)}};
   if (stop.T_world_base_true) {
     const Eigen::Isometry3d d = stop.T_world_base_true->inverse() * stop.T_world_base;
     j["truth"] = PoseJson(*stop.T_world_base_true);
