@@ -20,7 +20,7 @@ function(pitchlab_add_test name)
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main GTest::gmock)
   target_compile_definitions(${name} PRIVATE
-    PITCHLAB_TEST_DATA_DIR="${PITCHLAB_SHARED_DATA_DIR}"
+    PITCHLAB_TEST_DATA_DIR="${PITCHLAB_TEST_DATA_SOURCE_DIR}"
     PITCHLAB_WORLDS_DIR="${PITCHLAB_WORLDS_BUILD_DIR}"
     PITCHLAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 600)
