@@ -82,34 +82,34 @@ nlohmann::json ResultJson(const mapping::RegistrationResult& r) {
     for (int col = 0; col < 4; ++col) matrix.push_back(r.T_target_source.matrix()(row, col));
   }
   const mapping::RegistrationConfig& c = r.settings;
-  return {{"T_target_source", matrix},
-          {"success", r.success},
-          {"outcome", mapping::ToString(r.outcome)},
-          {"reason", r.reason},
-          {"path", mapping::ToString(r.path)},
-          {"fitness_m2", r.fitness_m2},
-          {"rmse_m", r.rmse_m},
-          {"inlier_ratio", r.inlier_ratio},
-          {"degeneracy", r.degeneracy},
-          {"sac_inliers", r.sac_inliers},
-          {"iterations", r.iterations},
-          {"information", Matrix6Json(r.information)},
-          {"covariance", Matrix6Json(r.covariance)},
-          {"covariance_order", "roll pitch yaw [rad] x y z [m], perturbation in TARGET's frame"},
-          {"sigma", SigmasJson(r.covariance)},
-          {"statistics", {{"source", StatisticsJson(r.source_statistics)},
+  nlohmann::json out = {{"T_target_source", matrix},
+                        {"success", r.success},
+                        {"reason", r.reason},
+                        {"path", mapping::ToString(r.path)},
+                        {"fitness_m2", r.fitness_m2},
+                        {"rmse_m", r.rmse_m},
+                        {"inlier_ratio", r.inlier_ratio},
+                        {"degeneracy", r.degeneracy},
+                        {"sac_inliers", r.sac_inliers},
+                        {"iterations", r.iterations},
+                        {"information", Matrix6Json(r.information)},
+                        {"sigma", SigmasJson(r.covariance)},
+                        {"statistics",
+                         {{"source", StatisticsJson(r.source_statistics)},
                           {"target", StatisticsJson(r.target_statistics)}}},
-          {"settings_used",
-           {{"length_scale", c.length_scale},
-            {"icp_voxel_m", c.icp_voxel_m},
-            {"feature_voxel_m", c.feature_voxel_m},
-            {"inlier_distance_m", c.inlier_distance_m},
-            {"max_rmse_m", c.max_rmse_m},
-            {"free_space_margin_m", c.free_space_margin_m},
-            {"icp_max_distance_m", c.icp_max_distance_m},
-            {"icp_min_distance_m", c.icp_min_distance_m},
-            {"constraint_translation_m", c.constraint_translation_m}}},
-          {"timings_s", StageTimingsJson(r.timings)}};
+                        {"settings_used",
+                         {{"length_scale", c.length_scale},
+                          {"icp_voxel_m", c.icp_voxel_m},
+                          {"feature_voxel_m", c.feature_voxel_m},
+                          {"inlier_distance_m", c.inlier_distance_m},
+                          {"max_rmse_m", c.max_rmse_m},
+                          {"free_space_margin_m", c.free_space_margin_m},
+                          {"icp_max_distance_m", c.icp_max_distance_m},
+                          {"icp_min_distance_m", c.icp_min_distance_m},
+                          {"constraint_translation_m", c.constraint_translation_m}}},
+                        {"timings_s", StageTimingsJson(r.timings)}};
+  out.update(ObservabilityJson(r));  // outcome, covariance, noise, length scale: as run stops say
+  return out;
 }
 
 }  // namespace
@@ -154,9 +154,9 @@ int RunRegister(int argc, char** argv) {
   }
   const Eigen::Matrix4d& M = r->T_target_source.matrix();
   std::printf("%s: %s\nT_target_source =\n",
-              r->success ? "registered" : (r->outcome == mapping::RegistrationOutcome::kAmbiguous
-                                               ? "AMBIGUOUS"
-                                               : "FAILED"),
+              r->success ? "registered"
+                         : (r->outcome == mapping::RegistrationOutcome::kAmbiguous ? "AMBIGUOUS"
+                                                                                   : "FAILED"),
               r->reason.c_str());
   for (int row = 0; row < 4; ++row) {
     std::printf("  %10.6f %10.6f %10.6f %10.6f\n", M(row, 0), M(row, 1), M(row, 2), M(row, 3));
