@@ -4,7 +4,8 @@
 // any: the outcome, the error against the reference, and the fit at our pose and at the
 // reference's (the share of the source's points within 5 cm of the target, and their
 // point-to-plane RMS, at full resolution), with the CPU time of the registering thread. Prints
-// JSON.
+// JSON. Then the map check (real_map_check.hpp) of all the scans at the reference poses and at
+// ours (each scan registered into the one before, with the odometry prior, chained).
 //
 //   real_eval DIR [--prior-error m,deg] [--config FILE.yaml]
 
@@ -25,6 +26,7 @@
 
 #include "pitchlab/mapping/registration.hpp"
 #include "pitchlab/sensors/cloud_file.hpp"
+#include "real_map_check.hpp"
 
 namespace {
 
@@ -143,7 +145,8 @@ Scan Load(const fs::path& path) {
 }
 
 json Run(const Scan& target, const Scan& source, const Grid& grid, bool with_prior,
-         const mapping::GuessUncertainty& bound, const mapping::RegistrationConfig& config) {
+         const mapping::GuessUncertainty& bound, const mapping::RegistrationConfig& config,
+         Eigen::Isometry3d& T_target_source) {
   mapping::RegistrationPrior prior;
   prior.source_sensor = source.scan.sensor_origin.value_or(Eigen::Vector3d::Zero()).cast<float>();
   prior.target_sensor = target.scan.sensor_origin.value_or(Eigen::Vector3d::Zero()).cast<float>();
@@ -156,6 +159,7 @@ json Run(const Scan& target, const Scan& source, const Grid& grid, bool with_pri
       mapping::Register(target.cloud, source.cloud, prior, config);
   const double cpu_s = ThreadCpuSeconds() - cpu;
   if (!r) return {{"error", r.error().message}};
+  T_target_source = r->T_target_source;
   const Eigen::Isometry3d reference = target.reference.inverse() * source.reference;
   const mapping::PoseError e = mapping::ComparePoses(r->T_target_source, reference);
   const Fit ours = FitAt(grid, target.cloud, source.cloud, r->T_target_source);
@@ -224,6 +228,9 @@ int main(int argc, char** argv) {
     for (const fs::path& p : paths) scans.push_back(Load(p));
     json pairs = json::array();
     std::vector<double> cpu;
+    // Our pose of each scan in the first one's frame (with the prior, into the scan before).
+    std::vector<Eigen::Isometry3d> ours{Eigen::Isometry3d::Identity()};
+    bool chained = true;
     int runs = 0, successes = 0, within_target = 0, false_successes = 0;
     for (std::size_t k = 0; k + 1 < scans.size(); ++k) {
       for (const auto& [t, s] : {std::pair{&scans[k], &scans[k + 1]}, {&scans[k + 1], &scans[k]}}) {
@@ -231,7 +238,12 @@ int main(int argc, char** argv) {
         for (const bool with_prior : {true, false}) {
           std::fprintf(stderr, "  %s -> %s, %s\n", s->path.c_str(), t->path.c_str(),
                        with_prior ? "odometry prior" : "no prior");
-          json r = Run(*t, *s, grid, with_prior, bound, config);
+          Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+          json r = Run(*t, *s, grid, with_prior, bound, config, T);
+          if (with_prior && s == &scans[k + 1]) {
+            chained = chained && r.value("success", false);
+            ours.push_back(ours.back() * T);
+          }
           r["source"] = s->path;
           r["target"] = t->path;
           if (!r.contains("error")) {
@@ -250,6 +262,25 @@ int main(int argc, char** argv) {
       }
     }
     std::sort(cpu.begin(), cpu.end());
+    std::vector<benchmarks::PosedCloud> at_reference, at_ours;
+    for (std::size_t k = 0; k < scans.size(); ++k) {
+      const Eigen::Vector3f sensor =
+          scans[k].scan.sensor_origin.value_or(Eigen::Vector3d::Zero()).cast<float>();
+      at_reference.push_back(
+          {&scans[k].cloud, sensor, scans[0].reference.inverse() * scans[k].reference});
+      at_ours.push_back({&scans[k].cloud, sensor, ours[k]});
+    }
+    std::fprintf(stderr, "  map check\n");
+    json map_check = {{"at_reference", benchmarks::CheckMap(at_reference)}};
+    // Each scan alone: how flat the data's own floor is, whatever the poses.
+    for (const benchmarks::PosedCloud& one : at_reference) {
+      map_check["each_scan_alone"].push_back(benchmarks::CheckMap({one})["floor"]);
+    }
+    if (chained) {
+      map_check["at_ours"] = benchmarks::CheckMap(at_ours);
+    } else {
+      map_check["at_ours"] = "not built: a registration with the prior failed";
+    }
     json out = {{"folder", dir},
                 {"prior_error", {bound.translation_m, bound.rotation_deg}},
                 {"runs", runs},
@@ -258,6 +289,7 @@ int main(int argc, char** argv) {
                 {"successes_off_the_reference", false_successes},
                 {"cpu_s", {{"median", cpu.empty() ? 0 : cpu[cpu.size() / 2]},
                            {"max", cpu.empty() ? 0 : cpu.back()}}},
+                {"map", map_check},
                 {"runs_detail", pairs}};
     std::cout << out.dump(2) << "\n";
   } catch (const std::exception& e) {

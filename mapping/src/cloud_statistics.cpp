@@ -105,4 +105,23 @@ CloudStatistics MeasureCloud(const PointCloud& cloud, const Eigen::Vector3f& sen
   return out;
 }
 
+double ShareWithin(const PointCloud& target, const PointCloud& source,
+                   const Eigen::Isometry3d& T_target_source, double distance_m) {
+  if (source.empty()) return 0;
+  PointCloud finite;
+  finite.reserve(target.size());
+  for (const Eigen::Vector3f& p : target) {
+    if (p.allFinite()) finite.push_back(p);
+  }
+  const VoxelHashIndex index(finite, distance_m);
+  const Eigen::Isometry3f T = T_target_source.cast<float>();
+  const float d = static_cast<float>(distance_m);
+  std::size_t within = 0;
+  float d2 = 0;
+  for (const Eigen::Vector3f& p : source) {
+    if (p.allFinite() && index.Nearest(T * p, d, d2) >= 0) ++within;
+  }
+  return static_cast<double>(within) / static_cast<double>(source.size());
+}
+
 }  // namespace pitchlab::mapping

@@ -113,5 +113,25 @@ TEST(Resolve, AutoReadsAndWritesAsAuto) {
                std::invalid_argument);
 }
 
+// A 2 x 2 m floor at 1 cm spacing against itself moved up: every point is within 5 cm at a 3 cm
+// lift and none at 6 cm; points beyond reach count against it, NaN points never count.
+TEST(ShareWithin, CountsTheSourcePointsTheTransformPutsNearTheTarget) {
+  PointCloud floor;
+  for (int i = 0; i < 200; ++i) {
+    for (int j = 0; j < 200; ++j) floor.emplace_back(0.01f * i, 0.01f * j, 0.0f);
+  }
+  const auto lift = [](double z) {
+    return Eigen::Isometry3d(Eigen::Translation3d(0, 0, z));
+  };
+  EXPECT_DOUBLE_EQ(ShareWithin(floor, floor, lift(0.03), 0.05), 1.0);
+  EXPECT_DOUBLE_EQ(ShareWithin(floor, floor, lift(0.06), 0.05), 0.0);
+  PointCloud half = floor;
+  for (Eigen::Vector3f& p : half) p.x() += 1.0f;  // x 1-2.99 m against 0-1.99 m
+  EXPECT_NEAR(ShareWithin(floor, half, lift(0.0), 0.05), 105.0 / 200, 1e-9);  // x <= 2.04 m
+  PointCloud with_nan = {floor[0], Eigen::Vector3f::Constant(NAN)};
+  EXPECT_DOUBLE_EQ(ShareWithin(floor, with_nan, lift(0.0), 0.05), 0.5);
+  EXPECT_DOUBLE_EQ(ShareWithin(floor, {}, lift(0.0), 0.05), 0.0);
+}
+
 }  // namespace
 }  // namespace pitchlab::mapping

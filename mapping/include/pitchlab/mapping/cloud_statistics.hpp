@@ -5,6 +5,7 @@
 #include <cstddef>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "pitchlab/mapping/point_cloud.hpp"
 
@@ -27,5 +28,12 @@ struct CloudStatistics {
 /// Measures `cloud` (points [m]) seen from `sensor` (in the cloud's frame). Non-finite points are
 /// skipped. A cloud with fewer than 20 finite points gives zeros apart from `points`. Deterministic.
 CloudStatistics MeasureCloud(const PointCloud& cloud, const Eigen::Vector3f& sensor);
+
+/// The share of `source`'s points that `T_target_source` puts within `distance_m` of a point of
+/// `target`, at full resolution: how well a pose fits as the scans measured it (every point
+/// counts once), the figure real_eval and the real-data tests compare a result with a reference
+/// pose by. 0 for an empty source. Non-finite points count as not within.
+double ShareWithin(const PointCloud& target, const PointCloud& source,
+                   const Eigen::Isometry3d& T_target_source, double distance_m);
 
 }  // namespace pitchlab::mapping
