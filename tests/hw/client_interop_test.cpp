@@ -388,16 +388,6 @@ std::vector<std::string> Sync2Strings(const Bytes& packet) {
   return out;
 }
 
-template <typename Pred>
-bool Eventually(Pred pred, milliseconds timeout = kReplyTimeout) {
-  const auto deadline = Clock::now() + timeout;
-  while (!pred()) {
-    if (Clock::now() > deadline) return false;
-    std::this_thread::sleep_for(milliseconds(5));
-  }
-  return true;
-}
-
 // ROS p2os P2OSNode::Setup: SYNC0 (repeated while unanswered), SYNC1, SYNC2, each answered by
 // a packet whose packet[3] is the same number; then the strings, OPEN, PULSE.
 std::vector<std::string> RosP2osSync(Wire& wire) {

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "pitchlab/hw/lms200_protocol.hpp"
@@ -123,6 +124,17 @@ inline std::optional<Bytes> SicktoolboxTransact(Wire& wire, const Bytes& request
     if ((*payload)[0] == std::uint8_t(request[0] + 0x80)) return payload;
   }
   return std::nullopt;
+}
+
+// Polls `pred` every 5 ms until it holds or `timeout` passes.
+template <typename Pred>
+inline bool Eventually(Pred pred, milliseconds timeout = kReplyTimeout) {
+  const auto deadline = Clock::now() + timeout;
+  while (!pred()) {
+    if (Clock::now() > deadline) return false;
+    std::this_thread::sleep_for(milliseconds(5));
+  }
+  return true;
 }
 
 }  // namespace pitchlab::hw::client

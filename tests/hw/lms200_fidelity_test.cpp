@@ -231,15 +231,38 @@ TEST(Lms200OutputModes, ASubrangeStreamsB7WithItsIndicesAndOnlyThoseValues) {
   EXPECT_EQ((*refused)[1], 0x02);
 }
 
-TEST(Lms200OutputModes, PartialScansAreNotPossibleAndTheModeInForceStays) {
+TEST(Lms200OutputModes, ModesItDoesNotEmulateAreNotPossibleAndTheModeInForceStays) {
   // Documented as not emulated (docs/hardware_interop.md): A0 with 0x02, nothing streamed.
+  // sicktoolbox's operating modes: 28 mean sub-range (BF), 29 values with field bits, 2A partial
+  // scans, 2B range and reflectivity of partial scans, 2C minimum per segment, 2E navigation,
+  // 50 range and reflectivity (LMS2x1-S14 only, C4).
+  const Bytes requests[] = {
+      {0x02, 0x00, 0x02, 0x00, 0x20, 0x28, 0x38, 0x08},
+      {0x02, 0x00, 0x02, 0x00, 0x20, 0x29, 0x39, 0x08},
+      {0x02, 0x00, 0x02, 0x00, 0x20, 0x2A, 0x3A, 0x08},
+      {0x02, 0x00, 0x02, 0x00, 0x20, 0x2B, 0x3B, 0x08},
+      {0x02, 0x00, 0x02, 0x00, 0x20, 0x2C, 0x3C, 0x08},
+      {0x02, 0x00, 0x02, 0x00, 0x20, 0x2E, 0x3E, 0x08},
+      {0x02, 0x00, 0x02, 0x00, 0x20, 0x50, 0x40, 0x08},
+  };
   Lms200Emulator emulator{Lms200EmulatorConfig{}};
   Wire wire(emulator.path(), 9600);
-  ASSERT_EQ(WriteAndReadAck(wire, {0x02, 0x00, 0x02, 0x00, 0x20, 0x2A, 0x3A, 0x08}), 0x06);
-  const auto reply = NextMessage(wire, 0xA0);
-  ASSERT_TRUE(reply);
-  EXPECT_EQ(*reply, (Bytes{0xA0, 0x02, 0x00}));
-  EXPECT_FALSE(emulator.streaming());
+  for (const Bytes& request : requests) {
+    SCOPED_TRACE(int(request[5]));
+    ASSERT_EQ(WriteAndReadAck(wire, request), 0x06);
+    const auto reply = NextMessage(wire, 0xA0);
+    ASSERT_TRUE(reply);
+    EXPECT_EQ(*reply, (Bytes{0xA0, 0x02, 0x00}));
+    EXPECT_FALSE(emulator.streaming());
+  }
+}
+
+TEST(Lms200Requests, RequestsOutsideTheEmulatedSetAreNotAcknowledged) {
+  // 36 (not in the emulated set) and 30 with a sub-code other than 01 (one full scan): NAK.
+  Lms200Emulator emulator{Lms200EmulatorConfig{}};
+  Wire wire(emulator.path(), 9600);
+  EXPECT_EQ(WriteAndReadAck(wire, {0x02, 0x00, 0x01, 0x00, 0x36, 0x12, 0x12}), 0x15);
+  EXPECT_EQ(WriteAndReadAck(wire, {0x02, 0x00, 0x02, 0x00, 0x30, 0x05, 0x35, 0x18}), 0x15);
 }
 
 }  // namespace
