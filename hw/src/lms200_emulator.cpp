@@ -72,12 +72,15 @@ void Lms200Emulator::OnBytes(const std::uint8_t* bytes, std::size_t size) {
     return;
   }
   reader_.Feed(bytes, size);
-  while (auto event = reader_.Next()) {
+  for (;;) {
+    std::optional<lms200::ReaderEvent> event = reader_.Next();
+    // A framed request whose CRC is wrong is NAKed, whether or not anything follows it.
     if (reader_.stats().crc_errors != crc_errors_seen_) {
       crc_errors_seen_ = reader_.stats().crc_errors;
       CountRequest(false);
       Send({lms200::kNak});
     }
+    if (!event) break;
     if (event->kind != lms200::ReaderEvent::Kind::kTelegram) continue;
     CountRequest(true);
     Handle(event->telegram);

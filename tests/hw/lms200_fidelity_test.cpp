@@ -263,6 +263,12 @@ TEST(Lms200Requests, RequestsOutsideTheEmulatedSetAreNotAcknowledged) {
   Wire wire(emulator.path(), 9600);
   EXPECT_EQ(WriteAndReadAck(wire, {0x02, 0x00, 0x01, 0x00, 0x36, 0x12, 0x12}), 0x15);
   EXPECT_EQ(WriteAndReadAck(wire, {0x02, 0x00, 0x02, 0x00, 0x30, 0x05, 0x35, 0x18}), 0x15);
+  // 31 (status) with its CRC's low byte flipped: NAK, as the listing says for a CRC error.
+  EXPECT_EQ(WriteAndReadAck(wire, LmsRequest({0x31})), 0x06);
+  ASSERT_TRUE(NextMessage(wire, 0xB1));  // the status reply, before the next request
+  Bytes corrupted = LmsRequest({0x31});
+  corrupted[5] ^= 0xFF;
+  EXPECT_EQ(WriteAndReadAck(wire, corrupted), 0x15);
 }
 
 }  // namespace

@@ -237,6 +237,29 @@ TEST(P2osKeepAlive, ADriverLeftAloneDuringAScanKeepsTheRobotAwakeAndItsSipsRead)
   EXPECT_NEAR(odom->x_m, 0.2 * 3.1, 0.1);
 }
 
+TEST(P2osSetO, SetoPutsTheReportedPoseBackToTheOrigin) {
+  P2osEmulator emulator{P2osEmulatorConfig{}};
+  Wire wire(emulator.path(), 9600);
+  p2os::PacketReader reader;
+  Connect(wire, reader);
+  wire.Write({0xFA, 0xFB, 0x06, 0x0B, 0x3B, 0xC8, 0x00, 0xD3, 0x3B});  // VEL 200
+  std::this_thread::sleep_for(milliseconds(500));
+  wire.Write({0xFA, 0xFB, 0x03, 0x1D, 0x00, 0x1D});  // STOP
+  std::this_thread::sleep_for(milliseconds(200));
+  wire.Flush();
+  reader.Clear();
+  const auto moved = NextSip(wire, reader);
+  ASSERT_TRUE(moved);
+  EXPECT_GT(Le16s(*moved, 1), 50);  // ~100 mm driven
+  wire.Write({0xFA, 0xFB, 0x03, 0x07, 0x00, 0x07});  // SETO
+  std::this_thread::sleep_for(milliseconds(200));
+  wire.Flush();
+  reader.Clear();
+  const auto reset = NextSip(wire, reader);
+  ASSERT_TRUE(reset);
+  EXPECT_EQ(Bytes(reset->begin() + 1, reset->begin() + 7), Bytes(6, 0x00));  // x, y, th
+}
+
 // A parked base whose simulation creeps: the heading drifts (a gyro's bias), the wheel speeds
 // flicker +-1 mm/s (a position loop), the wheels stay within a fraction of an encoder tick.
 struct CreepingBase {
