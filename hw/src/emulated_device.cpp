@@ -165,7 +165,8 @@ void EmulatedDevice::Loop() {
   }
 }
 
-void EmulatedDevice::Send(const std::vector<std::uint8_t>& message) {
+void EmulatedDevice::Send(const std::vector<std::uint8_t>& message,
+                          std::optional<std::chrono::steady_clock::time_point> not_before) {
   if (!powered_) return;
   std::vector<std::uint8_t> bytes = message;
   FaultPlan::Kind fault = FaultPlan::Kind::kNone;
@@ -201,17 +202,19 @@ void EmulatedDevice::Send(const std::vector<std::uint8_t>& message) {
       }
     }
   }
+  const auto start = not_before.value_or(std::chrono::steady_clock::now());
   if (fault == FaultPlan::Kind::kDelay) {
     const std::size_t half = bytes.size() / 2;
-    WriteAtLineRate(bytes.data(), half);
+    WriteAtLineRate(bytes.data(), half, start);
     line_free_at_ += std::chrono::milliseconds(delay_ms);
-    WriteAtLineRate(bytes.data() + half, bytes.size() - half);
+    WriteAtLineRate(bytes.data() + half, bytes.size() - half, line_free_at_);
     return;
   }
-  WriteAtLineRate(bytes.data(), bytes.size());
+  WriteAtLineRate(bytes.data(), bytes.size(), start);
 }
 
-void EmulatedDevice::WriteAtLineRate(const std::uint8_t* bytes, std::size_t size) {
+void EmulatedDevice::WriteAtLineRate(const std::uint8_t* bytes, std::size_t size,
+                                     std::chrono::steady_clock::time_point not_before) {
   // A UART puts 10 bits a byte (8N1) on the line, one message after the other. Writing the
   // message whole when its last byte would have arrived keeps every client's inter-byte timeout
   // (sicktoolbox: 35 ms) out of reach of the scheduler: a write in small paced chunks stalled
@@ -220,8 +223,11 @@ void EmulatedDevice::WriteAtLineRate(const std::uint8_t* bytes, std::size_t size
   using Clock = std::chrono::steady_clock;
   const auto wire = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(double(size) * 10.0 / double(baud_)));
-  line_free_at_ = std::max(line_free_at_, Clock::now()) + wire;
+  // The first byte leaves when the line is free (the previous message handed over) and not
+  // before `not_before`.
+  line_free_at_ = std::max({line_free_at_, last_write_, not_before}) + wire;
   std::this_thread::sleep_until(line_free_at_);
+  last_write_ = Clock::now();
   std::size_t sent = 0;
   while (sent < size && running_) {
     const int fd = master_;

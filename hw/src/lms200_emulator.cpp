@@ -311,22 +311,29 @@ double Lms200Emulator::ScanPeriodS() const {
   return sensors::Lms200Model(current()).interlaced_sweeps() / 75.0;
 }
 
-void Lms200Emulator::SendScan(bool mirror_wait) {
-  // A requested scan waits for the mirror; a streamed one is the newest already measured.
+void Lms200Emulator::SendScan(bool mirror_wait, double ready_s) {
+  // A requested scan waits for the mirror; a streamed one is the newest already measured, ready
+  // at `ready_s` (steady clock [s]): its bytes leave from then, or when the line is free.
   if (mirror_wait) std::this_thread::sleep_for(std::chrono::duration<double>(ScanPeriodS()));
+  std::optional<std::chrono::steady_clock::time_point> ready;
+  if (!mirror_wait) {
+    ready = std::chrono::steady_clock::time_point(std::chrono::duration_cast<
+                                                  std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(ready_s)));
+  }
   const std::uint8_t mode = output_;
   const int samples = mirror_wait || mode != lms200::kModeMeanValues ? 1 : mean_samples_;
   lms200::MeasuredValues mv = Measure(samples);
   if (!mirror_wait && mode == lms200::kModeMeanValues) {
-    Send(lms200::Encode(lms200::EncodeMeanValues(samples, mv)));
+    Send(lms200::Encode(lms200::EncodeMeanValues(samples, mv)), ready);
   } else if (!mirror_wait && mode == lms200::kModeSubrange) {
     const int last = std::min<int>(subrange_last_, int(mv.values.size()));
     const int first = std::min(subrange_first_, last);
     mv.values = std::vector<std::uint16_t>(mv.values.begin() + (first - 1),
                                            mv.values.begin() + last);
-    Send(lms200::Encode(lms200::EncodeSubrangeValues(first, last, mv)));
+    Send(lms200::Encode(lms200::EncodeSubrangeValues(first, last, mv)), ready);
   } else {
-    Send(lms200::Encode(lms200::EncodeMeasuredValues(mv)));
+    Send(lms200::Encode(lms200::EncodeMeasuredValues(mv)), ready);
   }
   std::lock_guard<std::mutex> lock(mutex_);
   ++scans_sent_;
@@ -336,9 +343,12 @@ void Lms200Emulator::OnIdle() {
   if (!streaming() || !plugged() || NowS() < next_stream_s_) return;
   // The next telegram is due when the mirror has measured it (n lines for a mean); on a slow
   // line it follows the previous telegram directly, as the device sends its newest scan.
+  // Due times follow each other by the mirror's period; after a stall (due far behind) the
+  // schedule restarts from now rather than catching up.
   const int samples = output_ == lms200::kModeMeanValues ? mean_samples_ : 1;
-  next_stream_s_ = NowS() + samples * ScanPeriodS();
-  SendScan(false);
+  const double due_s = next_stream_s_;
+  next_stream_s_ = std::max(due_s + samples * ScanPeriodS(), NowS() - ScanPeriodS());
+  SendScan(false, due_s);
 }
 
 }  // namespace pitchlab::hw

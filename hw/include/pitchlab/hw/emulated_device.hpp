@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdint>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <string>
 #include <thread>
@@ -82,9 +83,14 @@ class EmulatedDevice {
   /// Called on the I/O thread after Replug(): reset protocol state, send a power-on message.
   virtual void OnPowerOn() {}
   /// Sends one message through the fault plan (I/O thread): written in one call at the moment
-  /// its last byte would have left a UART at the current rate (10 bits a byte, 8N1, starting
-  /// when the line is free), so a client sees it whole and never earlier than the line allows.
-  void Send(const std::vector<std::uint8_t>& bytes);
+  /// its last byte would have left a UART at the current rate (10 bits a byte, 8N1), so a client
+  /// sees it whole and never earlier than the line allows. Its first byte leaves when the line
+  /// is free and not before `not_before` (default: now); a streaming device passes the time its
+  /// data was ready, so the emulator's own work between messages is not added to the line time
+  /// (the device measures while its UART sends). Two messages never arrive closer together than
+  /// the second one's wire time.
+  void Send(const std::vector<std::uint8_t>& bytes,
+            std::optional<std::chrono::steady_clock::time_point> not_before = std::nullopt);
   /// When the line will be free of everything sent so far (steady clock).
   std::chrono::steady_clock::time_point line_free_at() const { return line_free_at_; }
   /// Changes the rate the device speaks at from now on.
@@ -98,7 +104,8 @@ class EmulatedDevice {
   void OpenPty();
   void ClosePty();
   void Loop();
-  void WriteAtLineRate(const std::uint8_t* bytes, std::size_t size);
+  void WriteAtLineRate(const std::uint8_t* bytes, std::size_t size,
+                       std::chrono::steady_clock::time_point not_before);
 
   std::string name_;
   std::atomic<int> baud_;
@@ -111,6 +118,7 @@ class EmulatedDevice {
   std::atomic<bool> replugged_{false};
   std::atomic<bool> powered_{true};
   std::chrono::steady_clock::time_point line_free_at_{};  // I/O thread only
+  std::chrono::steady_clock::time_point last_write_{};    // I/O thread only
   std::thread thread_;
   mutable std::mutex mutex_;  // guards plan_, rng_, stats_, the pty fds during (un)plug
   FaultPlan plan_;

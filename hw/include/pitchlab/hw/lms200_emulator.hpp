@@ -53,7 +53,7 @@ class Lms200Emulator final : public EmulatedDevice {
   void Reply(std::uint8_t command, std::vector<std::uint8_t> data);
   void SendTelegram(std::uint8_t reply_command, std::vector<std::uint8_t> data);
   lms200::MeasuredValues Measure(int samples);
-  void SendScan(bool mirror_wait);
+  void SendScan(bool mirror_wait, double ready_s = 0.0);
   double ScanPeriodS() const;
   std::vector<std::uint8_t> StatusBlock() const;
   sensors::LaserLine FlatWall(const sensors::Lms200Config& config) const;
