@@ -224,7 +224,8 @@ void Lms200Emulator::Handle(const Telegram& request) {
       return;
     case lms200::kConfigure:
       // The LMS2xx family's block lengths; any other is not a configuration: not acknowledged.
-      if (d.size() != lms200::kConfigBlockBytes && d.size() != lms200::kConfigShortBlockBytes) break;
+      if (d.size() != lms200::kConfigBlockBytes && d.size() != lms200::kConfigShortBlockBytes)
+        break;
       Send({lms200::kAck});
       Configure(d);
       return;
@@ -247,7 +248,8 @@ std::vector<std::uint8_t> Lms200Emulator::StatusBlock() const {
   std::vector<std::uint8_t> b(lms200::kStatusBlockBytes, 0);
   const std::string version = kVersion;
   std::copy(version.begin(), version.end(), b.begin() + lms200::kStatusVersionIndex);
-  b[lms200::kStatusOperatingModeIndex] = setup_mode_ ? std::uint8_t(lms200::kModeSetup) : output_.load();
+  b[lms200::kStatusOperatingModeIndex] =
+      setup_mode_ ? std::uint8_t(lms200::kModeSetup) : output_.load();
   b[lms200::kStatusDeviceStatusIndex] = 0;
   b[lms200::kStatusMeasuringModeIndex] = config_block_[lms200::kConfigMeasuringModeIndex];
   const sensors::Lms200Config now = current();
@@ -317,9 +319,9 @@ void Lms200Emulator::SendScan(bool mirror_wait, double ready_s) {
   if (mirror_wait) std::this_thread::sleep_for(std::chrono::duration<double>(ScanPeriodS()));
   std::optional<std::chrono::steady_clock::time_point> ready;
   if (!mirror_wait) {
-    ready = std::chrono::steady_clock::time_point(std::chrono::duration_cast<
-                                                  std::chrono::steady_clock::duration>(
-        std::chrono::duration<double>(ready_s)));
+    ready = std::chrono::steady_clock::time_point(
+        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+            std::chrono::duration<double>(ready_s)));
   }
   const std::uint8_t mode = output_;
   const int samples = mirror_wait || mode != lms200::kModeMeanValues ? 1 : mean_samples_;
@@ -329,8 +331,8 @@ void Lms200Emulator::SendScan(bool mirror_wait, double ready_s) {
   } else if (!mirror_wait && mode == lms200::kModeSubrange) {
     const int last = std::min<int>(subrange_last_, int(mv.values.size()));
     const int first = std::min(subrange_first_, last);
-    mv.values = std::vector<std::uint16_t>(mv.values.begin() + (first - 1),
-                                           mv.values.begin() + last);
+    mv.values =
+        std::vector<std::uint16_t>(mv.values.begin() + (first - 1), mv.values.begin() + last);
     Send(lms200::Encode(lms200::EncodeSubrangeValues(first, last, mv)), ready);
   } else {
     Send(lms200::Encode(lms200::EncodeMeasuredValues(mv)), ready);

@@ -123,8 +123,7 @@ Result<void> P2osDriver::SyncOnce() {
     robot_.clear();
     for (const std::string& n : names) robot_ += (robot_.empty() ? "" : " ") + n;
     // The subclass decides the SIP's units: an unknown one would be read wrongly.
-    Result<PioneerParams> params =
-        FindPioneerParams(names.size() >= 3 ? names[2] : std::string());
+    Result<PioneerParams> params = FindPioneerParams(names.size() >= 3 ? names[2] : std::string());
     if (!params) return Fail(Error::Code::kInvalidArgument, params.error().message);
     params_ = *params;
   }

@@ -198,8 +198,8 @@ void P2osEmulator::SendSip() {
     const double forward = c * dx + sn * dy, left = -sn * dx + c * dy;
     x_m_ += std::cos(yaw_rad_) * forward - std::sin(yaw_rad_) * left;
     y_m_ += std::sin(yaw_rad_) * forward + std::cos(yaw_rad_) * left;
-    yaw_rad_ = std::remainder(yaw_rad_ + std::remainder(s.yaw_rad - last_.yaw_rad, 2.0 * kPi),
-                              2.0 * kPi);
+    yaw_rad_ =
+        std::remainder(yaw_rad_ + std::remainder(s.yaw_rad - last_.yaw_rad, 2.0 * kPi), 2.0 * kPi);
   }
   last_ = s;
   // Positions in wrapping 15-bit robot units (DistConvFactor mm), heading in AngleConvFactor

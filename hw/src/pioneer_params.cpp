@@ -12,9 +12,9 @@ namespace {
 // encoder units scaled by DistConvFactor (p3at.p: 0.465 "multiplier to mm from robot units").
 // Vel2Divisor is 20 in every P3 file (ArRobotParams' default; p3at.p states it).
 const PioneerParams kModels[] = {
-    {"p3at", 0.001534, 0.465, 1.0, 20.0},     {"p3at-sh", 0.001534, 1.0, 1.0, 20.0},
-    {"p3atiw", 0.001534, 0.3768, 1.0, 20.0},  {"p3atiw-sh", 0.001534, 1.0, 1.0, 20.0},
-    {"p3dx", 0.001534, 0.485, 1.0, 20.0},     {"p3dx-sh", 0.001534, 1.0, 1.0, 20.0},
+    {"p3at", 0.001534, 0.465, 1.0, 20.0},    {"p3at-sh", 0.001534, 1.0, 1.0, 20.0},
+    {"p3atiw", 0.001534, 0.3768, 1.0, 20.0}, {"p3atiw-sh", 0.001534, 1.0, 1.0, 20.0},
+    {"p3dx", 0.001534, 0.485, 1.0, 20.0},    {"p3dx-sh", 0.001534, 1.0, 1.0, 20.0},
 };
 
 std::string Lower(std::string s) {

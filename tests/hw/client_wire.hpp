@@ -116,7 +116,7 @@ inline std::optional<Bytes> SicktoolboxMessage(Wire& wire, Clock::time_point dea
 }
 
 inline std::optional<Bytes> SicktoolboxTransact(Wire& wire, const Bytes& request,
-                                         milliseconds timeout = kReplyTimeout) {
+                                                milliseconds timeout = kReplyTimeout) {
   wire.Flush();  // _flushTerminalBuffer before every request
   wire.Write(LmsRequest(request));
   const auto deadline = Clock::now() + timeout;

@@ -60,7 +60,8 @@ TEST(Lms200Reset, IsAcknowledgedWith91ThenThePowerOnTelegramComesAt9600) {
 
 // Installation mode, then `block` written with 77; returns the F7 payload.
 std::optional<Bytes> Configure(Wire& wire, const Bytes& block) {
-  const auto setup = SicktoolboxTransact(wire, {0x20, 0x00, 'S', 'I', 'C', 'K', '_', 'L', 'M', 'S'});
+  const auto setup =
+      SicktoolboxTransact(wire, {0x20, 0x00, 'S', 'I', 'C', 'K', '_', 'L', 'M', 'S'});
   EXPECT_TRUE(setup && (*setup)[1] == 0x00) << "installation mode refused";
   Bytes request = {0x77};
   request.insert(request.end(), block.begin(), block.end());
@@ -207,8 +208,8 @@ TEST(Lms200OutputModes, ASubrangeStreamsB7WithItsIndicesAndOnlyThoseValues) {
   ASSERT_TRUE(SicktoolboxTransact(wire, {0x20, 0x40}));
   wire.SetBaud(38400);
   // 20 27 0001 000A: values 1..10 (sicktoolbox SetSickOpModeMonitorStreamValuesSubrange).
-  ASSERT_EQ(WriteAndReadAck(wire, {0x02, 0x00, 0x06, 0x00, 0x20, 0x27, 0x01, 0x00, 0x0A, 0x00,
-                                   0x6C, 0xB7}),
+  ASSERT_EQ(WriteAndReadAck(
+                wire, {0x02, 0x00, 0x06, 0x00, 0x20, 0x27, 0x01, 0x00, 0x0A, 0x00, 0x6C, 0xB7}),
             0x06);
   const auto switched = NextMessage(wire, 0xA0);
   ASSERT_TRUE(switched);

@@ -19,7 +19,7 @@ namespace {
 
 using namespace client;  // NOLINT: the shared client-side helpers
 
-constexpr milliseconds kByteTimeout{35};  // sicktoolbox: between bytes of one telegram
+constexpr milliseconds kByteTimeout{35};    // sicktoolbox: between bytes of one telegram
 constexpr milliseconds kScanTimeout{1000};  // sicktoolbox GetSickScan: the next scan
 constexpr int kScans = 5;
 
@@ -66,8 +66,8 @@ std::vector<Timed> Record(SerialPort& port, Clock::time_point deadline) {
 }
 
 struct ScanTiming {
-  bool complete = false;        // CRC right, 401 values
-  milliseconds worst_gap{0};    // longest pause between two bytes of the telegram
+  bool complete = false;          // CRC right, 401 values
+  milliseconds worst_gap{0};      // longest pause between two bytes of the telegram
   Clock::time_point first, last;  // its first and last byte
 };
 
@@ -84,8 +84,8 @@ std::vector<ScanTiming> Scans(const std::vector<Timed>& bytes) {
     for (std::size_t k = i; k < i + total; ++k) {
       frame.push_back(bytes[k].byte);
       if (k > i) {
-        s.worst_gap = std::max(s.worst_gap, std::chrono::duration_cast<milliseconds>(
-                                                bytes[k].at - bytes[k - 1].at));
+        s.worst_gap = std::max(
+            s.worst_gap, std::chrono::duration_cast<milliseconds>(bytes[k].at - bytes[k - 1].at));
       }
     }
     const int count = frame[5] + 256 * (frame[6] & 0x03);
@@ -124,8 +124,8 @@ TEST(Lms200StreamTiming, A401ValueScanAt9600ArrivesWholeAndInTimeUnderFullCpuLoa
   for (int k = 0; k < kScans; ++k) {
     complete += scans[k].complete;
     worst_gap = std::max(worst_gap, scans[k].worst_gap);
-    worst_interval = std::max(
-        worst_interval, std::chrono::duration_cast<milliseconds>(scans[k].last - previous));
+    worst_interval = std::max(worst_interval,
+                              std::chrono::duration_cast<milliseconds>(scans[k].last - previous));
     EXPECT_TRUE(scans[k].complete) << "scan " << k;
     EXPECT_LE(scans[k].worst_gap, kByteTimeout) << "scan " << k;
     EXPECT_LE(scans[k].last - previous, kScanTimeout)
@@ -133,10 +133,11 @@ TEST(Lms200StreamTiming, A401ValueScanAt9600ArrivesWholeAndInTimeUnderFullCpuLoa
         << std::chrono::duration_cast<milliseconds>(scans[k].last - previous).count() << " ms";
     previous = scans[k].last;
   }
-  std::printf("streamed 401-value scans at 9600 under load: %d/%d complete, worst gap %lld ms, "
-              "worst scan-to-scan %lld ms\n",
-              complete, kScans, static_cast<long long>(worst_gap.count()),
-              static_cast<long long>(worst_interval.count()));
+  std::printf(
+      "streamed 401-value scans at 9600 under load: %d/%d complete, worst gap %lld ms, "
+      "worst scan-to-scan %lld ms\n",
+      complete, kScans, static_cast<long long>(worst_gap.count()),
+      static_cast<long long>(worst_interval.count()));
 }
 
 }  // namespace

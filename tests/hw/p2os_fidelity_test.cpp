@@ -162,9 +162,9 @@ class UarcsP3at final : public EmulatedDevice {
     if (!open_ || Clock::now() < next_) return;
     next_ = Clock::now() + milliseconds(100);
     // Stopped, XPOS 925 units (= 430 mm at 0.465 mm a unit), battery 12.8 V, motors on.
-    Send({0xFA, 0xFB, 0x1B, 0x32, 0x9D, 0x03, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
-          0x80, 0x00, 0x00, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
-          0x37, 0x1D});
+    Send({0xFA, 0xFB, 0x1B, 0x32, 0x9D, 0x03, 0x00, 0x00, 0x00, 0x00,
+          0x00, 0x00, 0x00, 0x00, 0x80, 0x00, 0x00, 0x00, 0x00, 0x01,
+          0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x37, 0x1D});
   }
   std::string subclass_;
   p2os::PacketReader reader_;
@@ -228,7 +228,7 @@ TEST(P2osKeepAlive, ADriverLeftAloneDuringAScanKeepsTheRobotAwakeAndItsSipsRead)
     longest_quiet_s = std::max(longest_quiet_s, emulator.seconds_since_client_packet());
     std::this_thread::sleep_for(milliseconds(20));
   }
-  EXPECT_LT(longest_quiet_s, 1.0);                // a PULSE at least every second
+  EXPECT_LT(longest_quiet_s, 1.0);                   // a PULSE at least every second
   EXPECT_NEAR(emulator.command().first, 0.2, 1e-9);  // the watchdog never fired
   // Read as they come: at most one SIP (37 bytes) in flight, not 30 piled up.
   EXPECT_LT(emulator.unread_bytes(), 2 * 37u);
@@ -250,7 +250,7 @@ TEST(P2osSetO, SetoPutsTheReportedPoseBackToTheOrigin) {
   reader.Clear();
   const auto moved = NextSip(wire, reader);
   ASSERT_TRUE(moved);
-  EXPECT_GT(Le16s(*moved, 1), 50);  // ~100 mm driven
+  EXPECT_GT(Le16s(*moved, 1), 50);                   // ~100 mm driven
   wire.Write({0xFA, 0xFB, 0x03, 0x07, 0x00, 0x07});  // SETO
   std::this_thread::sleep_for(milliseconds(200));
   wire.Flush();
@@ -302,7 +302,8 @@ TEST(P2osStandstill, AParkedBaseReportsZeroSpeedAndAConstantPose) {
     const auto sip = NextSip(wire, reader);
     ASSERT_TRUE(sip);
     EXPECT_EQ((*sip)[0], 0x32) << "SIP " << i << ": moving";
-    EXPECT_EQ(Bytes(sip->begin() + 1, sip->begin() + 11), Bytes(first->begin() + 1, first->begin() + 11))
+    EXPECT_EQ(Bytes(sip->begin() + 1, sip->begin() + 11),
+              Bytes(first->begin() + 1, first->begin() + 11))
         << "SIP " << i << ": pose or wheel speeds changed";
     EXPECT_EQ(Le16s(*sip, 28), 0) << "SIP " << i << ": ROTVEL";
   }

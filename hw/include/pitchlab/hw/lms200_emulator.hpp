@@ -67,8 +67,8 @@ class Lms200Emulator final : public EmulatedDevice {
   std::size_t scans_sent_ = 0;
   bool setup_mode_ = false;
   std::atomic<std::uint8_t> output_{lms200::kModeOnRequest};  // 0x24 / 0x25 / 0x26 / 0x27
-  int mean_samples_ = 1;                                       // mode 0x26: n
-  int subrange_first_ = 1, subrange_last_ = 1;                 // mode 0x27 [index from 1]
+  int mean_samples_ = 1;                                      // mode 0x26: n
+  int subrange_first_ = 1, subrange_last_ = 1;                // mode 0x27 [index from 1]
   double next_stream_s_ = 0.0;
   double power_on_s_ = 0.0;  // the mirror's revolutions count from here
   std::vector<std::uint8_t> config_block_;

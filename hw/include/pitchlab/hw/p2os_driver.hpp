@@ -74,9 +74,9 @@ class P2osDriver final : public sensors::MobileBase {
   std::thread service_;
   std::atomic<bool> running_{false};
   std::atomic<std::size_t> checksum_errors_{0};
-  std::mutex write_mutex_;  // one packet on the wire at a time
+  std::mutex write_mutex_;                           // one packet on the wire at a time
   std::chrono::steady_clock::time_point last_sent_;  // under write_mutex_
-  mutable std::mutex mutex_;  // guards everything below
+  mutable std::mutex mutex_;                         // guards everything below
   std::condition_variable sip_arrived_;
   std::optional<p2os::Sip> last_sip_;
   std::uint64_t sips_ = 0;

@@ -22,7 +22,7 @@ struct BaseState {
   double left_mps = 0.0, right_mps = 0.0;      ///< wheel speeds [m/s]
   double omega_rps = 0.0;                      ///< yaw rate [rad/s]
   bool stall_left = false, stall_right = false;
-  double battery_v = 12.8;                         ///< [V]
+  double battery_v = 12.8;                           ///< [V]
   double left_travel_m = 0.0, right_travel_m = 0.0;  ///< wheel travel the encoders count [m]
 };
 
@@ -90,9 +90,9 @@ class P2osEmulator final : public EmulatedDevice {
   double next_sip_s_ = 0.0, last_step_s_ = 0.0;
   BaseState own_;  // built-in model state
   // Reported odometry: the physics' motion, without the creep of a parked base.
-  BaseState last_;                   // physics state at the previous SIP
-  double x_m_ = 0.0, y_m_ = 0.0, yaw_rad_ = 0.0;  // since power-on / SETO
-  bool holding_ = false;             // parked: reported pose frozen
+  BaseState last_;                                 // physics state at the previous SIP
+  double x_m_ = 0.0, y_m_ = 0.0, yaw_rad_ = 0.0;   // since power-on / SETO
+  bool holding_ = false;                           // parked: reported pose frozen
   double hold_left_m_ = 0.0, hold_right_m_ = 0.0;  // wheel travel when it parked
 };
 

@@ -36,9 +36,9 @@ enum Command : std::uint8_t {
   /// Auxiliary power output: argument bits 8-15 the output, bits 0-7 on (1) / off (0) (ARIA's
   /// com2Bytes(31, port, state); its ArLaserConnector switches the laser with port 11).
   kAuxPower = 31,
-  kSonar = 28,   ///< sonars on (arg 1) / off (arg 0)
-  kStop = 29,    ///< stop moving, motors stay enabled
-  kVel2 = 32,    ///< wheel speeds: argument bits 8-15 left, 0-7 right, signed, kVel2Unit each
+  kSonar = 28,  ///< sonars on (arg 1) / off (arg 0)
+  kStop = 29,   ///< stop moving, motors stay enabled
+  kVel2 = 32,   ///< wheel speeds: argument bits 8-15 left, 0-7 right, signed, kVel2Unit each
   kEStop = 55,
 };
 /// Argument type bytes.

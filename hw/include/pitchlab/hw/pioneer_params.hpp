@@ -12,10 +12,10 @@ namespace pitchlab::hw {
 
 /// One model's factors.
 struct PioneerParams {
-  std::string subclass;          ///< lower case, e.g. "p3at-sh"
-  double angle_conv_rad = 0.0;   ///< AngleConvFactor: THPOS unit [rad] (2 pi / 4096)
-  double dist_conv_mm = 0.0;     ///< DistConvFactor: XPOS / YPOS unit [mm]
-  double vel_conv_mmps = 0.0;    ///< VelConvFactor: L/RVEL unit [mm/s]
+  std::string subclass;            ///< lower case, e.g. "p3at-sh"
+  double angle_conv_rad = 0.0;     ///< AngleConvFactor: THPOS unit [rad] (2 pi / 4096)
+  double dist_conv_mm = 0.0;       ///< DistConvFactor: XPOS / YPOS unit [mm]
+  double vel_conv_mmps = 0.0;      ///< VelConvFactor: L/RVEL unit [mm/s]
   double vel2_divisor_mmps = 0.0;  ///< Vel2Divisor: VEL2 wheel-speed unit [mm/s]
 };
 
