@@ -29,7 +29,12 @@ namespace pitchlab::apps {
 
 namespace {
 
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kRadToDeg = 180.0 / kPi;
+// Power-on rates: a P3 opens its host port at 9600 (ARIA and ROS p2os connect there); the pitch
+// unit's protocol defaults to 38400 (docs/pitch_unit_protocol.md).
+constexpr int kBasePowerOnBaud = 9600;
+constexpr int kPitchUnitPowerOnBaud = 38400;
 std::atomic<bool> g_interrupted{false};
 
 int ParseBaud(const std::string& text) {
@@ -58,7 +63,8 @@ const char* StatusName(sensors::ReadingStatus s) {
 // The simulator behind the three emulators. One mutex: physics is stepped by one caller at a time.
 class SimulatedDevices {
  public:
-  SimulatedDevices(const std::string& world_path, const AppConfig& config, int baud)
+  SimulatedDevices(const std::string& world_path, const AppConfig& config, int pitch_baud,
+                   int base_baud)
       : rig_(world_path, config.rig) {
     if (Result<Eigen::Isometry3d> placed = rig_.PlaceAtDefaultStart(); !placed) {
       throw std::runtime_error("cannot place the robot: " + placed.error().message);
@@ -76,32 +82,10 @@ class SimulatedDevices {
       std::lock_guard<std::mutex> lock(mutex_);
       return std::make_pair(rig_.pitch_axis().ReadEncoder().value_or(0.0), false);
     };
-    pitch_ = std::make_unique<hw::PitchUnitEmulator>(config.rig.pitch_unit, baud, pitch);
-    hw::BasePhysics base;
-    base.command = [this](double v, double w) {
-      v_mps_ = v;
-      omega_rps_ = w;
-    };
-    base.state = [this] {
-      std::lock_guard<std::mutex> lock(mutex_);
-      hw::BaseState s;
-      if (Result<sensors::Odometry> o = rig_.base().ReadOdometry(); o) {
-        const double half_track = 0.5 * rig_.base().effective_track_m();
-        s = {o->x_m,
-             o->y_m,
-             o->yaw_rad,
-             o->v_mps - half_track * o->omega_rps,
-             o->v_mps + half_track * o->omega_rps,
-             o->omega_rps,
-             o->stalled,
-             o->stalled,
-             12.8};
-      }
-      return s;
-    };
+    pitch_ = std::make_unique<hw::PitchUnitEmulator>(config.rig.pitch_unit, pitch_baud, pitch);
     hw::P2osEmulatorConfig p3;
-    p3.baud = baud;
-    p3_ = std::make_unique<hw::P2osEmulator>(p3, base);
+    p3.baud = base_baud;
+    p3_ = std::make_unique<hw::P2osEmulator>(p3, BaseOf(config));
     stepper_ = std::thread([this] { StepPhysics(); });
   }
   ~SimulatedDevices() {
@@ -113,6 +97,38 @@ class SimulatedDevices {
   }
 
  private:
+  // The simulated base as the P3's microcontroller sees it.
+  hw::BasePhysics BaseOf(const AppConfig& config) {
+    hw::BasePhysics base;
+    base.command = [this](double v, double w) {
+      v_mps_ = v;
+      omega_rps_ = w;
+    };
+    base.state = [this] {
+      std::lock_guard<std::mutex> lock(mutex_);
+      hw::BaseState s;
+      if (Result<sensors::Odometry> o = rig_.base().ReadOdometry(); o) {
+        const double half_track = 0.5 * rig_.base().effective_track_m();
+        const Eigen::Vector2d travel = rig_.sim().WheelAngles() * rig_.sim().params().wheel_radius_m;
+        s = {o->x_m,       o->y_m,     o->yaw_rad,   o->v_mps - half_track * o->omega_rps,
+             o->v_mps + half_track * o->omega_rps, o->omega_rps, o->stalled, o->stalled,
+             12.8,         travel[0],  travel[1]};
+      }
+      return s;
+    };
+    // VEL2's wheel speeds through the track the simulated base turns with (a skid-steer P3-AT's
+    // effective track, ~0.96 m, not its 0.33 m axle), so the wheels run as commanded.
+    base.track_m = rig_.base().effective_track_m();
+    // The simulated encoders' tick (OdometryConfig::ticks_per_rev on the wheel).
+    base.encoder_tick_m =
+        2.0 * kPi * rig_.sim().params().wheel_radius_m / config.rig.odometry.ticks_per_rev;
+    // Auxiliary power output 11 feeds the laser (ARIA switches it to reset an LMS).
+    base.aux_power = [this](int output, bool on) {
+      if (output == hw::p2os::kLaserPowerOutput) lms_->SetPowered(on);
+    };
+    return base;
+  }
+
   // The base keeps moving between requests: step physics in real time with its last command.
   void StepPhysics() {
     constexpr double kStep_s = 0.02;
@@ -160,14 +176,18 @@ int RunEmulate(int argc, char** argv) {
   args.Option("world", "NAME|FILE.xml", "built-in world (" + BuiltinWorldNames() + ") or MJCF",
               "terrain")
       .Option("config", "FILE.yaml", "rig configuration (see README)")
-      .Option("baud", "B", "pitch unit and base rate (the LMS200 starts at 9600)", "38400")
+      .Option("baud", "B",
+              "pitch unit and base rate (default: their power-on rates, pitch unit 38400, base "
+              "9600; the LMS200 starts at 9600)")
       .Flag("json", "print the device paths as JSON");
   if (!args.Parse(argc, argv)) return 0;
-  const int baud = ParseBaud(args.Get("baud"));
+  const bool baud_given = args.Has("baud");
+  const int pitch_baud = baud_given ? ParseBaud(args.Get("baud")) : kPitchUnitPowerOnBaud;
+  const int base_baud = baud_given ? ParseBaud(args.Get("baud")) : kBasePowerOnBaud;
   AppConfig config =
       LoadAppConfig(args.Has("config") ? std::optional(args.Get("config")) : std::nullopt);
   const auto world_path = worlds::ResolveWorld(args.Get("world"), WorldsDir());
-  SimulatedDevices devices(world_path.string(), config, baud);
+  SimulatedDevices devices(world_path.string(), config, pitch_baud, base_baud);
   const nlohmann::json paths = devices.Paths();
   if (args.Flagged("json")) {
     std::cout << paths.dump(2) << std::endl;

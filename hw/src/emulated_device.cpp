@@ -3,9 +3,11 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <pty.h>
+#include <sys/ioctl.h>
 #include <termios.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -18,7 +20,6 @@ namespace pitchlab::hw {
 namespace {
 
 constexpr int kIdlePeriodMs = 5;
-constexpr std::size_t kPacingChunkBytes = 16;
 
 }  // namespace
 
@@ -98,6 +99,18 @@ void EmulatedDevice::Replug() {
   replugged_ = true;
 }
 
+void EmulatedDevice::SetPowered(bool on) {
+  const bool was = powered_.exchange(on);
+  if (on && !was) replugged_ = true;  // the I/O thread runs OnPowerOn
+}
+
+std::size_t EmulatedDevice::unread_bytes() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  int queued = 0;
+  if (held_slave_ < 0 || ::ioctl(held_slave_, FIONREAD, &queued) != 0) return 0;
+  return std::size_t(queued);
+}
+
 void EmulatedDevice::SetFaults(const FaultPlan& plan) {
   std::lock_guard<std::mutex> lock(mutex_);
   plan_ = plan;
@@ -144,15 +157,17 @@ void EmulatedDevice::Loop() {
     const int ready = ::poll(&p, 1, kIdlePeriodMs);
     if (ready > 0 && (p.revents & POLLIN)) {
       const ssize_t n = ::read(fd, buffer, sizeof(buffer));
-      if (n > 0) OnBytes(buffer, std::size_t(n));
+      if (n > 0 && powered_) OnBytes(buffer, std::size_t(n));  // unpowered: bytes are lost
     } else if (ready > 0) {
       std::this_thread::sleep_for(std::chrono::milliseconds(kIdlePeriodMs));
     }
-    OnIdle();
+    if (powered_) OnIdle();
   }
 }
 
-void EmulatedDevice::Send(const std::vector<std::uint8_t>& message) {
+void EmulatedDevice::Send(const std::vector<std::uint8_t>& message,
+                          std::optional<std::chrono::steady_clock::time_point> not_before) {
+  if (!powered_) return;
   std::vector<std::uint8_t> bytes = message;
   FaultPlan::Kind fault = FaultPlan::Kind::kNone;
   int delay_ms = 0;
@@ -187,35 +202,41 @@ void EmulatedDevice::Send(const std::vector<std::uint8_t>& message) {
       }
     }
   }
+  const auto start = not_before.value_or(std::chrono::steady_clock::now());
   if (fault == FaultPlan::Kind::kDelay) {
     const std::size_t half = bytes.size() / 2;
-    WritePaced(bytes.data(), half);
-    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
-    WritePaced(bytes.data() + half, bytes.size() - half);
+    WriteAtLineRate(bytes.data(), half, start);
+    line_free_at_ += std::chrono::milliseconds(delay_ms);
+    WriteAtLineRate(bytes.data() + half, bytes.size() - half, line_free_at_);
     return;
   }
-  WritePaced(bytes.data(), bytes.size());
+  WriteAtLineRate(bytes.data(), bytes.size(), start);
 }
 
-void EmulatedDevice::WritePaced(const std::uint8_t* bytes, std::size_t size) {
-  // Bytes leave at the line rate: 10 bits each (8N1).
-  const auto start = std::chrono::steady_clock::now();
-  const double byte_s = 10.0 / double(baud_);
+void EmulatedDevice::WriteAtLineRate(const std::uint8_t* bytes, std::size_t size,
+                                     std::chrono::steady_clock::time_point not_before) {
+  // A UART puts 10 bits a byte (8N1) on the line, one message after the other. Writing the
+  // message whole when its last byte would have arrived keeps every client's inter-byte timeout
+  // (sicktoolbox: 35 ms) out of reach of the scheduler: a write in small paced chunks stalled
+  // 52 ms between chunks on a loaded machine. Sleeping to an absolute time keeps a late wake-up
+  // from adding up over a stream.
+  using Clock = std::chrono::steady_clock;
+  const auto wire = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(double(size) * 10.0 / double(baud_)));
+  // The first byte leaves when the line is free (the previous message handed over) and not
+  // before `not_before`.
+  line_free_at_ = std::max({line_free_at_, last_write_, not_before}) + wire;
+  std::this_thread::sleep_until(line_free_at_);
+  last_write_ = Clock::now();
   std::size_t sent = 0;
   while (sent < size && running_) {
     const int fd = master_;
     if (fd < 0) return;  // unplugged mid-message
-    const std::size_t chunk = std::min(kPacingChunkBytes, size - sent);
-    const ssize_t n = ::write(fd, bytes + sent, chunk);
-    if (n < 0 && errno != EAGAIN && errno != EINTR) return;
-    if (n < 0) {
-      // Nobody reads: the line buffer is full, like an overrun; drop the rest of the message.
-      if (errno == EAGAIN) return;
-      continue;
-    }
+    const ssize_t n = ::write(fd, bytes + sent, size - sent);
+    if (n < 0 && errno == EINTR) continue;
+    // Nobody reads and the pty's buffer is full (an overrun): the rest of the message is lost.
+    if (n < 0) return;
     sent += std::size_t(n);
-    std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                              std::chrono::duration<double>(sent * byte_s)));
   }
 }
 

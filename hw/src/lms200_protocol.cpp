@@ -141,7 +141,8 @@ Result<MeasuredValues> DecodeMeasuredValues(const Telegram& telegram) {
   if (d.size() < 3) return Fail(Error::Code::kProtocol, "measured-value reply too short");
   const std::uint16_t word = GetU16(d.data());
   const std::size_t count = word & 0x03FF;
-  if (d.size() != 2 + 2 * count + 1) {
+  const bool indexed = d.size() == 2 + 2 * count + 2;
+  if (d.size() != 2 + 2 * count + 1 && !indexed) {
     return Fail(Error::Code::kProtocol, "measured-value reply says " + std::to_string(count) +
                                             " values but carries " + std::to_string(d.size()) +
                                             " bytes");
@@ -153,18 +154,44 @@ Result<MeasuredValues> DecodeMeasuredValues(const Telegram& telegram) {
   mv.partial = (word >> 13) & 0x1;
   mv.values.resize(count);
   for (std::size_t i = 0; i < count; ++i) mv.values[i] = GetU16(&d[2 + 2 * i]) & 0x1FFF;
+  if (indexed) mv.real_time_index = d[d.size() - 2];
   mv.status = d.back();
   return mv;
 }
 
-Telegram EncodeMeasuredValues(const MeasuredValues& values) {
-  Telegram t{kReplyAddress, kRequestValues | kReplyBit, {}};
+namespace {
+
+// Count word, values, the optional real-time index and the status: the tail every
+// measured-value telegram (B0, B6, B7) shares.
+void PutValues(std::vector<std::uint8_t>& out, const MeasuredValues& values) {
   const std::uint16_t word =
       std::uint16_t((values.values.size() & 0x03FF) | (values.partial ? 1u << 13 : 0u) |
                     (unsigned(values.units) << 14));
-  PutU16(t.data, word);
-  for (std::uint16_t v : values.values) PutU16(t.data, std::uint16_t(v & 0x1FFF));
-  t.data.push_back(values.status);
+  PutU16(out, word);
+  for (std::uint16_t v : values.values) PutU16(out, std::uint16_t(v & 0x1FFF));
+  if (values.real_time_index) out.push_back(*values.real_time_index);
+  out.push_back(values.status);
+}
+
+}  // namespace
+
+Telegram EncodeMeasuredValues(const MeasuredValues& values) {
+  Telegram t{kReplyAddress, kRequestValues | kReplyBit, {}};
+  PutValues(t.data, values);
+  return t;
+}
+
+Telegram EncodeMeanValues(int samples, const MeasuredValues& values) {
+  Telegram t{kReplyAddress, kMeanValues, {std::uint8_t(samples)}};
+  PutValues(t.data, values);
+  return t;
+}
+
+Telegram EncodeSubrangeValues(int first, int last, const MeasuredValues& values) {
+  Telegram t{kReplyAddress, kSubrangeValues, {}};
+  PutU16(t.data, std::uint16_t(first));
+  PutU16(t.data, std::uint16_t(last));
+  PutValues(t.data, values);
   return t;
 }
 

@@ -13,6 +13,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -26,6 +28,7 @@
 #include "pitchlab/hw/lms200_emulator.hpp"
 #include "pitchlab/hw/p2os_emulator.hpp"
 #include "pitchlab/hw/pitch_unit_emulator.hpp"
+#include "pitchlab/hw/serial_port.hpp"
 #include "pitchlab/mapping/elevation_io.hpp"
 
 #include "cli_support.hpp"
@@ -49,9 +52,10 @@ constexpr char kMission[] = " --goal=-3,0 --quiet";
 constexpr int kEmulatorStartTimeout_ms = 30000;
 
 // `pitchlab hw emulate` as a child process; its device paths parsed from the JSON it prints.
+// `baud` empty: the devices' power-on rates (no --baud).
 class Emulators {
  public:
-  Emulators(const fs::path& config, const fs::path& log) {
+  Emulators(const fs::path& config, const fs::path& log, const std::string& baud = "38400") {
     int out[2];
     if (::pipe(out) != 0) return;
     pid_ = ::fork();
@@ -61,8 +65,13 @@ class Emulators {
       ::dup2(err, STDERR_FILENO);
       ::close(out[0]);
       ::close(out[1]);
-      ::execl(PITCHLAB_CLI, PITCHLAB_CLI, "hw", "emulate", "--world", kYard.c_str(), "--config",
-              config.c_str(), "--baud", "38400", "--json", static_cast<char*>(nullptr));
+      if (baud.empty()) {
+        ::execl(PITCHLAB_CLI, PITCHLAB_CLI, "hw", "emulate", "--world", kYard.c_str(), "--config",
+                config.c_str(), "--json", static_cast<char*>(nullptr));
+      } else {
+        ::execl(PITCHLAB_CLI, PITCHLAB_CLI, "hw", "emulate", "--world", kYard.c_str(), "--config",
+                config.c_str(), "--baud", baud.c_str(), "--json", static_cast<char*>(nullptr));
+      }
       ::_exit(127);
     }
     ::close(out[1]);
@@ -350,6 +359,169 @@ TEST_F(HwRunCli, SigtermWhileHwLms200WaitsForASilentDeviceEndsWithTheSignalsCode
   const std::string message = Slurp(err);
   EXPECT_NE(message.find("hw lms200: interrupted by SIGTERM"), std::string::npos) << message;
   EXPECT_FALSE(lms.streaming());
+}
+
+// ---------------------------------------------------------------------------------------------
+// `hw emulate` as a Pioneer client meets it (issue 17, items 6, 7, 8, 11): literal packets to
+// the base wired to the simulated P3-AT, at the rate a P3 opens at.
+
+using Bytes = std::vector<std::uint8_t>;
+using Clock = std::chrono::steady_clock;
+using std::chrono::milliseconds;
+
+// The client end of a serial line, with pitchlab's P2OS framing for the replies.
+class Line {
+ public:
+  Line(const std::string& device, int baud) : port_(device, baud) {}
+  void Write(const Bytes& bytes) { ASSERT_TRUE(port_.Write(bytes)); }
+  void Flush() {
+    port_.DiscardInput();
+    reader_.Clear();
+  }
+  std::optional<Bytes> Packet(milliseconds timeout = milliseconds(1000)) {
+    const auto deadline = Clock::now() + timeout;
+    std::uint8_t buffer[256];
+    for (;;) {
+      if (auto payload = reader_.Next()) return *payload;
+      const auto left = std::chrono::duration_cast<milliseconds>(deadline - Clock::now());
+      if (left.count() <= 0) return std::nullopt;
+      Result<std::size_t> n = port_.Read(buffer, sizeof(buffer), left);
+      if (n) reader_.Feed(buffer, *n);
+    }
+  }
+  std::optional<Bytes> Sip() {
+    while (auto p = Packet()) {
+      if ((*p)[0] == 0x32 || (*p)[0] == 0x33) return p;
+    }
+    return std::nullopt;
+  }
+  hw::SerialPort& port() { return port_; }
+
+ private:
+  hw::SerialPort port_;
+  hw::p2os::PacketReader reader_;
+};
+
+const Bytes kSync0 = {0xFA, 0xFB, 0x03, 0x00, 0x00, 0x00};
+const Bytes kSync1 = {0xFA, 0xFB, 0x03, 0x01, 0x00, 0x01};  // also OPEN once synced
+const Bytes kSync2 = {0xFA, 0xFB, 0x03, 0x02, 0x00, 0x02};
+const Bytes kEnable1 = {0xFA, 0xFB, 0x06, 0x04, 0x3B, 0x01, 0x00, 0x05, 0x3B};
+const Bytes kClose = {0xFA, 0xFB, 0x03, 0x02, 0x00, 0x02};  // CLOSE once open
+const Bytes kPulse = {0xFA, 0xFB, 0x03, 0x00, 0x00, 0x00};  // PULSE once open
+
+int Le16s(const Bytes& p, std::size_t at) { return std::int16_t(p[at] | (p[at + 1] << 8)); }
+
+class HwEmulate : public HwRunCli {
+ protected:
+  void SetUp() override {
+    HwRunCli::SetUp();
+    emulators_ = std::make_unique<Emulators>(Write("emulator.yaml", kSharedConfig),
+                                             dir_ / "emulator.log", "");
+    ASSERT_TRUE(emulators_->paths().contains("base")) << Slurp(dir_ / "emulator.log");
+  }
+  std::string Path(const char* device) const { return emulators_->paths()[device]; }
+  // ROS p2os's Setup at 9600: SYNC0/1/2 echoed, OPEN, ENABLE 1.
+  void Connect(Line& base) {
+    for (const Bytes* step : {&kSync0, &kSync1, &kSync2}) {
+      base.Write(*step);
+      const auto echo = base.Packet();
+      ASSERT_TRUE(echo) << "no echo at 9600";
+      ASSERT_EQ((*echo)[0], (*step)[3]);
+    }
+    base.Write(kSync1);
+    base.Write(kEnable1);
+  }
+  std::unique_ptr<Emulators> emulators_;
+};
+
+TEST_F(HwEmulate, TheBaseAnswersAt9600WhereAP3OpensItsHostPort) {
+  Line base(Path("base"), 9600);
+  base.Write(kSync0);
+  const auto echo = base.Packet();
+  ASSERT_TRUE(echo) << "no SYNC0 echo at 9600";
+  EXPECT_EQ(*echo, Bytes{0x00});
+}
+
+TEST_F(HwEmulate, Vel2TurnsTheSimulatedWheelsAtTheCommandedSpeeds) {
+  Line base(Path("base"), 9600);
+  Connect(base);
+  // VEL2 left 200, right 300 mm/s.
+  base.Write({0xFA, 0xFB, 0x06, 0x20, 0x3B, 0x0F, 0x0A, 0x2F, 0x45});
+  // The P3's acceleration ramp (0.5 m/s^2), then steady; a PULSE every 0.5 s as ROS p2os's
+  // loop sends one, or the 2 s watchdog stops the robot.
+  for (int i = 0; i < 3; ++i) {
+    std::this_thread::sleep_for(milliseconds(500));
+    base.Write(kPulse);
+  }
+  base.Flush();
+  double left = 0, right = 0;
+  constexpr int kSips = 5;
+  for (int i = 0; i < kSips; ++i) {
+    const auto sip = base.Sip();
+    ASSERT_TRUE(sip);
+    left += Le16s(*sip, 7) / double(kSips);
+    right += Le16s(*sip, 9) / double(kSips);
+  }
+  // The simulated encoders' speeds are ticks (1.4 mm) over a 0.1 s window: 14 mm/s steps.
+  constexpr double kWheelSpeedTolerance_mmps = 20.0;
+  EXPECT_NEAR(left, 200.0, kWheelSpeedTolerance_mmps);
+  EXPECT_NEAR(right, 300.0, kWheelSpeedTolerance_mmps);
+  base.Write(kClose);
+}
+
+TEST_F(HwEmulate, AParkedBaseReportsAConstantPoseAndZeroSpeeds) {
+  Line base(Path("base"), 9600);
+  Connect(base);
+  std::this_thread::sleep_for(milliseconds(500));
+  base.Flush();
+  const auto first = base.Sip();
+  ASSERT_TRUE(first);
+  // 12 s: the simulated gyro's drift (0.8 deg/min) would move THPOS by 2 units (0.088 deg).
+  const auto until = Clock::now() + std::chrono::seconds(12);
+  int sips = 0;
+  while (Clock::now() < until) {
+    const auto sip = base.Sip();
+    ASSERT_TRUE(sip);
+    ++sips;
+    ASSERT_EQ((*sip)[0], 0x32) << "SIP " << sips << " says moving";
+    ASSERT_EQ(Bytes(sip->begin() + 1, sip->begin() + 11),
+              Bytes(first->begin() + 1, first->begin() + 11))
+        << "SIP " << sips << ": pose or wheel speeds changed (x, y, th, l, r at 1..10)";
+  }
+  EXPECT_GT(sips, 100);
+  base.Write(kClose);
+}
+
+TEST_F(HwEmulate, PowerCyclingTheLaserThroughTheBaseRestartsItAt9600) {
+  Line laser(Path("lms200"), 9600);
+  // The laser to 38400 (20 40), as a client leaves it.
+  laser.Write({0x02, 0x00, 0x02, 0x00, 0x20, 0x40, 0x50, 0x08});
+  std::this_thread::sleep_for(milliseconds(300));
+  ASSERT_TRUE(laser.port().SetBaud(9600));
+  laser.port().DiscardInput();
+  Line base(Path("base"), 9600);
+  Connect(base);
+  // ARIA: com2Bytes(31, 11, 0), a second, com2Bytes(31, 11, 1).
+  base.Write({0xFA, 0xFB, 0x06, 0x1F, 0x3B, 0x00, 0x0B, 0x1F, 0x46});
+  std::this_thread::sleep_for(milliseconds(1000));
+  base.Write({0xFA, 0xFB, 0x06, 0x1F, 0x3B, 0x01, 0x0B, 0x20, 0x46});
+  // The power-on telegram at 9600: 02 80 LEN 90 "LMS200;30106..."
+  hw::lms200::TelegramReader reader;
+  std::uint8_t buffer[256];
+  const auto deadline = Clock::now() + milliseconds(3000);
+  std::optional<hw::lms200::Telegram> power_on;
+  while (!power_on && Clock::now() < deadline) {
+    Result<std::size_t> n = laser.port().Read(buffer, sizeof(buffer), milliseconds(100));
+    if (n) reader.Feed(buffer, *n);
+    while (auto e = reader.Next()) {
+      if (e->kind == hw::lms200::ReaderEvent::Kind::kTelegram && e->telegram.command == 0x90) {
+        power_on = e->telegram;
+      }
+    }
+  }
+  ASSERT_TRUE(power_on) << "no power-on telegram at 9600 after the power cycle";
+  EXPECT_EQ(std::string(power_on->data.begin(), power_on->data.begin() + 12), "LMS200;30106");
+  base.Write(kClose);
 }
 
 }  // namespace

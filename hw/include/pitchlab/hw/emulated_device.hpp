@@ -1,12 +1,14 @@
 #pragma once
-// The device side of a serial link on a pseudo-terminal: a thread that reads requests, a paced
-// writer for replies (bytes at the baud rate), fault injection and unplug/replug. The protocol
-// state machines (LMS200, pitch unit, P2OS) derive from it.
+// The device side of a serial link on a pseudo-terminal: a thread that reads requests, a writer
+// that hands each reply over whole when the line could have delivered its last byte, fault
+// injection, unplug/replug and power off/on. The protocol state machines (LMS200, pitch unit,
+// P2OS) derive from it.
 
 #include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <string>
 #include <thread>
@@ -59,6 +61,12 @@ class EmulatedDevice {
   /// A fresh pty behind the same path; the device restarts (power-on behaviour).
   void Replug();
   bool plugged() const { return plugged_; }
+  /// Supply off: the device reads and drops everything and sends nothing, the port stays open
+  /// (a powered-down device behind a live serial line). On again: the power-on behaviour.
+  void SetPowered(bool on);
+  bool powered() const { return powered_; }
+  /// Bytes the device sent that the driver has not read yet (the pty's input queue).
+  std::size_t unread_bytes() const;
   /// Current line rate [bit/s].
   int baud() const { return baud_; }
   DeviceStats stats() const;
@@ -74,8 +82,17 @@ class EmulatedDevice {
   virtual void OnIdle() {}
   /// Called on the I/O thread after Replug(): reset protocol state, send a power-on message.
   virtual void OnPowerOn() {}
-  /// Sends one message, paced at the baud rate, through the fault plan (I/O thread).
-  void Send(const std::vector<std::uint8_t>& bytes);
+  /// Sends one message through the fault plan (I/O thread): written in one call at the moment
+  /// its last byte would have left a UART at the current rate (10 bits a byte, 8N1), so a client
+  /// sees it whole and never earlier than the line allows. Its first byte leaves when the line
+  /// is free and not before `not_before` (default: now); a streaming device passes the time its
+  /// data was ready, so the emulator's own work between messages is not added to the line time
+  /// (the device measures while its UART sends). Two messages never arrive closer together than
+  /// the second one's wire time.
+  void Send(const std::vector<std::uint8_t>& bytes,
+            std::optional<std::chrono::steady_clock::time_point> not_before = std::nullopt);
+  /// When the line will be free of everything sent so far (steady clock).
+  std::chrono::steady_clock::time_point line_free_at() const { return line_free_at_; }
   /// Changes the rate the device speaks at from now on.
   void set_baud(int baud) { baud_ = baud; }
   /// True when the driver's port is set to the device's rate (a pty stores the termios speed);
@@ -87,7 +104,8 @@ class EmulatedDevice {
   void OpenPty();
   void ClosePty();
   void Loop();
-  void WritePaced(const std::uint8_t* bytes, std::size_t size);
+  void WriteAtLineRate(const std::uint8_t* bytes, std::size_t size,
+                       std::chrono::steady_clock::time_point not_before);
 
   std::string name_;
   std::atomic<int> baud_;
@@ -98,6 +116,9 @@ class EmulatedDevice {
   std::atomic<bool> plugged_{false};
   std::atomic<bool> running_{false};
   std::atomic<bool> replugged_{false};
+  std::atomic<bool> powered_{true};
+  std::chrono::steady_clock::time_point line_free_at_{};  // I/O thread only
+  std::chrono::steady_clock::time_point last_write_{};    // I/O thread only
   std::thread thread_;
   mutable std::mutex mutex_;  // guards plan_, rng_, stats_, the pty fds during (un)plug
   FaultPlan plan_;

@@ -1,7 +1,9 @@
 #pragma once
-// An emulated SICK LMS200 on a pseudo-terminal: ACK then reply, paced at the baud rate; power-on
-// telegram; baud switch acknowledged at the old rate; variant, range mode, single scans and
-// continuous output. Ranges come from a callback (the simulator, or a built-in flat wall).
+// An emulated SICK LMS200 on a pseudo-terminal: ACK then reply at the line rate; power-on
+// telegram; reset; baud switch acknowledged at the old rate; variant, range mode, configuration
+// blocks of 32 or 34 bytes, real-time scan indices, single scans and the streamed outputs (all
+// values, mean of n scans, a sub-range). What is refused and why: docs/hardware_interop.md.
+// Ranges come from a callback (the simulator, or a built-in flat wall).
 
 #include <atomic>
 #include <functional>
@@ -38,16 +40,21 @@ class Lms200Emulator final : public EmulatedDevice {
   sensors::Lms200Config current() const;
   /// Measured-value telegrams sent so far.
   std::size_t scans_sent() const;
-  /// True while the device streams measured values (mode 0x24).
-  bool streaming() const { return streaming_; }
+  /// True while the device streams measured values (modes 0x24, 0x26, 0x27).
+  bool streaming() const { return output_ != lms200::kModeOnRequest; }
 
  private:
   void OnBytes(const std::uint8_t* bytes, std::size_t size) override;
   void OnIdle() override;
   void OnPowerOn() override;
   void Handle(const lms200::Telegram& request);
+  void SwitchMode(const std::vector<std::uint8_t>& d);
+  void Configure(const std::vector<std::uint8_t>& d);
   void Reply(std::uint8_t command, std::vector<std::uint8_t> data);
-  void SendScan();
+  void SendTelegram(std::uint8_t reply_command, std::vector<std::uint8_t> data);
+  lms200::MeasuredValues Measure(int samples);
+  void SendScan(bool mirror_wait, double ready_s = 0.0);
+  double ScanPeriodS() const;
   std::vector<std::uint8_t> StatusBlock() const;
   sensors::LaserLine FlatWall(const sensors::Lms200Config& config) const;
 
@@ -59,8 +66,11 @@ class Lms200Emulator final : public EmulatedDevice {
   sensors::Lms200Config current_;
   std::size_t scans_sent_ = 0;
   bool setup_mode_ = false;
-  std::atomic<bool> streaming_{false};
+  std::atomic<std::uint8_t> output_{lms200::kModeOnRequest};  // 0x24 / 0x25 / 0x26 / 0x27
+  int mean_samples_ = 1;                                      // mode 0x26: n
+  int subrange_first_ = 1, subrange_last_ = 1;                // mode 0x27 [index from 1]
   double next_stream_s_ = 0.0;
+  double power_on_s_ = 0.0;  // the mirror's revolutions count from here
   std::vector<std::uint8_t> config_block_;
 };
 

@@ -29,23 +29,29 @@ constexpr std::size_t kMaxDataBytes = 1024;   ///< longest CMD + DATA accepted (
 
 /// Request commands the driver uses.
 enum Command : std::uint8_t {
-  kReset = 0x10,          ///< re-initialise; reply 0x91, then the power-on telegram
-  kSwitchMode = 0x20,     ///< operating mode / baud rate; reply 0xA0
-  kRequestValues = 0x30,  ///< measured values (0x01 = one full scan); reply 0xB0
-  kRequestStatus = 0x31,  ///< status; reply 0xB1 (kStatusBlockBytes + status byte)
-  kRequestErrors = 0x32,  ///< error list (type, number pairs); reply 0xB2
-  kRequestType = 0x3A,    ///< type string ("LMS200;30106"); reply 0xBA
-  kSwitchVariant = 0x3B,  ///< field of view + resolution; reply 0xBB
-  kRequestConfig = 0x74,  ///< configuration block; reply 0xF4
-  kConfigure = 0x77,      ///< write configuration block (setup mode); reply 0xF7
-  kPowerOn = 0x90,        ///< unsolicited power-on telegram (a reply-side command)
+  kReset = 0x10,           ///< re-initialise; reply 0x91, then the power-on telegram
+  kSwitchMode = 0x20,      ///< operating mode / baud rate; reply 0xA0
+  kRequestValues = 0x30,   ///< measured values (0x01 = one full scan); reply 0xB0
+  kRequestStatus = 0x31,   ///< status; reply 0xB1 (kStatusBlockBytes + status byte)
+  kRequestErrors = 0x32,   ///< error list (type, number pairs); reply 0xB2
+  kRequestType = 0x3A,     ///< type string ("LMS200;30106"); reply 0xBA
+  kSwitchVariant = 0x3B,   ///< field of view + resolution; reply 0xBB
+  kRequestConfig = 0x74,   ///< configuration block; reply 0xF4
+  kConfigure = 0x77,       ///< write configuration block (setup mode); reply 0xF7
+  kPowerOn = 0x90,         ///< unsolicited power-on telegram (a reply-side command)
+  kResetAck = 0x91,        ///< the reply to kReset (not kReset | 0x80, which is kPowerOn)
+  kMeanValues = 0xB6,      ///< streamed mean of n scans (mode 0x26)
+  kSubrangeValues = 0xB7,  ///< streamed sub-range of a scan (mode 0x27)
 };
 
 /// Operating-mode codes for kSwitchMode.
 enum Mode : std::uint8_t {
-  kModeSetup = 0x00,       ///< installation mode (needs the password "SICK_LMS")
-  kModeContinuous = 0x24,  ///< stream all measured values
-  kModeOnRequest = 0x25,   ///< measured values only on request
+  kModeSetup = 0x00,         ///< installation mode (needs the password "SICK_LMS")
+  kModeContinuous = 0x24,    ///< stream all measured values
+  kModeOnRequest = 0x25,     ///< measured values only on request
+  kModeMeanValues = 0x26,    ///< stream the mean of n scans (data: n, 2..250)
+  kModeSubrange = 0x27,      ///< stream values first..last (data: two LE16 indices, from 1)
+  kModePartialScans = 0x2A,  ///< stream the interlaced partial scans one by one
   kModeBaud38400 = 0x40,
   kModeBaud19200 = 0x41,
   kModeBaud9600 = 0x42,
@@ -56,9 +62,16 @@ enum Mode : std::uint8_t {
 /// request data): blocks A..A4, 34 bytes. Offsets of the bytes the clients touch (layout as
 /// docs/hardware_interop.md records it from independent LMS2xx drivers).
 constexpr std::size_t kConfigBlockBytes = 34;
-constexpr std::size_t kConfigAvailabilityIndex = 4;   ///< block C
-constexpr std::size_t kConfigMeasuringModeIndex = 5;  ///< block D: 0..2 = 8 m / 80 m modes
-constexpr std::size_t kConfigUnitsIndex = 6;          ///< block E: 0 = cm, 1 = mm
+/// The shorter block the LMS2xx family also takes: blocks A..A3 without the dazzling
+/// evaluation word (ARIA's ArLMS2xx builds these 32 bytes); applied as a prefix of the full one.
+constexpr std::size_t kConfigShortBlockBytes = 32;
+constexpr std::size_t kConfigAvailabilityIndex = 4;  ///< block C
+/// Block C bits (sicktoolbox's SICK_FLAG_AVAILABILITY_*).
+constexpr std::uint8_t kAvailabilityHigh = 0x01;             ///< highest availability
+constexpr std::uint8_t kAvailabilityRealTimeIndices = 0x02;  ///< scan index in each B0/B6/B7
+constexpr std::uint8_t kAvailabilityDazzleNoEffect = 0x04;   ///< dazzle: outputs unaffected
+constexpr std::size_t kConfigMeasuringModeIndex = 5;         ///< block D: 0..2 = 8 m / 80 m modes
+constexpr std::size_t kConfigUnitsIndex = 6;                 ///< block E: 0 = cm, 1 = mm
 /// The status block (kRequestStatus reply data without its status byte), 152 bytes, and the
 /// offsets in it of the fields clients read (data index: the telegram's byte after CMD is 0).
 constexpr std::size_t kStatusBlockBytes = 152;
@@ -118,13 +131,22 @@ struct MeasuredValues {
   Units units = Units::kCm;
   bool partial = false;               ///< bit 13: a partial (interlaced) scan
   std::vector<std::uint16_t> values;  ///< 13-bit readings (flag bits 13-15 stripped)
-  std::uint8_t status = 0;            ///< the telegram's status byte
+  /// The real-time scan index (mirror revolutions mod 256), one byte between the values and the
+  /// status byte while block C's kAvailabilityRealTimeIndices is set (sicktoolbox
+  /// _parseSickScanProfileB0/B6/B7 read it there).
+  std::optional<std::uint8_t> real_time_index;
+  std::uint8_t status = 0;  ///< the telegram's status byte
 };
 
-/// Decodes a 0xB0 telegram; kProtocol when the command, count or length do not agree.
+/// Decodes a 0xB0 telegram (with or without the real-time index byte); kProtocol when the
+/// command, count or length do not agree.
 [[nodiscard]] Result<MeasuredValues> DecodeMeasuredValues(const Telegram& telegram);
 /// Builds a 0xB0 reply telegram.
 Telegram EncodeMeasuredValues(const MeasuredValues& values);
+/// Builds a 0xB6 telegram: the number of scans averaged, then the values as in 0xB0.
+Telegram EncodeMeanValues(int samples, const MeasuredValues& values);
+/// Builds a 0xB7 telegram: first and last index (from 1, LE16 each), then the values as in 0xB0.
+Telegram EncodeSubrangeValues(int first, int last, const MeasuredValues& values);
 
 /// One reading as (range [m] or NaN, status): 8191 no return, 8190 dazzled, 8183 over range,
 /// other codes >= 8183 no return; else value x unit.

@@ -33,9 +33,12 @@ enum Command : std::uint8_t {
   kVel = 11,     ///< forward speed [mm/s]
   kConfig = 18,  ///< request a CONFIG packet (not emulated: clients fall back to their tables)
   kRVel = 21,    ///< rotational speed [deg/s]
-  kSonar = 28,   ///< sonars on (arg 1) / off (arg 0)
-  kStop = 29,    ///< stop moving, motors stay enabled
-  kVel2 = 32,    ///< wheel speeds: argument bits 8-15 left, 0-7 right, signed, kVel2Unit each
+  /// Auxiliary power output: argument bits 8-15 the output, bits 0-7 on (1) / off (0) (ARIA's
+  /// com2Bytes(31, port, state); its ArLaserConnector switches the laser with port 11).
+  kAuxPower = 31,
+  kSonar = 28,  ///< sonars on (arg 1) / off (arg 0)
+  kStop = 29,   ///< stop moving, motors stay enabled
+  kVel2 = 32,   ///< wheel speeds: argument bits 8-15 left, 0-7 right, signed, kVel2Unit each
   kEStop = 55,
 };
 /// Argument type bytes.
@@ -45,11 +48,9 @@ constexpr std::uint8_t kArgNegInt = 0x1B;
 constexpr std::uint8_t kSipStopped = 0x32;
 constexpr std::uint8_t kSipMoving = 0x33;
 
-/// Wheel-speed unit of VEL2 [mm/s] (the P3's Vel2Divisor in the client tables).
-constexpr int kVel2UnitMmps = 20;
-
-/// Angle unit of THPOS: 4096 per revolution [rad].
-constexpr double kAngleUnitRad = 0.001533981;
+/// The auxiliary power output that feeds the laser (ARIA ArLaserConnector: "legacy method to
+/// turn on LRF power", com2Bytes(31, 11, 1)).
+constexpr int kLaserPowerOutput = 11;
 
 std::uint16_t Checksum(const std::uint8_t* payload, std::size_t size);
 /// FA FB N payload checksum.
