@@ -167,7 +167,11 @@ void HtmlReport::Table(const std::vector<std::string>& header,
 
 void HtmlReport::Png(const std::string& png_bytes, const std::string& caption, int width_px,
                      const std::string& file) {
-  body_ += "<figure>" + ImgTag(png_bytes, caption, width_px) + "<figcaption>" +
+  // The figure as wide as its picture: a long caption wraps instead of widening it, so two
+  // pictures of kFigureWidth_px sit side by side.
+  body_ += (width_px > 0 ? "<figure style=\"width:" + std::to_string(width_px) + "px\">"
+                         : std::string("<figure>")) +
+           ImgTag(png_bytes, caption, width_px) + "<figcaption>" +
            HtmlEscape(caption) +
            (file.empty() ? std::string()
                          : " (<a href=\"" + HtmlEscape(file) + "\">" + HtmlEscape(file) + "</a>)") +

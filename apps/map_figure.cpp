@@ -12,12 +12,13 @@
 namespace pitchlab::apps {
 namespace {
 
-constexpr int kFont = 2;  // 10 x 14 px characters: legible at 100 % zoom on a laptop screen
+// 15 x 21 px characters: still ~9 x 12 px where the report shows a 1000 px figure 600 px wide.
+constexpr int kFont = 3;
 constexpr int kTick_px = 6;
 constexpr int kGap_px = 6;
-constexpr int kMarkerRadius_px = 12;  // holds one character of kFont with a ring around it
+constexpr int kMarkerRadius_px = 17;  // holds one character of kFont (15 x 21) inside its ring
 constexpr int kBarWidth_px = 22;
-constexpr int kMinBarHeight_px = 160;  // room for at least three labelled ticks
+constexpr int kMinBarHeight_px = 240;  // room for at least three labelled ticks
 // The whole picture is rendered before cropping: this bounds its memory (3 bytes a pixel).
 constexpr int kMaxRenderSide_px = 6000;
 // Keeps the start and goal markers (kMarkerRadius_px at ~0.05 m/px) and half a robot width clear
@@ -89,7 +90,7 @@ void DrawColourBar(mapping::RgbImage& img, int x0, int y0, int h, const ColourBa
   }
   Outline(img, x0, y0, kBarWidth_px, h, kBlack);
   const double span = bar.hi_m - bar.lo_m;
-  const double step = NiceStep(span, std::max(2, h / 60));
+  const double step = NiceStep(span, std::max(2, h / (4 * TextHeight(kFont))));
   for (double z : Ticks(bar.lo_m, bar.hi_m, step)) {
     const int y = y0 + static_cast<int>(std::lround((bar.hi_m - z) / span * (h - 1)));
     Fill(img, x0 + kBarWidth_px, y, kTick_px, 1, kBlack);
@@ -100,7 +101,7 @@ void DrawColourBar(mapping::RgbImage& img, int x0, int y0, int h, const ColourBa
 }
 
 int ColourBarLabelWidth(const ColourBar& bar, int h) {
-  const double step = NiceStep(bar.hi_m - bar.lo_m, std::max(2, h / 60));
+  const double step = NiceStep(bar.hi_m - bar.lo_m, std::max(2, h / (4 * TextHeight(kFont))));
   int w = TextWidth("z [m]", kFont);
   for (double z : Ticks(bar.lo_m, bar.hi_m, step))
     w = std::max(w, kTick_px + 4 + TextWidth(TickLabel(z, step), kFont));

@@ -27,7 +27,7 @@ MapWindow ExploredWindow(const mapping::ElevationLayers& layers,
 /// Pixels per cell at which `window` of a picture of `grid` is about `target_px` on its longer
 /// side [px/cell], at least 1, and small enough that the whole picture stays a few thousand pixels.
 int FigurePixelsPerCell(const mapping::GridGeometry& grid, const MapWindow& window,
-                        int target_px = 900);
+                        int target_px = 1000);
 
 /// A colour bar: heights [m] at its ends and the colour [0-255] of a relative height in [0, 1].
 struct ColourBar {

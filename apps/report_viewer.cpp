@@ -92,15 +92,16 @@ constexpr const char* kViewerJs = R"JS(
     return new THREE.Mesh(g, new THREE.MeshLambertMaterial(
         {vertexColors: THREE.VertexColors, side: THREE.DoubleSide}));
   }
-  function line(points, colour, box) {
-    var pos = new Float32Array(3 * points.length);
+  // A tube, not a GL line: WebGL draws lines 1 px wide whatever their width says.
+  function path(points, colour, radius, box) {
+    var v = [];
     for (var i = 0; i < points.length; ++i) {
-      for (var a = 0; a < 3; ++a) pos[3 * i + a] = points[i][a];
-      box.expandByPoint(new THREE.Vector3(points[i][0], points[i][1], points[i][2]));
+      v.push(new THREE.Vector3(points[i][0], points[i][1], points[i][2]));
+      box.expandByPoint(v[i]);
     }
-    var g = new THREE.BufferGeometry();
-    g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
-    return new THREE.Line(g, new THREE.LineBasicMaterial({color: colour}));
+    if (v.length < 2) return new THREE.Group();
+    var g = new THREE.TubeBufferGeometry(new THREE.CatmullRomCurve3(v), 2 * v.length, radius, 6, false);
+    return new THREE.Mesh(g, new THREE.MeshLambertMaterial({color: colour}));
   }
   function ball(p, radius, colour) {
     var m = new THREE.Mesh(new THREE.SphereBufferGeometry(radius, 16, 12),
@@ -139,8 +140,10 @@ constexpr const char* kViewerJs = R"JS(
     var box = new THREE.Box3(), layers = {};
     layers.surface = surface(d.surface, box);
     layers.cloud = cloud(d.cloud, box);
+    // Thick enough to see from the whole scene's view, thin beside the robot (0.5 m wide).
+    var radius = Math.max(0.03, box.getSize(new THREE.Vector3()).length() / 600);
     layers.paths = new THREE.Group();
-    layers.paths.add(line(d['true'], 0x1e50ff, box), line(d.estimated, 0xe08000, box));
+    layers.paths.add(path(d['true'], 0x1e50ff, radius, box), path(d.estimated, 0xe08000, radius, box));
     layers.stops = new THREE.Group();
     for (var i = 0; i < d.stops.length; ++i) layers.stops.add(ball(d.stops[i], 0.12, 0x20a020));
     layers.stops.add(ball(d.start, 0.25, 0x111111), ball(d.goal, 0.25, 0xd01010));
@@ -153,7 +156,7 @@ constexpr const char* kViewerJs = R"JS(
     controls.screenSpacePanning = true;
     function render() { renderer.render(scene, camera); }
     function view(from) {
-      camera.position.copy(centre).add(from.multiplyScalar(size));
+      camera.position.copy(centre).add(from.normalize().multiplyScalar(0.75 * size));
       controls.target.copy(centre);
       controls.update();
       render();
