@@ -20,7 +20,7 @@ constexpr int kMarkerRadius_px = 17;  // holds one character of kFont (15 x 21) 
 constexpr int kBarWidth_px = 22;
 constexpr int kMinBarHeight_px = 240;  // room for at least three labelled ticks
 // The whole picture is rendered before cropping: this bounds its memory (3 bytes a pixel).
-constexpr int kMaxRenderSide_px = 6000;
+constexpr int kMaxRenderSide_px = 3000;
 // Keeps the start and goal markers (kMarkerRadius_px at ~0.05 m/px) and half a robot width clear
 // of the border.
 constexpr double kWindowMargin_m = 1.0;
@@ -108,6 +108,80 @@ int ColourBarLabelWidth(const ColourBar& bar, int h) {
   return w;
 }
 
+// Where the parts of a figure go [px]: the map area at (left, top), margins around it.
+struct Frame {
+  double px_per_m = 1, step_m = 1;
+  int map_w = 0, map_h = 0, bar_h = 0;
+  int left = 0, top = 0, right = 0, bottom = 0;
+  int X(double x_m, const MapWindow& w) const {
+    return left + static_cast<int>(std::lround((x_m - w.lo_m.x()) * px_per_m));
+  }
+  int Y(double y_m, const MapWindow& w) const {
+    return top + static_cast<int>(std::lround((w.hi_m.y() - y_m) * px_per_m));
+  }
+};
+
+Frame Layout(const mapping::RgbImage& map, const mapping::GridGeometry& g, const MapWindow& w,
+             const FigureMarks& marks) {
+  Frame f;
+  f.px_per_m = map.pixels_per_cell / g.cell_m;
+  f.map_w = static_cast<int>(std::lround((w.hi_m.x() - w.lo_m.x()) * f.px_per_m));
+  f.map_h = static_cast<int>(std::lround((w.hi_m.y() - w.lo_m.y()) * f.px_per_m));
+  f.step_m = NiceStep((w.hi_m - w.lo_m).maxCoeff(), 7);
+  int y_label_w = TextWidth("y [m]", kFont);
+  for (double y : Ticks(w.lo_m.y(), w.hi_m.y(), f.step_m))
+    y_label_w = std::max(y_label_w, TextWidth(TickLabel(y, f.step_m), kFont));
+  f.bar_h = std::max(f.map_h, kMinBarHeight_px);
+  f.left = y_label_w + kTick_px + 2 * kGap_px;
+  f.top = TextHeight(kFont) + 3 * kGap_px;
+  f.bottom = kTick_px + 3 * kGap_px + 2 * TextHeight(kFont) + kGap_px;
+  f.right = 3 * kGap_px;
+  if (marks.colour_bar) {
+    f.right += 4 * kGap_px + kBarWidth_px + ColourBarLabelWidth(*marks.colour_bar, f.bar_h);
+  }
+  return f;
+}
+
+// The window's pixels of `map` into the frame's map area; off the map stays white.
+void CopyWindow(const mapping::RgbImage& map, const mapping::GridGeometry& g, const MapWindow& w,
+                const Frame& f, mapping::RgbImage& out) {
+  const Eigen::Vector2d s0 = mapping::MapToPixel(g, map, w.lo_m.x(), w.hi_m.y());
+  const int sx0 = static_cast<int>(std::lround(s0.x())), sy0 = static_cast<int>(std::lround(s0.y()));
+  for (int y = 0; y < f.map_h; ++y) {
+    const int sy = y + sy0;
+    if (sy < 0 || sy >= map.height) continue;
+    for (int x = 0; x < f.map_w; ++x) {
+      const int sx = x + sx0;
+      if (sx < 0 || sx >= map.width) continue;
+      const std::uint8_t* p = &map.rgb[(static_cast<std::size_t>(sy) * map.width + sx) * 3];
+      out.Set(f.left + x, f.top + y, p[0], p[1], p[2]);
+    }
+  }
+}
+
+// The frame, ticks every step_m labelled in metres, and the axis titles.
+void DrawAxes(mapping::RgbImage& out, const MapWindow& w, const Frame& f) {
+  Outline(out, f.left, f.top, f.map_w, f.map_h, kBlack);
+  const int below = f.top + f.map_h;
+  for (double x : Ticks(w.lo_m.x(), w.hi_m.x(), f.step_m)) {
+    const int px = f.X(x, w);
+    Fill(out, px, below, 1, kTick_px, kBlack);
+    const std::string s = TickLabel(x, f.step_m);
+    DrawText(out, px - TextWidth(s, kFont) / 2, below + kTick_px + kGap_px, s, kFont, 0, 0, 0);
+  }
+  for (double y : Ticks(w.lo_m.y(), w.hi_m.y(), f.step_m)) {
+    const int py = f.Y(y, w);
+    Fill(out, f.left - kTick_px, py, kTick_px, 1, kBlack);
+    const std::string s = TickLabel(y, f.step_m);
+    DrawText(out, f.left - kTick_px - kGap_px - TextWidth(s, kFont), py - TextHeight(kFont) / 2,
+             s, kFont, 0, 0, 0);
+  }
+  const std::string x_title = "x [m]";
+  DrawText(out, f.left + f.map_w / 2 - TextWidth(x_title, kFont) / 2,
+           below + kTick_px + 3 * kGap_px + TextHeight(kFont), x_title, kFont, 0, 0, 0);
+  DrawText(out, kGap_px, kGap_px, "y [m]", kFont, 0, 0, 0);
+}
+
 }  // namespace
 
 MapWindow ExploredWindow(const mapping::ElevationLayers& layers,
@@ -141,68 +215,22 @@ int FigurePixelsPerCell(const mapping::GridGeometry& g, const MapWindow& w, int 
 
 mapping::RgbImage ComposeMapFigure(const mapping::RgbImage& map, const mapping::GridGeometry& g,
                                    const MapWindow& w, const FigureMarks& marks) {
-  const double px_per_m = map.pixels_per_cell / g.cell_m;
-  const int map_w = static_cast<int>(std::lround((w.hi_m.x() - w.lo_m.x()) * px_per_m));
-  const int map_h = static_cast<int>(std::lround((w.hi_m.y() - w.lo_m.y()) * px_per_m));
-  const double step = NiceStep((w.hi_m - w.lo_m).maxCoeff(), 7);
-  const std::vector<double> xt = Ticks(w.lo_m.x(), w.hi_m.x(), step);
-  const std::vector<double> yt = Ticks(w.lo_m.y(), w.hi_m.y(), step);
-  int y_label_w = TextWidth("y [m]", kFont);
-  for (double y : yt) y_label_w = std::max(y_label_w, TextWidth(TickLabel(y, step), kFont));
-  const int bar_h = std::max(map_h, kMinBarHeight_px);
-  const int left = y_label_w + kTick_px + 2 * kGap_px;
-  const int top = TextHeight(kFont) + 3 * kGap_px;
-  const int bottom = kTick_px + 3 * kGap_px + 2 * TextHeight(kFont) + kGap_px;
-  const int right = 3 * kGap_px + (marks.colour_bar ? 4 * kGap_px + kBarWidth_px +
-                                                          ColourBarLabelWidth(*marks.colour_bar,
-                                                                              bar_h)
-                                                    : 0);
+  const Frame f = Layout(map, g, w, marks);
   mapping::RgbImage out;
   out.pixels_per_cell = map.pixels_per_cell;
-  out.width = left + map_w + right;
-  out.height = top + (marks.colour_bar ? std::max(map_h, bar_h) : map_h) + bottom;
+  out.width = f.left + f.map_w + f.right;
+  out.height = f.top + std::max(f.map_h, marks.colour_bar ? f.bar_h : 0) + f.bottom;
   out.rgb.assign(static_cast<std::size_t>(out.width) * out.height * 3, 255);
-  // The crop: window pixel (x, y) is source pixel (x + sx0, y + sy0).
-  const Eigen::Vector2d s0 = mapping::MapToPixel(g, map, w.lo_m.x(), w.hi_m.y());
-  const int sx0 = static_cast<int>(std::lround(s0.x())), sy0 = static_cast<int>(std::lround(s0.y()));
-  for (int y = 0; y < map_h; ++y) {
-    const int sy = y + sy0;
-    if (sy < 0 || sy >= map.height) continue;
-    for (int x = 0; x < map_w; ++x) {
-      const int sx = x + sx0;
-      if (sx < 0 || sx >= map.width) continue;
-      const std::uint8_t* p = &map.rgb[(static_cast<std::size_t>(sy) * map.width + sx) * 3];
-      out.Set(left + x, top + y, p[0], p[1], p[2]);
-    }
-  }
-  Outline(out, left, top, map_w, map_h, kBlack);
-  for (double x : xt) {
-    const int px = left + static_cast<int>(std::lround((x - w.lo_m.x()) * px_per_m));
-    Fill(out, px, top + map_h, 1, kTick_px, kBlack);
-    const std::string s = TickLabel(x, step);
-    DrawText(out, px - TextWidth(s, kFont) / 2, top + map_h + kTick_px + kGap_px, s, kFont, 0, 0, 0);
-  }
-  for (double y : yt) {
-    const int py = top + static_cast<int>(std::lround((w.hi_m.y() - y) * px_per_m));
-    Fill(out, left - kTick_px, py, kTick_px, 1, kBlack);
-    const std::string s = TickLabel(y, step);
-    DrawText(out, left - kTick_px - kGap_px - TextWidth(s, kFont), py - TextHeight(kFont) / 2, s,
-             kFont, 0, 0, 0);
-  }
-  const std::string x_title = "x [m]";
-  DrawText(out, left + map_w / 2 - TextWidth(x_title, kFont) / 2,
-           top + map_h + kTick_px + 3 * kGap_px + TextHeight(kFont), x_title, kFont, 0, 0, 0);
-  DrawText(out, kGap_px, kGap_px, "y [m]", kFont, 0, 0, 0);
-  ScaleBar(out, left, top + map_h, w.hi_m.x() - w.lo_m.x(), px_per_m);
+  CopyWindow(map, g, w, f, out);
+  DrawAxes(out, w, f);
+  ScaleBar(out, f.left, f.top + f.map_h, w.hi_m.x() - w.lo_m.x(), f.px_per_m);
   const auto mark = [&](const std::optional<Eigen::Vector2d>& p, const char* letter) {
-    if (!p) return;
-    Marker(out, left + static_cast<int>(std::lround((p->x() - w.lo_m.x()) * px_per_m)),
-           top + static_cast<int>(std::lround((w.hi_m.y() - p->y()) * px_per_m)), letter);
+    if (p) Marker(out, f.X(p->x(), w), f.Y(p->y(), w), letter);
   };
   mark(marks.start_m, "S");
   mark(marks.goal_m, "G");
   if (marks.colour_bar) {
-    DrawColourBar(out, left + map_w + 4 * kGap_px, top, bar_h, *marks.colour_bar);
+    DrawColourBar(out, f.left + f.map_w + 4 * kGap_px, f.top, f.bar_h, *marks.colour_bar);
   }
   return out;
 }

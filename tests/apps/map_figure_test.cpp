@@ -142,7 +142,7 @@ TEST(ExploredWindow, IsTheKnownCellsAndThePointsWithAMetreAround) {
 TEST(FigurePixelsPerCell, AimsAtTheTargetWidthWithinAMemoryCap) {
   const auto g = mapping::GridGeometry::FromArea(0, 0, 20, 20, 0.1);  // 200 cells a side
   EXPECT_EQ(FigurePixelsPerCell(g, {{0, 0}, {10, 5}}, 1000), 10);     // 100 cells -> 10 px
-  EXPECT_EQ(FigurePixelsPerCell(g, {{0, 0}, {0.5, 0.5}}, 1000), 30);  // capped: 6000 / 200
+  EXPECT_EQ(FigurePixelsPerCell(g, {{0, 0}, {0.5, 0.5}}, 1000), 15);  // capped: 3000 / 200
   const auto big = mapping::GridGeometry::FromArea(0, 0, 64, 64, 0.1);  // 640 cells a side
   EXPECT_EQ(FigurePixelsPerCell(big, {{0, 0}, {64, 64}}, 1000), 2);     // 1.6 px rounded
 }
