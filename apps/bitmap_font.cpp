@@ -66,7 +66,8 @@ void DrawText(mapping::RgbImage& image, int x, int y, const std::string& text, i
       for (int col = 0; col < 5; ++col) {
         if (!(glyph->rows[row] & (0x10 >> col))) continue;
         for (int dy = 0; dy < scale; ++dy)
-          for (int dx = 0; dx < scale; ++dx) image.Set(x0 + col * scale + dx, y + row * scale + dy, r, g, b);
+          for (int dx = 0; dx < scale; ++dx)
+            image.Set(x0 + col * scale + dx, y + row * scale + dy, r, g, b);
       }
     }
   }

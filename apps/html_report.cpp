@@ -122,11 +122,20 @@ std::string HtmlEscape(const std::string& text) {
   out.reserve(text.size());
   for (char c : text) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -135,8 +144,8 @@ std::string HtmlEscape(const std::string& text) {
 HtmlReport::HtmlReport(std::string title) : title_(std::move(title)) {}
 
 void HtmlReport::Heading(const std::string& text, const std::string& id) {
-  body_ += (id.empty() ? "<h2>" : "<h2 id=\"" + HtmlEscape(id) + "\">") + HtmlEscape(text) +
-           "</h2>\n";
+  body_ +=
+      (id.empty() ? "<h2>" : "<h2 id=\"" + HtmlEscape(id) + "\">") + HtmlEscape(text) + "</h2>\n";
 }
 
 void HtmlReport::Paragraph(const std::string& text) {
@@ -171,8 +180,7 @@ void HtmlReport::Png(const std::string& png_bytes, const std::string& caption, i
   // pictures of kFigureWidth_px sit side by side.
   body_ += (width_px > 0 ? "<figure style=\"width:" + std::to_string(width_px) + "px\">"
                          : std::string("<figure>")) +
-           ImgTag(png_bytes, caption, width_px) + "<figcaption>" +
-           HtmlEscape(caption) +
+           ImgTag(png_bytes, caption, width_px) + "<figcaption>" + HtmlEscape(caption) +
            (file.empty() ? std::string()
                          : " (<a href=\"" + HtmlEscape(file) + "\">" + HtmlEscape(file) + "</a>)") +
            "</figcaption></figure>\n";
@@ -182,9 +190,9 @@ void HtmlReport::PngStrip(const std::vector<StripPicture>& pictures, int width_p
   body_ += "<div class=strip>\n";
   for (const StripPicture& p : pictures) {
     body_ += "<figure>" + ImgTag(p.png, p.caption, width_px) + "<figcaption>" +
-             (p.file.empty() ? HtmlEscape(p.caption)
-                             : "<a href=\"" + HtmlEscape(p.file) + "\">" + HtmlEscape(p.caption) +
-                                   "</a>") +
+             (p.file.empty()
+                  ? HtmlEscape(p.caption)
+                  : "<a href=\"" + HtmlEscape(p.file) + "\">" + HtmlEscape(p.caption) + "</a>") +
              "</figcaption></figure>\n";
   }
   body_ += "</div>\n";
@@ -289,8 +297,8 @@ std::string HtmlReport::Render() const {
   for (int k = 0; k < open_details_; ++k) closing += "</details>\n";
   return "<!DOCTYPE html>\n<html lang=en><head><meta charset=utf-8>"
          "<meta name=viewport content=\"width=device-width, initial-scale=1\"><title>" +
-         HtmlEscape(title_) + "</title>\n<style>" + kStyle + "</style>\n<script>" +
-         kErrorRecorder + "</script></head>\n<body><h1>" + HtmlEscape(title_) +
+         HtmlEscape(title_) + "</title>\n<style>" + kStyle + "</style>\n<script>" + kErrorRecorder +
+         "</script></head>\n<body><h1>" + HtmlEscape(title_) +
          "</h1>\n<pre id=page-errors data-count=0 hidden></pre>\n" + body_ + closing +
          "<div id=lightbox><img alt=\"full size\"></div>\n<script>" + kLightbox +
          "</script>\n</body></html>\n";

@@ -50,8 +50,8 @@ void Disc(mapping::RgbImage& img, int cx, int cy, int r, const Rgb& c) {
 void Marker(mapping::RgbImage& img, int cx, int cy, const std::string& letter) {
   Disc(img, cx, cy, kMarkerRadius_px, kBlack);
   Disc(img, cx, cy, kMarkerRadius_px - 3, kWhite);
-  DrawText(img, cx - TextWidth(letter, kFont) / 2, cy - TextHeight(kFont) / 2, letter, kFont, 0,
-           0, 0);
+  DrawText(img, cx - TextWidth(letter, kFont) / 2, cy - TextHeight(kFont) / 2, letter, kFont, 0, 0,
+           0);
 }
 
 // The bar's length: the largest 1, 2 or 5 times a power of ten metres up to a quarter of the
@@ -146,7 +146,8 @@ Frame Layout(const mapping::RgbImage& map, const mapping::GridGeometry& g, const
 void CopyWindow(const mapping::RgbImage& map, const mapping::GridGeometry& g, const MapWindow& w,
                 const Frame& f, mapping::RgbImage& out) {
   const Eigen::Vector2d s0 = mapping::MapToPixel(g, map, w.lo_m.x(), w.hi_m.y());
-  const int sx0 = static_cast<int>(std::lround(s0.x())), sy0 = static_cast<int>(std::lround(s0.y()));
+  const int sx0 = static_cast<int>(std::lround(s0.x())),
+            sy0 = static_cast<int>(std::lround(s0.y()));
   for (int y = 0; y < f.map_h; ++y) {
     const int sy = y + sy0;
     if (sy < 0 || sy >= map.height) continue;
@@ -173,8 +174,8 @@ void DrawAxes(mapping::RgbImage& out, const MapWindow& w, const Frame& f) {
     const int py = f.Y(y, w);
     Fill(out, f.left - kTick_px, py, kTick_px, 1, kBlack);
     const std::string s = TickLabel(y, f.step_m);
-    DrawText(out, f.left - kTick_px - kGap_px - TextWidth(s, kFont), py - TextHeight(kFont) / 2,
-             s, kFont, 0, 0, 0);
+    DrawText(out, f.left - kTick_px - kGap_px - TextWidth(s, kFont), py - TextHeight(kFont) / 2, s,
+             kFont, 0, 0, 0);
   }
   const std::string x_title = "x [m]";
   DrawText(out, f.left + f.map_w / 2 - TextWidth(x_title, kFont) / 2,

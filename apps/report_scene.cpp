@@ -39,7 +39,8 @@ nlohmann::json Polyline(const std::vector<Eigen::Vector3d>& points) {
   // A trajectory sample every few centimetres is far more than a line on screen shows; 4000
   // vertices keep a long run's path smooth at full-screen width.
   constexpr std::size_t kMaxVertices = 4000;
-  const std::size_t step = std::max<std::size_t>(1, (points.size() + kMaxVertices - 1) / kMaxVertices);
+  const std::size_t step =
+      std::max<std::size_t>(1, (points.size() + kMaxVertices - 1) / kMaxVertices);
   nlohmann::json out = nlohmann::json::array();
   for (std::size_t k = 0; k < points.size(); k += step) {
     const Eigen::Vector3d& p = points[k];
@@ -81,9 +82,10 @@ nlohmann::json SurfaceJson(const SceneSurface& s) {
   std::string z;
   z.reserve(s.z_m.size() * 2);
   for (float v : s.z_m) PutInt16(z, std::isfinite(v) ? Quantise(v, lo, q) : kUnknown);
-  return {{"x0", s.x0_m}, {"y0", s.y0_m}, {"cell", s.cell_m}, {"nx", s.nx}, {"ny", s.ny},
-          {"z0", lo},     {"scale", q},   {"z", Base64(z)},
-          {"rgb", Base64(std::string(s.rgb.begin(), s.rgb.end()))}};
+  return {
+      {"x0", s.x0_m}, {"y0", s.y0_m},   {"cell", s.cell_m},
+      {"nx", s.nx},   {"ny", s.ny},     {"z0", lo},
+      {"scale", q},   {"z", Base64(z)}, {"rgb", Base64(std::string(s.rgb.begin(), s.rgb.end()))}};
 }
 
 nlohmann::json Point(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }

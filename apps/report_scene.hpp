@@ -27,8 +27,8 @@ inline constexpr std::size_t kSceneMaxCells = 160000;
 struct SceneSurface {
   double x0_m = 0, y0_m = 0, cell_m = 0.1;
   int nx = 0, ny = 0;
-  std::vector<float> z_m;          ///< nx * ny, index j * nx + i; NaN unknown
-  std::vector<std::uint8_t> rgb;   ///< nx * ny * 3, RenderTraversability's colours
+  std::vector<float> z_m;         ///< nx * ny, index j * nx + i; NaN unknown
+  std::vector<std::uint8_t> rgb;  ///< nx * ny * 3, RenderTraversability's colours
 };
 
 /// Everything the 3D view shows, in the world frame [m].
@@ -41,7 +41,8 @@ struct Scene3D {
 
 /// Every k-th point, k the smallest that leaves at most `max_points` (the merged cloud is in scan
 /// order, so this keeps each scan's share and its density pattern).
-std::vector<Eigen::Vector3f> DecimateCloud(const mapping::PointCloud& cloud, std::size_t max_points);
+std::vector<Eigen::Vector3f> DecimateCloud(const mapping::PointCloud& cloud,
+                                           std::size_t max_points);
 
 /// The surface of `layers` over `window`, coloured by `grid` (built from the same layers); every
 /// s-th cell in each direction with s the smallest that keeps at most kSceneMaxCells.

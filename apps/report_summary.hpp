@@ -11,10 +11,10 @@ namespace pitchlab::apps {
 
 /// The verdict of a run, read from metrics.json.
 struct Outcome {
-  bool success = false;  ///< reached the goal
-  bool safe = true;      ///< touched no true hazard (only known with ground truth)
-  std::string headline;  ///< "Goal reached", "Goal reached, but unsafe", "Failed"
-  std::string reason;    ///< the mission's reason, verbatim
+  bool success = false;             ///< reached the goal
+  bool safe = true;                 ///< touched no true hazard (only known with ground truth)
+  std::string headline;             ///< "Goal reached", "Goal reached, but unsafe", "Failed"
+  std::string reason;               ///< the mission's reason, verbatim
   std::vector<std::string> safety;  ///< one sentence per safety finding; empty when safe
 };
 

@@ -96,7 +96,8 @@ void WriteRunPictures(RunFolder& folder, const RunContext& c, const MissionResul
         folder.File("hazard_errors.png"));
 }
 
-mapping::RgbImage StopPicture(const MissionResult& so_far, const std::optional<planning::Path>& plan) {
+mapping::RgbImage StopPicture(const MissionResult& so_far,
+                              const std::optional<planning::Path>& plan) {
   const mapping::ElevationLayers layers = mapping::ComputeLayers(so_far.elevation);
   const mapping::GridGeometry& g = layers.geometry;
   std::vector<Eigen::Vector2d> keep = TrajectoryXy(so_far, false);

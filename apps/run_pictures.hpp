@@ -29,6 +29,7 @@ void WriteRunPictures(RunFolder& folder, const RunContext& context, const Missio
 
 /// A stop's map.png: the map so far with the stop's plan, cropped to what is known, the start
 /// (the first trajectory sample) and the plan's goal marked.
-mapping::RgbImage StopPicture(const MissionResult& so_far, const std::optional<planning::Path>& plan);
+mapping::RgbImage StopPicture(const MissionResult& so_far,
+                              const std::optional<planning::Path>& plan);
 
 }  // namespace pitchlab::apps

@@ -30,9 +30,10 @@ const std::map<std::string, std::string>& FileDescriptions() {
 std::string OutcomeHtml(const nlohmann::json& m) {
   const Outcome o = ReadOutcome(m);
   const char* kind = !o.success ? "failed" : o.safe ? "ok" : "unsafe";
-  std::string html = std::string("<div id=outcome class=\"outcome ") + kind + "\" data-success=" +
-                     (o.success ? "true" : "false") + " data-safe=" + (o.safe ? "true" : "false") +
-                     ">\n<div class=headline>" + HtmlEscape(o.headline) +
+  std::string html = std::string("<div id=outcome class=\"outcome ") + kind +
+                     "\" data-success=" + (o.success ? "true" : "false") +
+                     " data-safe=" + (o.safe ? "true" : "false") + ">\n<div class=headline>" +
+                     HtmlEscape(o.headline) +
                      "</div>\n<div class=reason>Reason: " + HtmlEscape(o.reason) + "</div>\n";
   if (!o.safety.empty()) {
     html += "<ul class=safety>";
@@ -43,8 +44,10 @@ std::string OutcomeHtml(const nlohmann::json& m) {
                       m.value("robot", std::string("?")) + ", seed " +
                       (m.contains("seed") ? m["seed"].dump() : std::string("?"));
   if (m.contains("stops")) facts += ", " + m["stops"].dump() + " stops";
-  if (m.contains("distance_m")) facts += ", " + Significant(m["distance_m"].get<double>()) + " m driven";
-  if (m.contains("sim_time_s")) facts += ", " + Significant(m["sim_time_s"].get<double>()) + " s simulated";
+  if (m.contains("distance_m"))
+    facts += ", " + Significant(m["distance_m"].get<double>()) + " m driven";
+  if (m.contains("sim_time_s"))
+    facts += ", " + Significant(m["sim_time_s"].get<double>()) + " s simulated";
   if (const auto& d = m.find("closest_approach_to_forbidden_m"); d != m.end() && d->is_number()) {
     facts += ", closest approach to a true hazard " + Significant(d->get<double>(), 2) + " m";
   }
@@ -80,7 +83,8 @@ std::string FilesHtml(const std::vector<std::string>& files) {
            "</li>\n";
   }
   top += "</ul>\n";
-  if (!stops.empty()) top += "<details><summary>each stop's files</summary><p>" + stops + "</p></details>\n";
+  if (!stops.empty())
+    top += "<details><summary>each stop's files</summary><p>" + stops + "</p></details>\n";
   return top;
 }
 

@@ -39,7 +39,7 @@ std::vector<Eigen::Vector3d> Trajectory3d(const MissionResult& r, bool truth) {
 }
 
 void AddStops(RunReportInput& in, const MissionResult& r) {
-  in.stop_header = {"stop",      "t [s]",    "x [m]",       "y [m]",    "pose error [m]",
+  in.stop_header = {"stop",         "t [s]",    "x [m]",       "y [m]",    "pose error [m]",
                     "registration", "rmse [m]", "to goal [m]", "plan cost"};
   for (const StopRecord& s : r.stops) {
     const Eigen::Vector3d e = s.T_world_base.translation();
@@ -50,7 +50,8 @@ void AddStops(RunReportInput& in, const MissionResult& r) {
          s.merge.merged ? mapping::ToString(s.merge.registration.path) : "failed",
          Fixed(s.merge.registration.rmse_m, 4), Fixed(s.distance_to_goal_m, 2),
          s.plan ? Fixed(s.plan->cost, 1) : (s.plan_error.empty() ? "-" : "none")});
-    in.stop_pictures.push_back({StopFile(s.index, "map.png"), "stop " + std::to_string(s.index), ""});
+    in.stop_pictures.push_back(
+        {StopFile(s.index, "map.png"), "stop " + std::to_string(s.index), ""});
   }
 }
 
@@ -65,8 +66,7 @@ Scene3D BuildRunScene(const RunContext& c, const MissionResult& r,
   keep.push_back(c.start.head<2>());
   keep.push_back(c.goal);
   const MapWindow window = ExploredWindow(layers, keep);
-  scene.surface =
-      BuildSurface(layers, planning::BuildTraversability(layers, c.planner), window);
+  scene.surface = BuildSurface(layers, planning::BuildTraversability(layers, c.planner), window);
   // Start and goal at ground level: the first pose's height, the goal cell's height when known.
   const double z0 = scene.estimated_m.empty() ? 0.0 : scene.estimated_m.front().z();
   scene.start_m = {c.start.x(), c.start.y(), z0};
@@ -91,8 +91,8 @@ std::vector<std::string> FolderFiles(const std::filesystem::path& root) {
 
 }  // namespace
 
-RunReportInput GatherRunReport(const RunFolder& folder, const RunContext& c,
-                               const MissionResult& r, const nlohmann::json& metrics,
+RunReportInput GatherRunReport(const RunFolder& folder, const RunContext& c, const MissionResult& r,
+                               const nlohmann::json& metrics,
                                const mapping::ElevationLayers& layers) {
   RunReportInput in;
   in.metrics = metrics;
@@ -103,19 +103,23 @@ RunReportInput GatherRunReport(const RunFolder& folder, const RunContext& c,
   in.pictures.push_back({"elevation.png", "estimated elevation map",
                          "Estimated elevation map with every planned path (red), the estimated "
                          "trajectory (orange) and the true one (blue); unknown cells are "
-                         "checkered, drops magenta." + marks});
+                         "checkered, drops magenta." +
+                             marks});
   if (truth) {
-    in.pictures.push_back(
-        {"truth_elevation.png", "true elevation map, true optimal path (red), true trajectory (blue)", ""});
+    in.pictures.push_back({"truth_elevation.png",
+                           "true elevation map, true optimal path (red), true trajectory (blue)",
+                           ""});
   }
   in.pictures.push_back({"traversability.png", "traversability, estimated map",
                          "Where the planner may go, on the estimated map at the end and on the "
-                         "true map. " + TraversabilityLegend()});
+                         "true map. " +
+                             TraversabilityLegend()});
   if (truth) in.pictures.push_back({"truth_traversability.png", "traversability, true map", ""});
   if (std::filesystem::exists(in.folder / "hazard_errors.png")) {
     in.pictures.push_back({"hazard_errors.png", "hazard errors of the final map",
                            "Where the final map's hazards are wrong (map_hazards in the "
-                           "metrics). " + HazardErrorsLegend()});
+                           "metrics). " +
+                               HazardErrorsLegend()});
   }
   in.trajectories = {{"estimated", "#e08000", TrajectoryXy(r, false), false},
                      {"true", "#1e50ff", TrajectoryXy(r, true), true}};

@@ -30,8 +30,8 @@ mapping::RgbImage GreyMap(const mapping::GridGeometry& g, int ppc) {
     const Eigen::Vector2d p = mapping::MapToPixel(g, img, x - 0.05, y + 0.05);  // cell's corner
     for (int dy = 0; dy < ppc; ++dy)
       for (int dx = 0; dx < ppc; ++dx)
-        img.Set(static_cast<int>(std::lround(p.x())) + dx, static_cast<int>(std::lround(p.y())) + dy,
-                r, gr, b);
+        img.Set(static_cast<int>(std::lround(p.x())) + dx,
+                static_cast<int>(std::lround(p.y())) + dy, r, gr, b);
   };
   paint(2.05, 3.05, 255, 0, 0);
   paint(8.05, 8.05, 0, 0, 255);
@@ -98,7 +98,8 @@ TEST_F(MapFigure, MarksStartAndGoalWhereTheyAre) {
     for (int x = grey.x0; x <= grey.x1; ++x)
       if (Pixel(fig, x, y) == Rgb{255, 255, 255}) white.Add(x, y);
   ASSERT_GT(white.count, 100);
-  const double cx = (white.x0 + white.x1) / 2.0 - grey.x0, cy = (white.y0 + white.y1) / 2.0 - grey.y0;
+  const double cx = (white.x0 + white.x1) / 2.0 - grey.x0,
+               cy = (white.y0 + white.y1) / 2.0 - grey.y0;
   EXPECT_NEAR(cx, 40 * (2.0 - 1.0), 1.0);
   EXPECT_NEAR(cy, 40 * (5.0 - 4.0), 1.0);
 }
@@ -140,9 +141,9 @@ TEST(ExploredWindow, IsTheKnownCellsAndThePointsWithAMetreAround) {
 }
 
 TEST(FigurePixelsPerCell, AimsAtTheTargetWidthWithinAMemoryCap) {
-  const auto g = mapping::GridGeometry::FromArea(0, 0, 20, 20, 0.1);  // 200 cells a side
-  EXPECT_EQ(FigurePixelsPerCell(g, {{0, 0}, {10, 5}}, 1000), 10);     // 100 cells -> 10 px
-  EXPECT_EQ(FigurePixelsPerCell(g, {{0, 0}, {0.5, 0.5}}, 1000), 15);  // capped: 3000 / 200
+  const auto g = mapping::GridGeometry::FromArea(0, 0, 20, 20, 0.1);    // 200 cells a side
+  EXPECT_EQ(FigurePixelsPerCell(g, {{0, 0}, {10, 5}}, 1000), 10);       // 100 cells -> 10 px
+  EXPECT_EQ(FigurePixelsPerCell(g, {{0, 0}, {0.5, 0.5}}, 1000), 15);    // capped: 3000 / 200
   const auto big = mapping::GridGeometry::FromArea(0, 0, 64, 64, 0.1);  // 640 cells a side
   EXPECT_EQ(FigurePixelsPerCell(big, {{0, 0}, {64, 64}}, 1000), 2);     // 1.6 px rounded
 }

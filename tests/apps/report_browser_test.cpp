@@ -70,7 +70,8 @@ std::string Attribute(const std::string& dom, const std::string& id, const std::
 }
 
 std::string Unescape(std::string s) {
-  for (const auto& [from, to] : {std::pair<std::string, std::string>{"&quot;", "\""}, {"&amp;", "&"}}) {
+  for (const auto& [from, to] :
+       {std::pair<std::string, std::string>{"&quot;", "\""}, {"&amp;", "&"}}) {
     for (std::size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + 1))
       s.replace(at, from.size(), to);
   }
@@ -110,10 +111,10 @@ std::string RunChromium(const fs::path& page, const fs::path& profile, int width
   const std::string command =
       "timeout 180 '" + std::string(PITCHLAB_CHROMIUM) +
       "' --headless --no-sandbox --enable-unsafe-swiftshader --use-angle=swiftshader "
-      "--no-first-run --user-data-dir='" + profile.string() + "' --window-size=" +
-      std::to_string(width_px) + "," + std::to_string(kHeight_px) +
-      " --virtual-time-budget=5000 --enable-logging=stderr --v=0 " + mode + " 'file://" +
-      page.string() + "' 2>'" + log.string() + "'";
+      "--no-first-run --user-data-dir='" +
+      profile.string() + "' --window-size=" + std::to_string(width_px) + "," +
+      std::to_string(kHeight_px) + " --virtual-time-budget=5000 --enable-logging=stderr --v=0 " +
+      mode + " 'file://" + page.string() + "' 2>'" + log.string() + "'";
   std::string out;
   std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(command.c_str(), "r"), pclose);
   char buf[65536];
@@ -172,7 +173,8 @@ class ReportInBrowser : public ::testing::Test {
 TEST_F(ReportInBrowser, TheThreeDViewDrawsAndNoScriptFails) {
   for (const auto& [width, s] : *seen_) {
     ASSERT_NE(s.dom.find("</html>"), std::string::npos) << s.err;
-    EXPECT_EQ(Attribute(s.dom, "view3d", "data-status"), "ok") << width << ": " << s.dom.substr(0, 2000);
+    EXPECT_EQ(Attribute(s.dom, "view3d", "data-status"), "ok")
+        << width << ": " << s.dom.substr(0, 2000);
     // The scene (an 8 m plane with a block, seen whole) covers a large part of the canvas
     // (1240 px wide, 55 % as high); an empty canvas draws nothing that differs from the
     // background.
@@ -189,8 +191,8 @@ TEST_F(ReportInBrowser, TheOutcomeAndItsReasonAreOnTheFirstScreen) {
   for (const auto& [width, s] : *seen_) {
     const std::size_t at = s.dom.find("data-probe=\"");
     ASSERT_NE(at, std::string::npos) << width << " px: " << s.err;
-    const nlohmann::json p = nlohmann::json::parse(
-        Unescape(s.dom.substr(at + 12, s.dom.find('"', at + 12) - at - 12)));
+    const nlohmann::json p =
+        nlohmann::json::parse(Unescape(s.dom.substr(at + 12, s.dom.find('"', at + 12) - at - 12)));
     EXPECT_EQ(p["width"].get<int>(), width);
     EXPECT_LE(p["scroll_width"].get<int>(), width) << "the page scrolls sideways at " << width;
     for (const char* part : {"headline", "reason"}) {

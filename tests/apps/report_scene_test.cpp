@@ -52,7 +52,8 @@ TEST(SceneJson, PointsComeBackWithinTheQuantum) {
   EXPECT_LE(q, 0.001);  // 16 bits over a 16 m span: finer than the 1 mm floor
   for (std::size_t p = 0; p < 3; ++p) {
     for (int a = 0; a < 3; ++a) {
-      const double v = j["cloud"]["origin"][a].get<double>() + (Int16At(xyz, 3 * p + a) + 32767) * q;
+      const double v =
+          j["cloud"]["origin"][a].get<double>() + (Int16At(xyz, 3 * p + a) + 32767) * q;
       EXPECT_NEAR(v, scene.cloud_m[p][a], q) << p << "," << a;
     }
   }

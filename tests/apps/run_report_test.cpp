@@ -14,7 +14,8 @@ class RunReport : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::path(::testing::TempDir()) /
-           ("run_report_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+           ("run_report_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir_);
   }
   void TearDown() override { fs::remove_all(dir_); }
@@ -45,7 +46,8 @@ TEST_F(RunReport, ASuccessThatCrossedHazardsSaysSoBesideTheOutcome) {
   in.metrics["hazard_cells_crossed"] = 2;
   in.metrics["forbidden_cells_crossed"] = 2;
   const std::string html = RenderRunReport(in, LoadThreeJs(DefaultThreeJsDir()));
-  const std::size_t outcome = html.find("<div id=outcome class=\"outcome unsafe\" data-success=true data-safe=false>");
+  const std::size_t outcome =
+      html.find("<div id=outcome class=\"outcome unsafe\" data-success=true data-safe=false>");
   ASSERT_NE(outcome, std::string::npos);
   EXPECT_NE(html.find("Goal reached, but unsafe"), std::string::npos);
   const std::size_t unsafe = html.find("Unsafe: the true trajectory crossed 2 true hazard cells");
@@ -69,7 +71,8 @@ TEST_F(RunReport, WithoutThreeJsThePageSaysWhyAndHasNoViewer) {
 TEST_F(RunReport, LinksTheRunFiles) {
   const RunReportInput in = testing::SyntheticReport(dir_, 1000, 40);
   const std::string html = RenderRunReport(in, LoadThreeJs(DefaultThreeJsDir()));
-  EXPECT_NE(html.find("<a href=\"metrics.json\">metrics.json</a>: every metric"), std::string::npos);
+  EXPECT_NE(html.find("<a href=\"metrics.json\">metrics.json</a>: every metric"),
+            std::string::npos);
   EXPECT_NE(html.find("<a href=\"stops/000/map.png\">stops/000/map.png</a>"), std::string::npos);
   EXPECT_NE(html.find("<a href=\"elevation.png\">elevation.png</a>"), std::string::npos);
 }

@@ -64,7 +64,8 @@ void WritePicture(const mapping::ElevationLayers& L, const std::filesystem::path
                     ColourBar{lo, hi, mapping::ElevationRamp}};
   const mapping::RgbImage figure =
       ComposeMapFigure(mapping::RenderElevationImage(L, options), L.geometry, window, marks);
-  if (!mapping::WritePng(figure, file.string())) throw std::runtime_error("cannot write " + file.string());
+  if (!mapping::WritePng(figure, file.string()))
+    throw std::runtime_error("cannot write " + file.string());
 }
 
 }  // namespace
@@ -76,11 +77,16 @@ RunReportInput SyntheticReport(const std::filesystem::path& folder, std::size_t 
   WritePicture(L, folder / "elevation.png");
   WritePicture(L, folder / "stops/000/map.png");
   RunReportInput in;
-  in.metrics = {{"success", false},       {"reason", kSyntheticReason},
-                {"world", "synthetic"},   {"robot", "p3at"},
-                {"seed", 7},              {"stops", 1},
-                {"distance_m", 3.14159},  {"sim_time_s", 42.0},
-                {"hazard_cells_crossed", 0}, {"forbidden_cells_crossed", 0},
+  in.metrics = {{"success", false},
+                {"reason", kSyntheticReason},
+                {"world", "synthetic"},
+                {"robot", "p3at"},
+                {"seed", 7},
+                {"stops", 1},
+                {"distance_m", 3.14159},
+                {"sim_time_s", 42.0},
+                {"hazard_cells_crossed", 0},
+                {"forbidden_cells_crossed", 0},
                 {"closest_approach_to_forbidden_m", 1.25}};
   in.config_yaml = "seed: 7\n";
   in.folder = folder;

@@ -10,8 +10,8 @@ namespace pitchlab::apps::testing {
 
 /// A report input for a failed run (reason: kSyntheticReason) whose pictures are written into
 /// `folder` (created). `cloud_points` and `surface_side_cells` size the 3D scene.
-RunReportInput SyntheticReport(const std::filesystem::path& folder, std::size_t cloud_points = 20000,
-                               int surface_side_cells = 80);
+RunReportInput SyntheticReport(const std::filesystem::path& folder,
+                               std::size_t cloud_points = 20000, int surface_side_cells = 80);
 
 /// The failed run's reason, as the page must show it.
 inline constexpr const char* kSyntheticReason =
