@@ -64,7 +64,7 @@ constexpr const char* kViewerJs = R"JS(
     g.computeBoundingBox();
     if (n > 0) box.union(g.boundingBox);
     return new THREE.Points(g, new THREE.PointsMaterial(
-        {size: 2, sizeAttenuation: false, vertexColors: THREE.VertexColors}));
+        {size: 1.5, sizeAttenuation: false, vertexColors: THREE.VertexColors}));
   }
   function surface(s, box) {
     var z = int16(s.z), rgb = bytes(s.rgb), n = s.nx * s.ny;
@@ -89,8 +89,11 @@ constexpr const char* kViewerJs = R"JS(
     g.setAttribute('color', new THREE.BufferAttribute(col, 3));
     g.setIndex(new THREE.BufferAttribute(n > 65535 ? new Uint32Array(index) : new Uint16Array(index), 1));
     g.computeVertexNormals();
-    return new THREE.Mesh(g, new THREE.MeshLambertMaterial(
-        {vertexColors: THREE.VertexColors, side: THREE.DoubleSide}));
+    // Pulled towards the camera in depth: the cloud's ground points (on the surface, within the
+    // range noise) hide behind it, points above the ground (walls, rocks) stay in view.
+    return new THREE.Mesh(g, new THREE.MeshLambertMaterial({
+      vertexColors: THREE.VertexColors, side: THREE.DoubleSide,
+      polygonOffset: true, polygonOffsetFactor: -4, polygonOffsetUnits: -4}));
   }
   // A tube, not a GL line: WebGL draws lines 1 px wide whatever their width says.
   function path(points, colour, radius, box) {
@@ -101,11 +104,15 @@ constexpr const char* kViewerJs = R"JS(
     }
     if (v.length < 2) return new THREE.Group();
     var g = new THREE.TubeBufferGeometry(new THREE.CatmullRomCurve3(v), 2 * v.length, radius, 6, false);
-    return new THREE.Mesh(g, new THREE.MeshLambertMaterial({color: colour}));
+    // Further forward in depth than the surface: a path on the ground stays visible.
+    return new THREE.Mesh(g, new THREE.MeshLambertMaterial(
+        {color: colour, polygonOffset: true, polygonOffsetFactor: -8, polygonOffsetUnits: -8}));
   }
   function ball(p, radius, colour) {
     var m = new THREE.Mesh(new THREE.SphereBufferGeometry(radius, 16, 12),
-                           new THREE.MeshLambertMaterial({color: colour}));
+                           new THREE.MeshLambertMaterial({color: colour, polygonOffset: true,
+                                                          polygonOffsetFactor: -8,
+                                                          polygonOffsetUnits: -8}));
     m.position.set(p[0], p[1], p[2]);
     return m;
   }
@@ -137,9 +144,12 @@ constexpr const char* kViewerJs = R"JS(
     var sun = new THREE.DirectionalLight(0xffffff, 0.5);
     sun.position.set(-1, 1, 2);  // from the north-west, as the map pictures' hillshade
     scene.add(sun);
-    var box = new THREE.Box3(), layers = {};
+    // The view frames the mapped surface and the trajectories; the cloud only when there is
+    // nothing else (its far returns would shrink the scene to a speck).
+    var box = new THREE.Box3(), cloudBox = new THREE.Box3(), layers = {};
     layers.surface = surface(d.surface, box);
-    layers.cloud = cloud(d.cloud, box);
+    layers.cloud = cloud(d.cloud, cloudBox);
+    if (box.isEmpty()) box.copy(cloudBox);
     // Thick enough to see from the whole scene's view, thin beside the robot (0.5 m wide).
     var radius = Math.max(0.03, box.getSize(new THREE.Vector3()).length() / 600);
     layers.paths = new THREE.Group();
@@ -156,7 +166,7 @@ constexpr const char* kViewerJs = R"JS(
     controls.screenSpacePanning = true;
     function render() { renderer.render(scene, camera); }
     function view(from) {
-      camera.position.copy(centre).add(from.normalize().multiplyScalar(0.75 * size));
+      camera.position.copy(centre).add(from.normalize().multiplyScalar(0.7 * size));
       controls.target.copy(centre);
       controls.update();
       render();

@@ -37,10 +37,17 @@ addEventListener('load', function () {
     var r = range.getBoundingClientRect();
     return [r.left, r.top, r.right, r.bottom];
   }
-  document.body.setAttribute('data-probe', JSON.stringify({
+  var probe = {
     headline: text('#outcome .headline'), reason: text('#outcome .reason'),
     width: innerWidth, height: innerHeight,
-    scroll_width: document.documentElement.scrollWidth}));
+    scroll_width: document.documentElement.scrollWidth};
+  // A click on a stop's thumbnail opens the picture full size over the page.
+  var thumb = document.querySelector('.strip img.zoom'), box = document.getElementById('lightbox');
+  thumb.click();
+  var big = box.querySelector('img');
+  probe.lightbox = [getComputedStyle(box).display, big.src === thumb.src, big.width];
+  probe.thumb_width = thumb.width;
+  document.body.setAttribute('data-probe', JSON.stringify(probe));
 });
 </script>)JS";
 
@@ -203,7 +210,16 @@ TEST_F(ReportInBrowser, TheOutcomeAndItsReasonAreOnTheFirstScreen) {
       EXPECT_LE(r[3].get<double>(), kHeight_px) << part << " at " << width;
       EXPECT_GT(r[2].get<double>() - r[0].get<double>(), 50) << part << " has no text";
     }
+
   }
+}
+
+TEST_F(ReportInBrowser, AClickOnAThumbnailOpensItFullSize) {
+  const nlohmann::json p = Probe(seen_->at(1366).dom);
+  ASSERT_FALSE(p.is_null()) << seen_->at(1366).err;
+  EXPECT_EQ(p["lightbox"][0], "block");
+  EXPECT_EQ(p["lightbox"][1], true);  // the same picture
+  EXPECT_GT(p["lightbox"][2].get<int>(), p["thumb_width"].get<int>());
 }
 
 TEST_F(ReportInBrowser, TheScreenshotAt1366ShowsTheFailedOutcome) {
