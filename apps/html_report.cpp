@@ -73,7 +73,11 @@ constexpr const char* kLightbox = R"JS(
     var t = e.target;
     if (t.classList && t.classList.contains('zoom')) {
       e.preventDefault();
-      big.src = t.src;
+      // A thumbnail opens the full-size file it links to; the thumbnail itself when that file
+      // is not beside the page.
+      var link = t.closest('a');
+      big.onerror = function () { big.onerror = null; big.src = t.src; };
+      big.src = link ? link.href : t.src;
       box.style.display = 'block';
     } else if (box.style.display === 'block' && box.contains(t)) {
       box.style.display = 'none';
@@ -189,7 +193,10 @@ void HtmlReport::Png(const std::string& png_bytes, const std::string& caption, i
 void HtmlReport::PngStrip(const std::vector<StripPicture>& pictures, int width_px) {
   body_ += "<div class=strip>\n";
   for (const StripPicture& p : pictures) {
-    body_ += "<figure>" + ImgTag(p.png, p.caption, width_px) + "<figcaption>" +
+    const std::string img = ImgTag(p.png, p.caption, width_px);
+    body_ += "<figure>" +
+             (p.file.empty() ? img : "<a href=\"" + HtmlEscape(p.file) + "\">" + img + "</a>") +
+             "<figcaption>" +
              (p.file.empty()
                   ? HtmlEscape(p.caption)
                   : "<a href=\"" + HtmlEscape(p.file) + "\">" + HtmlEscape(p.caption) + "</a>") +

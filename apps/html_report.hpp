@@ -25,8 +25,8 @@ struct PlotMarker {
   Eigen::Vector2d point_m{0, 0};
 };
 
-/// A picture of a strip: the PNG's bytes, its caption, and the run-folder file it came from
-/// (a link for the reader; may be empty).
+/// A picture of a strip: the PNG's bytes (a thumbnail), its caption, and the run-folder file of
+/// its full-size picture (opened on click; may be empty: the thumbnail itself).
 struct StripPicture {
   std::string png, caption, file;
 };
@@ -49,7 +49,8 @@ class HtmlReport {
   /// run-folder file it came from, linked under the caption.
   void Png(const std::string& png_bytes, const std::string& caption, int width_px = 0,
            const std::string& file = "");
-  /// A row of small PNGs with captions (the per-stop strip), each opening full size on click.
+  /// A row of thumbnails with captions (the per-stop strip), each opening its full-size file on
+  /// click (the thumbnail itself when that file cannot be loaded: the page was moved alone).
   void PngStrip(const std::vector<StripPicture>& pictures, int width_px);
   /// An x-y plot of the series with axes in metres (equal scales), as inline SVG.
   void Plot(const std::vector<PlotSeries>& series, const std::string& caption,

@@ -144,7 +144,7 @@ void WriteStopOutputs(RunFolder& folder, const StopRecord& stop, const MissionRe
           planning::WritePathGeoJson(*stop.plan, origin, folder.File(d + "path.geojson").string()));
     }
   }
-  Check(mapping::WritePng(StopPicture(so_far, stop.plan), folder.File(d + "map.png").string()));
+  WriteStopPictures(folder, d, so_far, stop.plan);
 }
 
 nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,

@@ -30,7 +30,7 @@ struct RunContext {
   double wall_time_s = 0;       ///< whole run including set-up [s]
 };
 
-/// Writes stops/NN/{scan.pcd, registration.json, path.csv, path.geojson, map.png}.
+/// Writes stops/NN/{scan.pcd, registration.json, path.csv, path.geojson, map.png, map_small.png}.
 /// Throws std::runtime_error naming the file on a write failure.
 void WriteStopOutputs(RunFolder& folder, const StopRecord& stop, const MissionResult& so_far,
                       const std::optional<mapping::GeodeticOrigin>& origin);

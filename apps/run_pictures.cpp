@@ -96,6 +96,37 @@ void WriteRunPictures(RunFolder& folder, const RunContext& c, const MissionResul
         folder.File("hazard_errors.png"));
 }
 
+mapping::RgbImage Downscale(const mapping::RgbImage& image, int max_width_px) {
+  const int f = std::max(1, (image.width + max_width_px - 1) / std::max(1, max_width_px));
+  mapping::RgbImage out;
+  out.pixels_per_cell = image.pixels_per_cell;
+  out.width = image.width / f;
+  out.height = image.height / f;
+  out.rgb.assign(static_cast<std::size_t>(out.width) * out.height * 3, 0);
+  for (int y = 0; y < out.height; ++y) {
+    for (int x = 0; x < out.width; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        int sum = 0;
+        for (int dy = 0; dy < f; ++dy)
+          for (int dx = 0; dx < f; ++dx)
+            sum +=
+                image.rgb[((static_cast<std::size_t>(y) * f + dy) * image.width + x * f + dx) * 3 +
+                          c];
+        out.rgb[(static_cast<std::size_t>(y) * out.width + x) * 3 + c] =
+            static_cast<std::uint8_t>((sum + f * f / 2) / (f * f));
+      }
+    }
+  }
+  return out;
+}
+
+void WriteStopPictures(RunFolder& folder, const std::string& dir, const MissionResult& so_far,
+                       const std::optional<planning::Path>& plan) {
+  const mapping::RgbImage picture = StopPicture(so_far, plan);
+  Write(picture, folder.File(dir + "map.png"));
+  Write(Downscale(picture, kThumbnailWidth_px), folder.File(dir + "map_small.png"));
+}
+
 mapping::RgbImage StopPicture(const MissionResult& so_far,
                               const std::optional<planning::Path>& plan) {
   const mapping::ElevationLayers layers = mapping::ComputeLayers(so_far.elevation);

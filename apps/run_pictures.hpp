@@ -32,4 +32,18 @@ void WriteRunPictures(RunFolder& folder, const RunContext& context, const Missio
 mapping::RgbImage StopPicture(const MissionResult& so_far,
                               const std::optional<planning::Path>& plan);
 
+/// The report's thumbnails are this wide [px]: twice the 240 px they are shown at, sharp on a
+/// high-density screen; a thumbnail is ~1/4 of its picture's bytes, which keeps a 40-stop report
+/// (the default run.max_stops) well under 10 MB.
+inline constexpr int kThumbnailWidth_px = 480;
+
+/// `image` shrunk by a whole factor to at most `max_width_px` wide, each pixel the mean of the
+/// block it replaces.
+mapping::RgbImage Downscale(const mapping::RgbImage& image, int max_width_px);
+
+/// Writes `dir`map.png (StopPicture) and `dir`map_small.png (its thumbnail). Throws
+/// std::runtime_error naming the file on a write failure.
+void WriteStopPictures(RunFolder& folder, const std::string& dir, const MissionResult& so_far,
+                       const std::optional<planning::Path>& plan);
+
 }  // namespace pitchlab::apps

@@ -127,7 +127,8 @@ std::string RenderRunReport(const RunReportInput& in, const Result<ThreeJs>& thr
   if (!in.stop_rows.empty()) page.Table(in.stop_header, in.stop_rows);
   std::vector<StripPicture> strip;
   for (const ReportPicture& p : in.stop_pictures) {
-    strip.push_back({ReadBinaryFile(in.folder / p.file), p.caption, p.file});
+    strip.push_back(
+        {ReadBinaryFile(in.folder / p.file), p.caption, p.full.empty() ? p.file : p.full});
   }
   page.PngStrip(strip, kStripWidth_px);
 

@@ -23,6 +23,7 @@ struct ReportPicture {
   std::string file;     ///< relative to the run folder
   std::string caption;  ///< under the picture
   std::string legend;   ///< a sentence before it (may be empty)
+  std::string full = "";  ///< the full-size picture a thumbnail opens (empty: `file` itself)
 };
 
 /// Everything report.html shows, gathered from a run (GatherRunReport) or made by a test.
@@ -35,9 +36,9 @@ struct RunReportInput {
   std::vector<PlotMarker> markers;
   std::vector<std::string> stop_header;
   std::vector<std::vector<std::string>> stop_rows;
-  std::vector<ReportPicture> stop_pictures;
-  std::string scene_json;          ///< SceneJson(); empty: no 3D view
-  std::vector<std::string> files;  ///< the run folder's files, relative paths
+  std::vector<ReportPicture> stop_pictures;  ///< thumbnails, each with its `full` picture
+  std::string scene_json;                    ///< SceneJson(); empty: no 3D view
+  std::vector<std::string> files;            ///< the run folder's files, relative paths
 };
 
 /// The page. `three` is three.js (LoadThreeJs) or why it is missing: then the page says the 3D

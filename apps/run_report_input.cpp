@@ -50,8 +50,9 @@ void AddStops(RunReportInput& in, const MissionResult& r) {
          s.merge.merged ? mapping::ToString(s.merge.registration.path) : "failed",
          Fixed(s.merge.registration.rmse_m, 4), Fixed(s.distance_to_goal_m, 2),
          s.plan ? Fixed(s.plan->cost, 1) : (s.plan_error.empty() ? "-" : "none")});
-    in.stop_pictures.push_back(
-        {StopFile(s.index, "map.png"), "stop " + std::to_string(s.index), ""});
+    in.stop_pictures.push_back({StopFile(s.index, "map_small.png"),
+                                "stop " + std::to_string(s.index), "",
+                                StopFile(s.index, "map.png")});
   }
 }
 

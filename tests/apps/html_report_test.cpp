@@ -44,10 +44,14 @@ TEST(HtmlReport, PicturesLinkTheirFileAndOpenFullSize) {
   HtmlReport report("t");
   report.Png("png", "the map", 600, "elevation.png");
   report.PngStrip({{"a", "stop 0", "stops/000/map.png"}}, 240);
+  report.PngStrip({{"b", "stop 1", ""}}, 240);
   const std::string html = report.Render();
   EXPECT_NE(html.find("<a href=\"elevation.png\">elevation.png</a>"), std::string::npos);
   EXPECT_NE(html.find("<a href=\"stops/000/map.png\">stop 0</a>"), std::string::npos);
-  EXPECT_EQ(Count(html, "<img class=zoom"), 2u);  // the lightbox script opens class=zoom
+  // The thumbnail links its full-size file, which the lightbox opens.
+  EXPECT_NE(html.find("<a href=\"stops/000/map.png\"><img class=zoom"), std::string::npos);
+  EXPECT_NE(html.find("<figure><img class=zoom alt=\"stop 1\""), std::string::npos);
+  EXPECT_EQ(Count(html, "<img class=zoom"), 3u);  // the lightbox script opens class=zoom
   EXPECT_NE(html.find("id=lightbox"), std::string::npos);
   EXPECT_NE(html.find("style=\"width:600px\""), std::string::npos);
 }

@@ -1,4 +1,5 @@
 #include "map_figure.hpp"
+#include "run_pictures.hpp"
 
 #include <array>
 #include <cmath>
@@ -125,6 +126,20 @@ TEST_F(MapFigure, ColourBarRunsFromLowAtTheBottomToHighAtTheTop) {
   EXPECT_GT(bar.x0, Find(fig, {128, 128, 128}).x1);  // right of the map
   EXPECT_GT(top_red, 250);
   EXPECT_GT(bottom_blue, 250);
+}
+
+TEST(Downscale, AveragesWholeBlocks) {
+  mapping::RgbImage img;
+  img.width = 5;  // the odd column is dropped: 5 / 2 = 2 blocks
+  img.height = 2;
+  img.rgb = {0,  0, 0, 10, 20, 30, 100, 0, 0, 200, 0, 0, 7, 7, 7,  //
+             30, 0, 0, 41, 20, 30, 100, 0, 0, 201, 0, 0, 7, 7, 7};
+  const mapping::RgbImage small = Downscale(img, 3);  // factor 2 makes it 2 <= 3 wide
+  ASSERT_EQ(small.width, 2);
+  ASSERT_EQ(small.height, 1);
+  EXPECT_EQ(Pixel(small, 0, 0), (Rgb{20, 10, 15}));  // (0 + 10 + 30 + 41) / 4 = 20.25
+  EXPECT_EQ(Pixel(small, 1, 0), (Rgb{150, 0, 0}));   // 150.25
+  EXPECT_EQ(Downscale(img, 10).width, 5);            // already small enough
 }
 
 TEST(ExploredWindow, IsTheKnownCellsAndThePointsWithAMetreAround) {

@@ -41,13 +41,16 @@ addEventListener('load', function () {
     headline: text('#outcome .headline'), reason: text('#outcome .reason'),
     width: innerWidth, height: innerHeight,
     scroll_width: document.documentElement.scrollWidth};
-  // A click on a stop's thumbnail opens the picture full size over the page.
-  var thumb = document.querySelector('.strip img.zoom'), box = document.getElementById('lightbox');
-  thumb.click();
-  var big = box.querySelector('img');
-  probe.lightbox = [getComputedStyle(box).display, big.src === thumb.src, big.width];
-  probe.thumb_width = thumb.width;
   document.body.setAttribute('data-probe', JSON.stringify(probe));
+  // A click on a stop's thumbnail opens its full-size file over the page.
+  var thumb = document.querySelector('.strip img.zoom'), box = document.getElementById('lightbox');
+  var big = box.querySelector('img');
+  big.addEventListener('load', function () {
+    document.body.setAttribute('data-lightbox', JSON.stringify({
+      display: getComputedStyle(box).display, src: big.src, width: big.naturalWidth,
+      thumb_width: thumb.naturalWidth}));
+  });
+  thumb.click();
 });
 </script>)JS";
 
@@ -218,12 +221,16 @@ TEST_F(ReportInBrowser, TheOutcomeAndItsReasonAreOnTheFirstScreen) {
   }
 }
 
-TEST_F(ReportInBrowser, AClickOnAThumbnailOpensItFullSize) {
-  const nlohmann::json p = Probe(seen_->at(1366).dom);
-  ASSERT_FALSE(p.is_null()) << seen_->at(1366).err;
-  EXPECT_EQ(p["lightbox"][0], "block");
-  EXPECT_EQ(p["lightbox"][1], true);  // the same picture
-  EXPECT_GT(p["lightbox"][2].get<int>(), p["thumb_width"].get<int>());
+TEST_F(ReportInBrowser, AClickOnAThumbnailOpensItsFullSizeFile) {
+  const std::string& dom = seen_->at(1366).dom;
+  const std::size_t at = dom.find("data-lightbox=\"");
+  ASSERT_NE(at, std::string::npos) << "the full-size picture did not load";
+  const nlohmann::json p =
+      nlohmann::json::parse(Unescape(dom.substr(at + 15, dom.find('"', at + 15) - at - 15)));
+  EXPECT_EQ(p["display"], "block");
+  const std::string src = p["src"].get<std::string>();
+  EXPECT_EQ(src.substr(src.size() - 17), "stops/000/map.png");
+  EXPECT_GT(p["width"].get<int>(), p["thumb_width"].get<int>());  // the synthetic 500 vs 240 px
 }
 
 TEST_F(ReportInBrowser, TheScreenshotAt1366ShowsTheFailedOutcome) {

@@ -55,10 +55,11 @@ planning::TraversabilityGrid Grid(const mapping::ElevationLayers& L) {
   return T;
 }
 
-void WritePicture(const mapping::ElevationLayers& L, const std::filesystem::path& file) {
+void WritePicture(const mapping::ElevationLayers& L, const std::filesystem::path& file,
+                  int width_px = 500) {
   const MapWindow window = ExploredWindow(L, {});
   mapping::ImageOptions options;
-  options.pixels_per_cell = FigurePixelsPerCell(L.geometry, window, 500);
+  options.pixels_per_cell = FigurePixelsPerCell(L.geometry, window, width_px);
   const auto [lo, hi] = mapping::ElevationRampRange(L);
   FigureMarks marks{Eigen::Vector2d(0, 0), Eigen::Vector2d(6, 4),
                     ColourBar{lo, hi, mapping::ElevationRamp}};
@@ -76,6 +77,7 @@ RunReportInput SyntheticReport(const std::filesystem::path& folder, std::size_t 
   const mapping::ElevationLayers L = Layers(side);
   WritePicture(L, folder / "elevation.png");
   WritePicture(L, folder / "stops/000/map.png");
+  WritePicture(L, folder / "stops/000/map_small.png", 240);
   RunReportInput in;
   in.metrics = {{"success", false},
                 {"reason", kSyntheticReason},
@@ -103,7 +105,7 @@ RunReportInput SyntheticReport(const std::filesystem::path& folder, std::size_t 
   in.markers = {{"start", "#111111", {0, 0}}, {"goal", "#d01010", {6, 4}}};
   in.stop_header = {"stop", "t [s]"};
   in.stop_rows = {{"0", "0.0"}};
-  in.stop_pictures = {{"stops/000/map.png", "stop 0", ""}};
+  in.stop_pictures = {{"stops/000/map_small.png", "stop 0", "", "stops/000/map.png"}};
   // The cloud: points on the plane and on the block's faces, a deterministic spiral of samples.
   for (std::size_t k = 0; k < cloud_points; ++k) {
     const double u = std::fmod(k * 0.618033988749895, 1.0), v = double(k) / cloud_points;
