@@ -12,9 +12,9 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path Scratch() {
-  const fs::path dir =
-      fs::temp_directory_path() / ("pitchlab_runfolder_" + std::to_string(::getpid()) + "_" +
-                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  const fs::path dir = fs::temp_directory_path() /
+                       ("pitchlab_runfolder_" + std::to_string(::getpid()) + "_" +
+                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
