@@ -108,7 +108,13 @@ std::vector<MetricRow> KeyMetrics(const nlohmann::json& m) {
     const nlohmann::json* v = At(m, s.key);
     if (!v || !v->is_number()) continue;
     const std::string value = v->is_number_integer() ? v->dump() : Significant(v->get<double>());
-    rows.push_back({s.label, value, s.unit, s.note});
+    std::string note = s.note;
+    // A count of map cells means little without how many were compared.
+    const nlohmann::json* compared = At(m, "map_hazards.cells_compared");
+    if (std::string(s.key).rfind("map_hazards.", 0) == 0 && compared) {
+      note += ", of " + compared->dump() + " cells compared";
+    }
+    rows.push_back({s.label, value, s.unit, note});
   }
   return rows;
 }

@@ -1,5 +1,8 @@
 #include "report_summary.hpp"
 
+#include <algorithm>
+#include <limits>
+
 #include <gtest/gtest.h>
 
 namespace pitchlab::apps {
@@ -88,6 +91,14 @@ TEST(KeyMetrics, ShowsUnitsAndLeavesOutWhatIsUnknown) {
   ASSERT_NE(find("final heading error"), nullptr);
   EXPECT_EQ(find("final heading error")->unit, "deg");
   EXPECT_EQ(find("path cost / optimal cost"), nullptr);
+  m["map_hazards"] = {{"cells_compared", 10205}, {"false_hazard_cells", 31}};
+  const std::vector<MetricRow> with_map = KeyMetrics(m);
+  const auto false_hazards = std::find_if(with_map.begin(), with_map.end(), [](const MetricRow& r) {
+    return r.label == "false hazard cells in the final map";
+  });
+  ASSERT_NE(false_hazards, with_map.end());
+  EXPECT_EQ(false_hazards->value, "31");
+  EXPECT_NE(false_hazards->note.find("of 10205 cells compared"), std::string::npos);
   EXPECT_EQ(find("wall time"), nullptr);
 }
 
