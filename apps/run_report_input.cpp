@@ -68,7 +68,8 @@ Scene3D BuildRunScene(const RunContext& c, const MissionResult& r,
   keep.push_back(c.goal);
   const MapWindow window = ExploredWindow(layers, keep);
   scene.surface = BuildSurface(layers, planning::BuildTraversability(layers, c.planner), window);
-  // Start and goal at ground level: the first pose's height, the goal cell's height when known.
+  // Start at the robot's first height; the goal on the map where its cell is known, else at the
+  // robot's last height.
   const double z0 = scene.estimated_m.empty() ? 0.0 : scene.estimated_m.front().z();
   scene.start_m = {c.start.x(), c.start.y(), z0};
   double goal_z = scene.estimated_m.empty() ? z0 : scene.estimated_m.back().z();
