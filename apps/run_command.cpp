@@ -26,7 +26,6 @@
 #include "run_folder.hpp"
 #include "run_outputs.hpp"
 #include "run_scoring.hpp"
-#include "traversability_image.hpp"
 #include "world_paths.hpp"
 
 namespace pitchlab::apps {
@@ -192,14 +191,6 @@ int RunRun(int argc, char** argv) {
       mapping::ComputeLayers(result.elevation, mission.layers), mission.planner);
   const RunScore score =
       ScoreRun(result, truth_grid, final_grid, start.head<2>(), goal, mission.algorithm);
-  // The picture of map_hazards, from the very grids it counted.
-  mapping::ImageOptions picture;
-  picture.max_side_px = kRunPictureMaxSide_px;
-  if (Result<void> written = mapping::WritePng(RenderHazardErrors(final_grid, truth_grid, picture),
-                                               folder.File("hazard_errors.png").string());
-      !written) {
-    throw std::runtime_error(written.error().message);
-  }
 
   RunContext context;
   context.world = world;

@@ -1,6 +1,7 @@
 #include "run_outputs.hpp"
 #include "registration_json.hpp"
-#include "traversability_image.hpp"
+#include "run_pictures.hpp"
+#include "run_report.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -10,7 +11,6 @@
 
 #include <GeographicLib/LocalCartesian.hpp>
 
-#include "html_report.hpp"
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/planning/path_io.hpp"
 #include "pitchlab/sensors/scan_pcd.hpp"
@@ -19,7 +19,6 @@ namespace pitchlab::apps {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
-constexpr int kStripWidth_px = 260;
 
 template <typename T>
 void Check(const Result<T>& r) {
@@ -35,49 +34,6 @@ nlohmann::json PoseJson(const Eigen::Isometry3d& T) {
           {"roll_deg", std::atan2(R(2, 1), R(2, 2)) * kRadToDeg},
           {"pitch_deg", std::asin(std::clamp(-R(2, 0), -1.0, 1.0)) * kRadToDeg},
           {"yaw_deg", std::atan2(R(1, 0), R(0, 0)) * kRadToDeg}};
-}
-
-std::string Fixed(double v, int digits = 3) {
-  if (!std::isfinite(v)) return "-";
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
-  return buf;
-}
-
-// A 3 px line through the map points, on a picture rendered from `g`.
-void DrawPolyline(mapping::RgbImage& image, const mapping::GridGeometry& g,
-                  const std::vector<Eigen::Vector2d>& points_m, std::uint8_t r, std::uint8_t gr,
-                  std::uint8_t b) {
-  for (std::size_t k = 1; k < points_m.size(); ++k) {
-    const Eigen::Vector2d a =
-        mapping::MapToPixel(g, image, points_m[k - 1].x(), points_m[k - 1].y());
-    const Eigen::Vector2d c = mapping::MapToPixel(g, image, points_m[k].x(), points_m[k].y());
-    const int steps = std::max(1, static_cast<int>(std::ceil((c - a).norm())));
-    for (int s = 0; s <= steps; ++s) {
-      const Eigen::Vector2d p = a + (c - a) * (double(s) / steps);
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int x = static_cast<int>(p.x()) + dx, y = static_cast<int>(p.y()) + dy;
-          if (x >= 0 && y >= 0 && x < image.width && y < image.height) image.Set(x, y, r, gr, b);
-        }
-      }
-    }
-  }
-}
-
-std::vector<Eigen::Vector2d> EstimatedXy(const MissionResult& r) {
-  std::vector<Eigen::Vector2d> xy;
-  for (const TrajectorySample& s : r.trajectory)
-    xy.push_back(s.T_world_base_est.translation().head<2>());
-  return xy;
-}
-
-std::vector<Eigen::Vector2d> TrueXy(const MissionResult& r) {
-  std::vector<Eigen::Vector2d> xy;
-  for (const TrajectorySample& s : r.trajectory) {
-    if (s.T_world_base_true) xy.push_back(s.T_world_base_true->translation().head<2>());
-  }
-  return xy;
 }
 
 void WriteTrajectoryCsv(const std::filesystem::path& file, const MissionResult& r, bool truth) {
@@ -172,16 +128,6 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
   return j;
 }
 
-mapping::RgbImage RenderWithPath(const mapping::ElevationMap& map,
-                                 const std::optional<planning::Path>& path) {
-  const mapping::ElevationLayers layers = mapping::ComputeLayers(map);
-  mapping::ImageOptions options;
-  options.max_side_px = 1024;
-  mapping::RgbImage image = mapping::RenderElevationImage(layers, options);
-  if (path) planning::DrawPath(*path, map.geometry(), image);
-  return image;
-}
-
 }  // namespace
 
 void WriteStopOutputs(RunFolder& folder, const StopRecord& stop, const MissionResult& so_far,
@@ -198,8 +144,7 @@ void WriteStopOutputs(RunFolder& folder, const StopRecord& stop, const MissionRe
           planning::WritePathGeoJson(*stop.plan, origin, folder.File(d + "path.geojson").string()));
     }
   }
-  Check(mapping::WritePng(RenderWithPath(so_far.elevation, stop.plan),
-                          folder.File(d + "map.png").string()));
+  WriteStopPictures(folder, d, so_far, stop.plan);
 }
 
 nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
@@ -282,89 +227,11 @@ void WriteFinalOutputs(RunFolder& folder, const RunContext& c, const MissionResu
   if (c.geodetic_origin) {
     WriteTrajectoryGeoJson(folder.File("trajectories.geojson"), r, *c.geodetic_origin);
   }
-  // The picture: estimated map, last plan (red), estimated (orange) and true (blue) trajectory.
-  mapping::ImageOptions options;
-  options.max_side_px = kRunPictureMaxSide_px;
-  mapping::RgbImage image = mapping::RenderElevationImage(layers, options);
-  for (const StopRecord& s : r.stops) {
-    if (s.plan) planning::DrawPath(*s.plan, r.elevation.geometry(), image);
-  }
-  DrawPolyline(image, r.elevation.geometry(), EstimatedXy(r), 255, 140, 0);
-  DrawPolyline(image, r.elevation.geometry(), TrueXy(r), 30, 80, 255);
-  Check(mapping::WritePng(image, folder.File("elevation.png").string()));
-  const planning::TraversabilityGrid estimated = planning::BuildTraversability(layers, c.planner);
-  Check(mapping::WritePng(RenderTraversability(estimated, options),
-                          folder.File("traversability.png").string()));
-  if (truth) {
-    const planning::TraversabilityGrid true_grid = planning::BuildTraversability(*truth, c.planner);
-    Check(mapping::WritePng(RenderTraversability(true_grid, options),
-                            folder.File("truth_traversability.png").string()));
-    mapping::RgbImage truth_image = mapping::RenderElevationImage(*truth, options);
-    if (truth_optimum) planning::DrawPath(*truth_optimum, truth->geometry, truth_image);
-    DrawPolyline(truth_image, truth->geometry, TrueXy(r), 30, 80, 255);
-    Check(mapping::WritePng(truth_image, folder.File("truth_elevation.png").string()));
-  }
+  WriteRunPictures(folder, c, r, layers, truth, truth_optimum);
   const nlohmann::json metrics = RunMetrics(c, r, score);
   WriteTextFile(folder.File("metrics.json"), metrics.dump(2));
 
-  HtmlReport report("pitchlab run: " + c.world + (r.success ? " (success)" : " (failed)"));
-  std::vector<std::pair<std::string, std::string>> rows;
-  for (const auto& [key, value] : metrics.items()) {
-    rows.emplace_back(key, value.is_string() ? value.get<std::string>() : value.dump());
-  }
-  report.KeyValues(rows);
-  report.Heading("Map and trajectories");
-  report.Paragraph(
-      "Estimated elevation map with every planned path (red), the estimated "
-      "trajectory (orange) and the true one (blue). Unknown cells are checkered.");
-  report.Png(ReadBinaryFile(folder.File("elevation.png")), "estimated elevation map", 900);
-  if (truth) {
-    report.Png(ReadBinaryFile(folder.File("truth_elevation.png")),
-               "true elevation map, true optimal path (red), true trajectory (blue)", 900);
-  }
-  report.Paragraph(
-      "Where the planner may go, on the estimated map at the end and on the true "
-      "map. " +
-      TraversabilityLegend());
-  report.Png(ReadBinaryFile(folder.File("traversability.png")), "traversability, estimated map",
-             900);
-  if (truth) {
-    report.Png(ReadBinaryFile(folder.File("truth_traversability.png")), "traversability, true map",
-               900);
-  }
-  if (std::filesystem::exists(folder.File("hazard_errors.png"))) {
-    report.Paragraph("Where the final map's hazards are wrong (map_hazards in the metrics). " +
-                     HazardErrorsLegend());
-    report.Png(ReadBinaryFile(folder.File("hazard_errors.png")), "hazard errors of the final map",
-               900);
-  }
-  report.Plot(
-      {{"estimated", "#e08000", EstimatedXy(r), false}, {"true", "#1e50ff", TrueXy(r), true}},
-      "trajectories (world frame, metres)");
-  report.Heading("Stops");
-  std::vector<std::vector<std::string>> table;
-  std::vector<std::pair<std::string, std::string>> strip;
-  for (const StopRecord& s : r.stops) {
-    const Eigen::Vector3d e = s.T_world_base.translation();
-    std::string err = "-";
-    if (s.T_world_base_true) {
-      err = Fixed((s.T_world_base_true->translation() - e).norm());
-    }
-    table.push_back({std::to_string(s.index), Fixed(s.stamp_s, 1), Fixed(e.x(), 2), Fixed(e.y(), 2),
-                     err, s.merge.merged ? mapping::ToString(s.merge.registration.path) : "failed",
-                     Fixed(s.merge.registration.rmse_m, 4), Fixed(s.distance_to_goal_m, 2),
-                     s.plan ? Fixed(s.plan->cost, 1) : (s.plan_error.empty() ? "-" : "none")});
-    char dir[32];
-    std::snprintf(dir, sizeof(dir), "stops/%03d/map.png", s.index);
-    strip.emplace_back(ReadBinaryFile(folder.File(dir)), "stop " + std::to_string(s.index));
-  }
-  report.Table({"stop", "t [s]", "x [m]", "y [m]", "error [m]", "registration", "rmse [m]",
-                "to goal [m]", "plan cost"},
-               table);
-  report.PngStrip(strip, kStripWidth_px);
-  report.Heading("Configuration");
-  report.Preformatted(c.config_yaml);
-  WriteTextFile(folder.File("report.html"), report.Render());
+  WriteRunReport(folder, c, r, metrics, layers);
 }
 
 }  // namespace pitchlab::apps

@@ -16,9 +16,6 @@
 
 namespace pitchlab::apps {
 
-/// The longer side of the run folder's map pictures [px].
-inline constexpr int kRunPictureMaxSide_px = 1400;
-
 /// Facts about the run that the mission itself does not hold.
 struct RunContext {
   std::string world, world_file, robot;
@@ -33,7 +30,7 @@ struct RunContext {
   double wall_time_s = 0;       ///< whole run including set-up [s]
 };
 
-/// Writes stops/NN/{scan.pcd, registration.json, path.csv, path.geojson, map.png}.
+/// Writes stops/NN/{scan.pcd, registration.json, path.csv, path.geojson, map.png, map_small.png}.
 /// Throws std::runtime_error naming the file on a write failure.
 void WriteStopOutputs(RunFolder& folder, const StopRecord& stop, const MissionResult& so_far,
                       const std::optional<mapping::GeodeticOrigin>& origin);
@@ -43,8 +40,8 @@ nlohmann::json RunMetrics(const RunContext& context, const MissionResult& result
                           const std::optional<RunScore>& score);
 
 /// Everything written at the end (see the file comment), report.html last. `truth` may be null
-/// (hardware runs), `truth_optimum` is the true optimal path when known. A hazard_errors.png the
-/// caller wrote (from the grids it scored) goes into the report.
+/// (hardware runs), `truth_optimum` is the true optimal path when known; with `truth` also
+/// hazard_errors.png (run_pictures.hpp).
 void WriteFinalOutputs(RunFolder& folder, const RunContext& context, const MissionResult& result,
                        const std::optional<RunScore>& score, const mapping::ElevationLayers* truth,
                        const std::optional<planning::Path>& truth_optimum);

@@ -11,10 +11,8 @@
 #include "pitchlab/mapping/elevation_io.hpp"
 
 namespace pitchlab::mapping {
-namespace {
 
-// Height ramp: deep blue, green, yellow-brown, white.
-std::array<double, 3> Ramp(double t) {
+std::array<double, 3> ElevationRamp(double t) {
   static constexpr double kStops[][4] = {{0.00, 40, 70, 160},
                                          {0.25, 60, 150, 90},
                                          {0.50, 170, 190, 90},
@@ -32,8 +30,7 @@ std::array<double, 3> Ramp(double t) {
   return {250, 250, 250};
 }
 
-// 2nd and 98th percentile of the observed heights.
-std::pair<double, double> HeightRange(const ElevationLayers& L) {
+std::pair<double, double> ElevationRampRange(const ElevationLayers& L) {
   std::vector<float> z;
   for (std::size_t k = 0; k < L.mean_z.size(); ++k)
     if (L.state[k] == CellState::kObserved) z.push_back(L.mean_z[k]);
@@ -46,6 +43,8 @@ std::pair<double, double> HeightRange(const ElevationLayers& L) {
   const double lo = at(0.02), hi = at(0.98);
   return {lo, hi > lo ? hi : lo + 1.0};
 }
+
+namespace {
 
 // Hillshade in [0, 1] of cell (i, j) from central differences of known neighbours (Horn-like).
 double Hillshade(const ElevationLayers& L, int i, int j, const ImageOptions& o) {
@@ -86,14 +85,14 @@ RgbImage RenderElevationImage(const ElevationLayers& L, const ImageOptions& o) {
   img.width = g.size_x * ppc;
   img.height = g.size_y * ppc;
   img.rgb.assign(static_cast<std::size_t>(img.width) * img.height * 3, 0);
-  const auto [lo, hi] = HeightRange(L);
+  const auto [lo, hi] = ElevationRampRange(L);
   for (int j = 0; j < g.size_y; ++j) {
     for (int i = 0; i < g.size_x; ++i) {
       const std::size_t k = g.Linear({i, j});
       std::array<double, 3> c;
       if (L.state[k] == CellState::kObserved) {
         const double shade = 0.35 + 0.65 * Hillshade(L, i, j, o);
-        c = Ramp((L.mean_z[k] - lo) / (hi - lo));
+        c = ElevationRamp((L.mean_z[k] - lo) / (hi - lo));
         for (double& v : c) v *= shade;
       } else if (L.state[k] == CellState::kDrop) {
         c = {220, 0, 220};

@@ -15,8 +15,10 @@
 //   uint64       FNV-1a 64 hash of every byte before it
 // Files are written to a temporary name and renamed: a failure leaves no partial file.
 
+#include <array>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pitchlab/mapping/elevation_layers.hpp"
@@ -62,6 +64,12 @@ struct ImageOptions {
   double z_exaggeration = 1.0;   ///< hillshade vertical exaggeration [1]
 };
 
+/// RenderElevationImage's colour [0-255] of relative height t (0 low, 1 high, clamped) before
+/// hillshade: deep blue, green, yellow-brown, white. Exposed for colour bars.
+std::array<double, 3> ElevationRamp(double t);
+/// The heights [m] RenderElevationImage maps to the ramp's ends: the 2nd and 98th percentile of
+/// the observed cells' mean heights (0 and 1 for an empty map; hi > lo always).
+std::pair<double, double> ElevationRampRange(const ElevationLayers& layers);
 /// Colour by mean height (2nd-98th percentile, blue-green-brown-white ramp) times a hillshade;
 /// unknown cells a grey checkerboard, drops magenta.
 RgbImage RenderElevationImage(const ElevationLayers& layers, const ImageOptions& options = {});
