@@ -126,11 +126,12 @@ cleanup() {
 trap cleanup EXIT
 trap 'exit 130' INT TERM HUP  # through cleanup
 
-# Waits up to $1 s for the command after it to succeed.
+# Waits up to $1 s (wall clock: one try of a Slurm command can itself take seconds) for the
+# command after it to succeed.
 wait_for() {
-  local limit=$1 i
+  local deadline=$((SECONDS + $1))
   shift
-  for ((i = 0; i < limit * 5; i++)); do
+  while [ $SECONDS -lt $deadline ]; do
     "$@" >/dev/null 2>&1 && return 0
     sleep 0.2
   done
@@ -138,10 +139,10 @@ wait_for() {
 }
 
 port_busy() { (exec 3<>"/dev/tcp/127.0.0.1/$1") 2>/dev/null; }
-# The wanted port when nothing listens on it, else a free one from the ephemeral-free range.
+# The wanted port when nothing listens on it, else (or for 0) a free one below the ephemeral range.
 pick_port() {
   local port=$1 avoid=$2 i
-  if ! port_busy "$port" && [ "$port" != "$avoid" ]; then
+  if [ "$port" != 0 ] && ! port_busy "$port" && [ "$port" != "$avoid" ]; then
     echo "$port"
     return
   fi
@@ -180,7 +181,8 @@ memory=$(slurmd -C | sed -n 's/.*RealMemory=\([0-9]*\).*/\1/p')
 cpus=$(nproc)
 
 export SLURM_CONF=$sdir/slurm.conf  # every Slurm command of this test reads this config
-cat >"$SLURM_CONF" <<CONF
+write_conf() {
+  cat >"$SLURM_CONF" <<CONF
 # A one-node cluster for scripts/test-slurm.sh, private to $tmp.
 ClusterName=pitchlabtest
 SlurmctldHost=localhost
@@ -220,17 +222,46 @@ SlurmdTimeout=30
 NodeName=localhost NodeAddr=127.0.0.1 CPUs=$cpus RealMemory=$memory State=UNKNOWN
 PartitionName=test Nodes=localhost Default=YES MaxTime=INFINITE State=UP
 CONF
-chmod 0644 "$SLURM_CONF"
+  chmod 0644 "$SLURM_CONF"
+}
 
-say "starting munged, slurmctld (port $ctld_port), slurmd (port $slurmd_port) in $tmp"
-env "$marker" slurmctld -c -D >"$sdir/log/slurmctld.stderr" 2>&1 &
-slurmctld_pid=$!
-wait_for 30 scontrol ping || fail "slurmctld does not answer (see $sdir/log/slurmctld.log)"
-env "$marker" slurmd -D -N localhost >"$sdir/log/slurmd.stderr" 2>&1 &
-slurmd_pid=$!
+# Starts slurmctld and slurmd on the chosen ports; 1 when one of them died at once (most
+# likely a port taken between our check and its bind, e.g. by a parallel CI job).
+start_slurm() {
+  write_conf
+  say "starting slurmctld (port $ctld_port) and slurmd (port $slurmd_port) in $tmp"
+  env "$marker" slurmctld -c -D >"$sdir/log/slurmctld.stderr" 2>&1 &
+  slurmctld_pid=$!
+  wait_for 30 dead_or "$slurmctld_pid" scontrol ping || true
+  kill -0 "$slurmctld_pid" 2>/dev/null || return 1
+  scontrol ping >/dev/null 2>&1 || fail "slurmctld does not answer (see $sdir/log/slurmctld.log)"
+  env "$marker" slurmd -D -N localhost >"$sdir/log/slurmd.stderr" 2>&1 &
+  slurmd_pid=$!
+  wait_for 60 dead_or "$slurmd_pid" node_idle || true
+  kill -0 "$slurmd_pid" 2>/dev/null || return 1
+  node_idle ||
+    fail "node localhost is not idle: $(sinfo -h -N -o '%N %T %E' 2>&1) (see $sdir/log/slurmd.log)"
+}
 node_idle() { [ "$(sinfo -h -n localhost -o %T)" = idle ]; }
-wait_for 60 node_idle ||
-  fail "node localhost is not idle: $(sinfo -h -N -o '%N %T %E' 2>&1) (see $sdir/log/slurmd.log)"
+# Succeeds when the pid has ended or the command after it succeeds: a daemon that died at start
+# ends the wait at once instead of after the whole timeout.
+dead_or() {
+  local pid=$1
+  shift
+  kill -0 "$pid" 2>/dev/null || return 0
+  "$@"
+}
+
+for attempt in 1 2 3; do
+  start_slurm && break
+  [ $attempt -lt 3 ] || fail "Slurm did not start: $(tail -q -n 3 "$sdir"/log/*.stderr)"
+  say "a daemon died at start ($(tail -q -n 1 "$sdir"/log/*.stderr | tr '\n' ' ')); other ports"
+  stop_pid "$slurmd_pid" 15
+  stop_pid "$slurmctld_pid" 15
+  slurmd_pid="" slurmctld_pid=""
+  ctld_port=$(pick_port 0 "")
+  slurmd_port=$(pick_port 0 "$ctld_port")
+done
 say "one-node Slurm up in $((SECONDS - started_at)) s: $cpus CPU(s)"
 
 # ---- the sweep on Slurm, then the same sweep here --------------------------------------------------
@@ -242,8 +273,11 @@ local_dir=$tmp/local
 
 t0=$SECONDS
 status=0
+# Long commands run in the background with `wait`: bash runs a trap only once the foreground
+# command ends, but interrupts `wait` at once, so a stopped test cleans up without delay.
 env "$marker" PITCHLAB="$pitchlab" timeout 600 bash "$repo/scripts/slurm/submit.sh" \
-  --out "$cluster" --shards 4 --wait -- "${sweep[@]}" || status=$?
+  --out "$cluster" --shards 4 --wait -- "${sweep[@]}" &
+wait $! || status=$?
 say "Slurm sweep took $((SECONDS - t0)) s"
 [ $status -eq 0 ] || fail "submit.sh --wait exited $status (the merge job failed or never ran)"
 
@@ -264,8 +298,10 @@ grep -q "merging 4 shards" "$summary_out" || fail "the merge job did not merge: 
 [ -f "$cluster/summary.json" ] || fail "the merge job wrote no $cluster/summary.json"
 
 t0=$SECONDS
-timeout 600 "$pitchlab" bench "${sweep[@]}" --jobs "$cpus" --quiet --out "$local_dir" >/dev/null ||
-  fail "the local sweep exited $? (124: over 600 s)"
+env "$marker" timeout 600 "$pitchlab" bench "${sweep[@]}" --jobs "$cpus" --quiet \
+  --out "$local_dir" >/dev/null &
+wait $! || status=$?
+[ $status -eq 0 ] || fail "the local sweep exited $status (124: over 600 s)"
 say "local sweep took $((SECONDS - t0)) s"
 
 # ---- merged == local, run by run --------------------------------------------------------------------
