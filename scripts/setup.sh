@@ -8,6 +8,7 @@ packages=(
   libyaml-cpp-dev libexpected-dev libpng-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libboost-graph-dev
   libjs-three chromium
+  slurmctld slurmd slurm-client munge
 )
 
 missing=()
