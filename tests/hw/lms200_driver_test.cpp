@@ -48,7 +48,9 @@ class Lms200DriverTest : public ::testing::Test {
     Lms200DriverConfig c;
     c.device = emulator_.path();
     c.lms.baud = 38400;
-    c.reply_timeout_ms = 300;
+    // The driver's default: a loaded 2-core machine has stalled the emulator's reply past two
+    // 300 ms waits at 9600 baud (fresh-clone test run, all rates unanswered).
+    c.reply_timeout_ms = Lms200DriverConfig{}.reply_timeout_ms;
     return c;
   }
   Lms200Emulator emulator_{Lms200EmulatorConfig{}};
