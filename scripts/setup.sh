@@ -7,6 +7,7 @@ packages=(
   libeigen3-dev libmujoco-dev libembree-dev libpcl-dev libgeographiclib-dev
   libyaml-cpp-dev libexpected-dev libpng-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libboost-graph-dev
+  clang libclang-rt-dev valgrind  # the hw libFuzzer targets in CTest; scripts/sanitize.sh
 )
 
 missing=()
