@@ -144,16 +144,6 @@ Result<Eigen::Isometry3d> Simulation::PlaceRobot(double x_m, double y_m, double 
                       Xy(samples[i].x(), samples[i].y()) + " in " + world_.path);
     }
     ground_max = std::max(ground_max, ground[i]);
-    if (any_terrain) continue;
-    // More than a step above what lies under it: an object's top the robot could not have driven
-    // onto (a bridge would count too; the built-in worlds have none).
-    if (const double height = HeightAboveSurfaceBelow(s.m, s.d, samples[i], from_z, groups);
-        height > config.max_step_m) {
-      return Fail(Error::Code::kInvalidArgument,
-                  "start " + Xy(x_m, y_m) + " is on top of an obstacle, not on the ground: at " +
-                      Xy(samples[i].x(), samples[i].y()) + " the surface is " +
-                      std::to_string(height) + " m above the ground under it (a roof, a table)");
-    }
   }
 
   // 1b. The footprint must rest on one surface: samples may deviate from their best-fit plane by
@@ -169,6 +159,18 @@ Result<Eigen::Isometry3d> Simulation::PlaceRobot(double x_m, double y_m, double 
   // 2. Nothing may stand in the robot's volume above the ground (upward rays from step height).
   const double envelope_m =
       robot_.mount.t_base_mount_m.z() + robot_.mount.t_mount_laser_m.norm() + 0.1;
+  // 2a. Without terrain geoms, the first surface from above may be an object's top: one higher
+  // above the ground under it than the robot is tall (a roof, a table, a car) is no start; a
+  // lower one (a ramp, a platform) the robot could have driven onto.
+  for (std::size_t i = 0; i < samples.size() && !any_terrain; ++i) {
+    if (const double height = HeightAboveSurfaceBelow(s.m, s.d, samples[i], from_z, groups);
+        height > envelope_m) {
+      return Fail(Error::Code::kInvalidArgument,
+                  "start " + Xy(x_m, y_m) + " is on top of an obstacle, not on the ground: at " +
+                      Xy(samples[i].x(), samples[i].y()) + " the surface is " +
+                      std::to_string(height) + " m above the ground under it (a roof, a table)");
+    }
+  }
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const mjtNum pnt[3] = {samples[i].x(), samples[i].y(), ground[i] + config.max_step_m};
     const mjtNum up[3] = {0, 0, 1};
