@@ -129,10 +129,14 @@ std::string NothingInserted(const mapping::InsertStats& s, std::size_t points) {
          std::to_string(s.non_finite) + " without a finite position";
 }
 
-// The point farthest from the sensor that saw it, the one that stretches the clouds' extent: named
-// so a user can find the stray point (or the cloud in other units) instead of a cell count.
-std::string FarthestPoint(const std::vector<LoadedCloud>& clouds,
-                          const std::vector<std::string>& paths) {
+// The LMS200's longest range, cm mode's 8191 counts of 1 cm (DESIGN.md): a point farther from the
+// sensor that saw it is not a return, and it is what stretches a map past its size [m].
+constexpr double kLms200MaxRange_m = 81.91;
+
+// The point farthest from the sensor that saw it when that is beyond any LMS200 return (named, so a
+// user can find the stray point or the cloud in other units); empty when every point is in range.
+std::string StrayPoint(const std::vector<LoadedCloud>& clouds,
+                       const std::vector<std::string>& paths) {
   double farthest = -1;
   std::size_t cloud = 0, index = 0;
   for (std::size_t c = 0; c < clouds.size(); ++c) {
@@ -141,13 +145,13 @@ std::string FarthestPoint(const std::vector<LoadedCloud>& clouds,
       if (d > farthest) farthest = d, cloud = c, index = i;
     }
   }
-  if (farthest < 0) return "the clouds hold no points";
+  if (farthest <= kLms200MaxRange_m) return "";
   const Eigen::Vector3f& p = clouds[cloud].points[index];
   char text[320];
   std::snprintf(text, sizeof(text),
                 "the farthest point, %zu of '%s' at (%.6g, %.6g, %.6g) m, lies %.6g m from its "
-                "sensor (an LMS200 reaches 81.91 m): crop the clouds or give --area",
-                index, paths[cloud].c_str(), p.x(), p.y(), p.z(), farthest);
+                "sensor (an LMS200 reaches %.2f m): crop the clouds or give --area",
+                index, paths[cloud].c_str(), p.x(), p.y(), p.z(), farthest, kLms200MaxRange_m);
   return text;
 }
 
@@ -263,14 +267,25 @@ int RunMap(int argc, char** argv) {
     if (total_points == 0) throw std::runtime_error("the clouds hold no points; give --area");
     try {
       geometry = mapping::GridGeometry::Covering(lo, hi, cell, margin);
-    } catch (const std::invalid_argument& e) {
-      throw std::runtime_error(std::string(e.what()) + "; " +
-                               FarthestPoint(clouds, args.positionals()));
+    } catch (const std::invalid_argument&) {  // more than 2^31 cells
+      char extent[160];
+      std::snprintf(extent, sizeof(extent),
+                    "the clouds span %.6g x %.6g m: at --cell %g that is more cells than a map "
+                    "holds (2^31); ",
+                    hi.x() - lo.x(), hi.y() - lo.y(), cell);
+      const std::string stray = StrayPoint(clouds, args.positionals());
+      throw std::runtime_error(extent +
+                               (stray.empty() ? "give a coarser --cell or a smaller --area" : stray));
+    }
+    // A cloud from another scanner, or a merged map, may mean it: a warning, not an error.
+    if (const std::string stray = StrayPoint(clouds, args.positionals()); !stray.empty()) {
+      std::fprintf(stderr, "warning: %s\n", stray.c_str());
     }
   }
   if (const std::string too_big = MemoryShortfall(geometry); !too_big.empty()) {
-    throw std::runtime_error(too_big + (args.Has("area") ? "give a smaller --area"
-                                                         : FarthestPoint(clouds, args.positionals())));
+    const std::string stray = args.Has("area") ? "" : StrayPoint(clouds, args.positionals());
+    throw std::runtime_error(too_big +
+                             (stray.empty() ? "give a coarser --cell or a smaller --area" : stray));
   }
 
   // The world, when given: its geodetic origin and its true surface.

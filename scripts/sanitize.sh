@@ -4,6 +4,7 @@
 # the normal build and tests again. Any report fails the run (halt_on_error, no UB recovery).
 #   bash scripts/sanitize.sh                 # every test
 #   bash scripts/sanitize.sh -R 'ScanPcd'    # extra arguments go to ctest
+#   TARGETS="sensors_test pitchlab" bash scripts/sanitize.sh -R 'Pcd|BadInput'   # build only these
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -11,7 +12,8 @@ flags="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-fr
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_C_FLAGS="$flags" -DCMAKE_CXX_FLAGS="$flags" \
   -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined"
-cmake --build build-asan -j"$(nproc)"
+# shellcheck disable=SC2086  # TARGETS is a list of words
+cmake --build build-asan -j"$(nproc)" ${TARGETS:+--target $TARGETS}
 # Leaks: the libraries' process-lifetime singletons (TBB's, VTK's through PCL) are listed in
 # scripts/lsan.supp, each with why; anything else is ours and fails.
 export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:abort_on_error=0:strict_string_checks=1"

@@ -206,6 +206,26 @@ TEST_F(BadInputCli, AnAbsurdPointIsNamedAndPclSaysNothingFirst) {
   EXPECT_EQ(Left({"far.pcd", "bad.pcd"}), std::vector<std::string>{});
 }
 
+TEST_F(BadInputCli, AMapTooBigForAMapSaysWhetherAStrayPointOrTheCellIsTheCause) {
+  std::vector<std::string> points = Floor();
+  Pcd("floor.pcd", points);
+  points.push_back("90000 5 0");  // 90 km out: finite, within the reader's 100 km, no return
+  Pcd("stray.pcd", points);
+  CliResult r = Exec("map " + (dir_ / "stray.pcd").string() + " --no-level --cell 0.01 --out " +
+                     Out("m"));
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("the farthest point, " + std::to_string(points.size() - 1) + " of '" +
+                       (dir_ / "stray.pcd").string() + "' at (90000, 5, 0) m"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("coarser"), std::string::npos) << r.err;  // the cell is not the cause
+  r = Exec("map " + (dir_ / "floor.pcd").string() + " --no-level --cell 0.00001 --out " +
+           Out("m"));
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("give a coarser --cell or a smaller --area"), std::string::npos) << r.err;
+  EXPECT_EQ(Left({"floor.pcd", "stray.pcd"}), std::vector<std::string>{});
+}
+
 TEST_F(BadInputCli, ADuplicateConfigKeyIsAnErrorNamingIt) {
   std::ofstream(dir_ / "dup.yaml") << "lms200:\n  noise_sigma_m: 0.01\n  noise_sigma_m: 0.5\n";
   const CliResult r = Exec("scan --world office --config " + (dir_ / "dup.yaml").string() +
