@@ -351,6 +351,13 @@ pid_t StartRun(const SweepSettings& s, const BenchRun& run) {
     ::dup2(null, 0);
     ::dup2(fd, 1);
     ::dup2(fd, 2);
+    // The bench blocks SIGINT / SIGTERM for its watcher thread; a run starts with them open (a
+    // hardware run's own handlers rely on it).
+    sigset_t interrupts;
+    sigemptyset(&interrupts);
+    sigaddset(&interrupts, SIGINT);
+    sigaddset(&interrupts, SIGTERM);
+    ::sigprocmask(SIG_UNBLOCK, &interrupts, nullptr);
     ::execv("/proc/self/exe", argv.data());
     static const char kMessage[] = "bench: cannot exec /proc/self/exe\n";
     [[maybe_unused]] const ssize_t ignored = ::write(2, kMessage, sizeof(kMessage) - 1);
