@@ -43,6 +43,7 @@ Result<PcdHeader> PeekPcdHeader(const std::string& path) {
   if (!in) return Fail(Error::Code::kNotFound, "cannot read PCD '" + path + "'");
   PcdHeader h;
   std::vector<double> sizes, counts;
+  std::size_t fields = 0, types = 0;
   std::optional<double> width, height, points;
   for (std::string line; std::getline(in, line);) {
     const std::vector<std::string_view> f = SplitFields(line);
@@ -50,6 +51,15 @@ Result<PcdHeader> PeekPcdHeader(const std::string& path) {
     const std::optional<std::vector<double>> v = Numbers(f);
     if (f[0] == "DATA") {
       if (f.size() < 2) break;
+      // What PCL's readHeader would only print about before failing: say it in the error.
+      for (const auto& [what, n] : {std::pair{"SIZE", sizes.size()}, {"TYPE", types == 0 ? fields : types},
+                                    {"COUNT", counts.empty() ? fields : counts.size()}}) {
+        if (n != fields) {
+          return Fail(Error::Code::kInvalidArgument,
+                      "PCD '" + path + "': " + what + " has " + std::to_string(n) +
+                          " entries for " + std::to_string(fields) + " FIELDS");
+        }
+      }
       h.data = f[1] == "binary"              ? PcdData::kBinary
                : f[1] == "binary_compressed" ? PcdData::kBinaryCompressed
                                              : PcdData::kAscii;
@@ -80,6 +90,8 @@ Result<PcdHeader> PeekPcdHeader(const std::string& path) {
       return Fail(Error::Code::kInvalidArgument,
                   "PCD '" + path + "': '" + line + "' is not a count of points");
     }
+    if (f[0] == "FIELDS") fields = f.size() - 1;
+    if (f[0] == "TYPE") types = f.size() - 1;
     if (f[0] == "SIZE" && v) sizes = *v;
     if (f[0] == "COUNT" && v) counts = *v;
   }
