@@ -19,6 +19,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -32,6 +33,7 @@
 #include "app_config.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
+#include "interrupt.hpp"
 #include "pitchlab/worlds/world_catalog.hpp"
 #include "run_config.hpp"
 #include "run_folder.hpp"
@@ -45,6 +47,9 @@ using Clock = std::chrono::steady_clock;
 using json = nlohmann::ordered_json;  // records keep their field order
 
 constexpr auto kPollPeriod = std::chrono::milliseconds(20);
+// How long an interrupted bench waits for its runs to remove their staging folders (a run's is at
+// most ~8 MB: well under a second) before it kills them and removes the folders itself.
+constexpr auto kChildCleanup = std::chrono::seconds(10);
 constexpr std::size_t kMaxReasonChars = 300;
 
 /// One world of the sweep: `label` names its runs and summary row ("office", "yard" for yard.xml).
@@ -73,6 +78,8 @@ struct SweepSettings {
   int jobs = 1;
   double timeout_s = 600.0;
   std::optional<fs::path> config;
+  /// ConfigHash of the config's bytes, recorded per run: a resumed sweep must use the same one.
+  std::string config_hash;
 };
 
 /// A child process running one `pitchlab run`.
@@ -89,7 +96,8 @@ CliArgs BenchArgs() {
       "A sweep of closed-loop runs: every world x every seed, each run isolated in its\n"
       "own process and run folder (DIR/runs/<world>-s<seed>). One JSON line per run is\n"
       "appended to DIR/runs.jsonl as it ends; runs already recorded there are skipped, so\n"
-      "a killed sweep resumes. A summary per world is printed and written to\n"
+      "a killed sweep resumes (with the same --config: each line records its config_hash,\n"
+      "and a sweep with another is refused). A summary per world is printed and written to\n"
       "DIR/summary.json. With --shard K/N only runs whose index % N == K-1 are run, e.g.\n"
       "--shard $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT; merge the shards' folders\n"
       "with --summarize DIR1 DIR2 ... . Exit 0 when every run of the shard is recorded\n"
@@ -127,31 +135,23 @@ std::vector<std::string> SplitList(const std::string& text, const std::string& o
   return items;
 }
 
-std::uint64_t ParseCount(const std::string& text, const std::string& what) {
-  if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos ||
-      text.size() > 18) {
-    throw CliError(what + " '" + text + "' is not a whole number >= 0");
-  }
-  return std::stoull(text);
-}
-
 /// "1..20", "1,5,9", "1..3,7" -> the seeds in the order given; empty ranges and repeats are errors.
 std::vector<std::uint64_t> ParseSeeds(const std::string& text) {
   std::vector<std::uint64_t> seeds;
   for (const std::string& item : SplitList(text, "seeds")) {
     const auto dots = item.find("..");
     if (dots == std::string::npos) {
-      seeds.push_back(ParseCount(item, "seed"));
+      seeds.push_back(ParseWholeNumber(item, "seed"));
       continue;
     }
-    const std::uint64_t first = ParseCount(item.substr(0, dots), "seed");
-    const std::uint64_t last = ParseCount(item.substr(dots + 2), "seed");
+    const std::uint64_t first = ParseWholeNumber(item.substr(0, dots), "seed");
+    const std::uint64_t last = ParseWholeNumber(item.substr(dots + 2), "seed");
     if (last < first) {
       throw CliError("--seeds range '" + item + "' is empty: write the smaller seed first (" +
                      std::to_string(last) + ".." + std::to_string(first) + ")");
     }
     if (last - first >= 1000000) throw CliError("--seeds range '" + item + "' is too long");
-    for (std::uint64_t s = first; s <= last; ++s) seeds.push_back(s);
+    for (std::uint64_t i = 0; i <= last - first; ++i) seeds.push_back(first + i);
   }
   std::set<std::uint64_t> seen;
   for (std::uint64_t s : seeds) {
@@ -187,8 +187,8 @@ Shard ParseShard(const std::string& text) {
   const auto slash = text.find('/');
   if (slash == std::string::npos) throw CliError("--shard '" + text + "' is not K/N (e.g. 1/4)");
   Shard s;
-  const std::uint64_t k = ParseCount(text.substr(0, slash), "--shard K");
-  const std::uint64_t n = ParseCount(text.substr(slash + 1), "--shard N");
+  const std::uint64_t k = ParseWholeNumber(text.substr(0, slash), "--shard K");
+  const std::uint64_t n = ParseWholeNumber(text.substr(slash + 1), "--shard N");
   if (n < 1 || n > 1000000 || k < 1 || k > n) {
     throw CliError("--shard " + text + ": need 1 <= K <= N (K is 1-based, like " +
                    "$SLURM_ARRAY_TASK_ID with --array=1-N)");
@@ -196,6 +196,17 @@ Shard ParseShard(const std::string& text) {
   s.k = static_cast<int>(k);
   s.n = static_cast<int>(n);
   return s;
+}
+
+/// FNV-1a (64 bits) of a config file's bytes as 16 hex digits; "built-in-defaults" without one.
+/// Identifies the configuration a run was made with (a file edited in place changes it).
+std::string ConfigHash(const std::string& bytes) {
+  if (bytes.empty()) return "built-in-defaults";
+  std::uint64_t h = 0xcbf29ce484222325ULL;  // FNV offset basis
+  for (unsigned char c : bytes) h = (h ^ c) * 0x100000001b3ULL;  // FNV prime
+  char text[17];
+  std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(h));
+  return text;
 }
 
 /// Loads the config the way `pitchlab run` will, so a bad file fails before any run.
@@ -213,11 +224,13 @@ SweepSettings ParseSweepSettings(const CliArgs& args) {
   SweepSettings s;
   s.out = args.Get("out");
   s.shard = ParseShard(args.Get("shard"));
-  s.jobs = static_cast<int>(ParseCount(args.Get("jobs"), "--jobs"));
-  if (s.jobs < 1 || s.jobs > 1024) throw CliError("--jobs must be 1..1024");
+  const std::uint64_t jobs = ParseWholeNumber(args.Get("jobs"), "--jobs");
+  if (jobs < 1 || jobs > 1024) throw CliError("--jobs must be 1..1024");
+  s.jobs = static_cast<int>(jobs);
   s.timeout_s = args.GetNumbers("timeout-s", 1)[0];
   if (!(s.timeout_s > 0)) throw CliError("--timeout-s must be positive");
   if (args.Has("config")) s.config = CheckConfig(args.Get("config"));
+  s.config_hash = ConfigHash(s.config ? ReadBinaryFile(*s.config) : std::string());
   return s;
 }
 
@@ -338,6 +351,13 @@ pid_t StartRun(const SweepSettings& s, const BenchRun& run) {
     ::dup2(null, 0);
     ::dup2(fd, 1);
     ::dup2(fd, 2);
+    // The bench blocks SIGINT / SIGTERM for its watcher thread; a run starts with them open (a
+    // hardware run's own handlers rely on it).
+    sigset_t interrupts;
+    sigemptyset(&interrupts);
+    sigaddset(&interrupts, SIGINT);
+    sigaddset(&interrupts, SIGTERM);
+    ::sigprocmask(SIG_UNBLOCK, &interrupts, nullptr);
     ::execv("/proc/self/exe", argv.data());
     static const char kMessage[] = "bench: cannot exec /proc/self/exe\n";
     [[maybe_unused]] const ssize_t ignored = ::write(2, kMessage, sizeof(kMessage) - 1);
@@ -378,6 +398,7 @@ json MakeRecord(const SweepSettings& s, const BenchRun& run, std::optional<int> 
             {"seed", run.seed},
             {"index", run.index},
             {"shard", s.shard.Text()},
+            {"config_hash", s.config_hash},
             {"exit_code", exit_code ? json(*exit_code) : json()},
             {"signal", signal ? json(*signal) : json()},
             {"wall_time_s", wall_s},
@@ -473,10 +494,41 @@ json RecoveredRecord(const SweepSettings& s, const BenchRun& run) {
   return r;
 }
 
+/// On SIGINT / SIGTERM: passes the signal on to the running runs (each removes its own staging
+/// folder), waits up to kChildCleanup for them, kills what is left, removes their staging folders.
+/// True when runs were stopped.
+bool StopRuns(const SweepSettings& s, std::vector<Running>& running, int signal) {
+  for (const Running& r : running) ::kill(r.pid, signal);
+  const auto deadline = Clock::now() + kChildCleanup;
+  for (const Running& r : running) {
+    while (::waitpid(r.pid, nullptr, WNOHANG) == 0) {
+      if (Clock::now() > deadline) {
+        ::kill(r.pid, SIGKILL);
+        ::waitpid(r.pid, nullptr, 0);
+        break;
+      }
+      std::this_thread::sleep_for(kPollPeriod);
+    }
+    RemoveStaging(s.out, r.run);
+  }
+  return !running.empty();
+}
+
 /// Runs `pending` with at most `jobs` at once, appending each record to the log as it ends.
 void RunSweep(const SweepSettings& s, const std::vector<BenchRun>& pending, RecordLog& log,
               bool quiet) {
   std::vector<Running> running;
+  std::mutex running_mutex;  // the interruption's watcher thread reads `running`
+  const int cleanup = RegisterCleanup(
+      [&](int signal) {
+        std::lock_guard<std::mutex> lock(running_mutex);
+        return StopRuns(s, running, signal);
+      },
+      "the unfinished runs' folders (their logs stay in " + (s.out / "logs").string() + ")");
+  struct Unregister {
+    int id;
+    ~Unregister() { UnregisterCleanup(id); }
+  } unregister{cleanup};
   std::size_t next = 0, done = 0;
   const auto finish = [&](const json& record) {
     log.Append(record);
@@ -495,9 +547,11 @@ void RunSweep(const SweepSettings& s, const std::vector<BenchRun>& pending, Reco
         std::fprintf(stderr, "bench: start %s seed %llu (%zu of %zu)\n", run.world.label.c_str(),
                      static_cast<unsigned long long>(run.seed), next, pending.size());
       }
+      std::lock_guard<std::mutex> lock(running_mutex);
       running.push_back({run, StartRun(s, run), Clock::now(), false});
     }
     bool reaped = false;
+    std::unique_lock<std::mutex> lock(running_mutex);
     for (auto it = running.begin(); it != running.end();) {
       if (std::optional<json> record = Poll(s, *it)) {
         finish(*record);
@@ -507,7 +561,9 @@ void RunSweep(const SweepSettings& s, const std::vector<BenchRun>& pending, Reco
         ++it;
       }
     }
-    if (!reaped && !running.empty()) std::this_thread::sleep_for(kPollPeriod);
+    const bool idle = !reaped && !running.empty();
+    lock.unlock();
+    if (idle) std::this_thread::sleep_for(kPollPeriod);
   }
 }
 
@@ -671,7 +727,28 @@ int SummarizeFolders(const CliArgs& args) {
   return 0;
 }
 
+/// A resumed sweep reuses the runs already recorded: they must have been made with this config.
+/// Records from before config_hash was recorded say nothing and are taken as they are.
+void CheckSameConfig(const SweepSettings& s, const std::vector<json>& records) {
+  std::map<std::string, std::vector<std::string>> other;  // hash -> run ids
+  for (const json& r : records) {
+    const std::string hash = r.value("config_hash", std::string());
+    if (!hash.empty() && hash != s.config_hash) other[hash].push_back(RecordKey(r));
+  }
+  if (other.empty()) return;
+  std::string made_with;
+  for (const auto& [hash, ids] : other) {
+    made_with += (made_with.empty() ? "" : "; ") + hash + ": " + ids.front() +
+                 (ids.size() > 1 ? " and " + std::to_string(ids.size() - 1) + " more" : "");
+  }
+  throw CliError("bench folder '" + s.out.string() + "' holds runs made with another config (" +
+                 made_with + "); this sweep's is " + s.config_hash + " (" +
+                 (s.config ? "--config " + s.config->string() : std::string("no --config")) +
+                 "): resuming would mix them; give a new --out, or the config they were made with");
+}
+
 int Sweep(const CliArgs& args) {
+  InstallInterruptCleanup("pitchlab bench");  // first: before any thread starts
   if (!args.positionals().empty()) {
     throw CliError("unexpected argument '" + args.positionals().front() +
                    "' (folders are for --summarize)");
@@ -686,7 +763,9 @@ int Sweep(const CliArgs& args) {
   fs::create_directories(s.out / "logs");
   const fs::path jsonl = s.out / "runs.jsonl";
   std::set<std::string> recorded;
-  for (const json& r : ReadRecords(jsonl)) recorded.insert(RecordKey(r));
+  const std::vector<json> records = ReadRecords(jsonl);
+  CheckSameConfig(s, records);
+  for (const json& r : records) recorded.insert(RecordKey(r));
   std::vector<BenchRun> pending;
   for (const BenchRun& run : shard) {
     if (!recorded.count(run.Id())) pending.push_back(run);

@@ -1,6 +1,8 @@
 #include "cli_args.hpp"
 
+#include <charconv>
 #include <cmath>
+#include <limits>
 #include <iostream>
 #include <sstream>
 
@@ -133,6 +135,37 @@ std::vector<double> CliArgs::GetNumbers(const std::string& name, std::size_t cou
                    " comma-separated numbers (" + specs_.at(name).metavar + ")");
   }
   return numbers;
+}
+
+double CliArgs::GetNumber(const std::string& name, double min, double max) const {
+  const std::string text = Get(name);
+  double v = 0;
+  if (std::isinf(max) && (text == "inf" || text == "Inf")) {
+    v = max;
+  } else {
+    v = GetNumbers(name, 1)[0];
+  }
+  if (!(v >= min && v <= max)) {
+    std::ostringstream range;
+    range << min << " .. " << max;
+    throw CliError("--" + name + " '" + text + "' is out of range (" + range.str() + ")");
+  }
+  return v;
+}
+
+std::uint64_t CliArgs::GetWholeNumber(const std::string& name) const {
+  return ParseWholeNumber(Get(name), "--" + name);
+}
+
+std::uint64_t ParseWholeNumber(const std::string& text, const std::string& what) {
+  std::uint64_t value = 0;
+  const char* end = text.data() + text.size();
+  const auto [stop, error] = std::from_chars(text.data(), end, value);
+  if (text.empty() || text.front() == '-' || error != std::errc() || stop != end) {
+    throw CliError(what + " '" + text + "' is not a whole number 0 .. " +
+                   std::to_string(std::numeric_limits<std::uint64_t>::max()));
+  }
+  return value;
 }
 
 }  // namespace pitchlab::apps

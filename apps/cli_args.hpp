@@ -2,6 +2,7 @@
 // A small command-line parser for pitchlab's subcommands: `--name value`, `--flag`, positionals,
 // and a generated --help. Errors throw CliError with a message for the user.
 
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -39,6 +40,11 @@ class CliArgs {
 
   /// "1.5,-2,90" -> {1.5, -2, 90}; exactly `count` finite numbers or CliError naming the option.
   std::vector<double> GetNumbers(const std::string& name, std::size_t count) const;
+  /// One number within [min, max] (max may be infinite: then "inf" is accepted too), else
+  /// CliError naming the option, the value and the range.
+  double GetNumber(const std::string& name, double min, double max) const;
+  /// A whole number 0 .. 2^64-1 (a seed, a count), else CliError naming the option and the value.
+  std::uint64_t GetWholeNumber(const std::string& name) const;
 
  private:
   struct Spec {
@@ -54,5 +60,8 @@ class CliArgs {
   int positional_min_ = 0, positional_max_ = 0;
   std::vector<std::string> positionals_;
 };
+
+/// "42" -> 42 (0 .. 2^64-1, digits only), else CliError "<what> '<text>' is not a whole number".
+std::uint64_t ParseWholeNumber(const std::string& text, const std::string& what);
 
 }  // namespace pitchlab::apps

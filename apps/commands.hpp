@@ -25,4 +25,10 @@ int RunBench(int argc, char** argv);
 /// `pitchlab worlds`: the built-in worlds and their metadata.
 int RunWorlds(int argc, char** argv);
 
+/// pitchlab's version (CMake's project version), for `pitchlab --version`.
+const char* Version();
+/// Turns off the libraries' own console output (PCL's), so pitchlab's message is the first line
+/// a user reads; their failures still reach us as errors.
+void SilenceLibraryConsoles();
+
 }  // namespace pitchlab::apps

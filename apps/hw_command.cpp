@@ -216,8 +216,13 @@ int RunLms200(int argc, char** argv) {
   hw::Lms200DriverConfig config;
   config.device = args.Get("device");
   config.lms.baud = ParseBaud(args.Get("baud"));
-  config.lms.fov_deg = std::stod(args.Get("fov"));
-  config.lms.resolution_deg = std::stod(args.Get("resolution"));
+  config.lms.fov_deg = args.GetNumbers("fov", 1)[0];
+  config.lms.resolution_deg = args.GetNumbers("resolution", 1)[0];
+  try {  // a variant the LMS200 does not have is a command-line mistake: exit 2
+    config.lms.Validate();
+  } catch (const std::invalid_argument& e) {
+    throw CliError(std::string("--fov / --resolution: ") + e.what());
+  }
   const std::string units = args.Get("units");
   if (units != "cm" && units != "mm") throw CliError("--units '" + units + "' is not cm or mm");
   config.lms.range_mode =

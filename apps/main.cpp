@@ -3,11 +3,15 @@
 
 #include <cstring>
 #include <exception>
+#include <new>
+#include <stdexcept>
 #include <iostream>
 #include <string>
 
 #include "cli_args.hpp"
 #include "commands.hpp"
+#include "interrupt.hpp"
+#include "run_folder.hpp"
 
 namespace {
 
@@ -31,7 +35,8 @@ constexpr Command kCommands[] = {
 };
 
 void PrintUsage(std::ostream& os) {
-  os << "usage: pitchlab <command> [options]   (pitchlab <command> --help for its options)\n\n"
+  os << "usage: pitchlab <command> [options]   (pitchlab <command> --help for its options)\n"
+        "       pitchlab --version\n\n"
         "pitchlab: pitching-LMS200 3D mapping and elevation-map planning testbed\n\ncommands:\n";
   for (const Command& c : kCommands) os << "  " << c.name << "\t" << c.summary << "\n";
 }
@@ -39,19 +44,42 @@ void PrintUsage(std::ostream& os) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc >= 2 && !std::strcmp(argv[1], "--version")) {
+    std::cout << "pitchlab " << pitchlab::apps::Version() << "\n";
+    return 0;
+  }
+  // PCL prints its own diagnostics to stderr before ours reach the user; every PCL failure that
+  // matters comes back to us as an error we word ourselves.
+  pitchlab::apps::SilenceLibraryConsoles();
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
     PrintUsage(argc < 2 ? std::cerr : std::cout);
     return argc < 2 ? 2 : 0;
   }
   for (const Command& c : kCommands) {
     if (std::string(argv[1]) != c.name) continue;
+    // An interruption's cleanup may make the command fail (its folder removed under it): the
+    // watcher's exit status (130, 143) is the one that counts, so wait for it.
     try {
-      return c.run(argc - 2, argv + 2);
+      const int code = c.run(argc - 2, argv + 2);
+      pitchlab::apps::WaitIfInterrupted();
+      return code;
     } catch (const pitchlab::apps::CliError& e) {
+      pitchlab::apps::WaitIfInterrupted();
       std::cerr << "pitchlab " << c.name << ": " << e.what() << "\n";
       return 2;
+    } catch (const std::bad_alloc&) {
+      std::cerr << "pitchlab " << c.name << ": error: out of memory: an input or option asks "
+                << "for more than this machine has (a size in a file header, a cell too small "
+                << "for the area)\n";
+      return 1;
+    } catch (const std::length_error&) {  // std::vector's "vector::_M_default_append"
+      std::cerr << "pitchlab " << c.name << ": error: an input or option asks for a size no "
+                << "container can hold (a count in a file header, a cell too small for the area)\n";
+      return 1;
     } catch (const std::exception& e) {
-      std::cerr << "pitchlab " << c.name << ": error: " << e.what() << "\n";
+      pitchlab::apps::WaitIfInterrupted();
+      std::cerr << "pitchlab " << c.name << ": error: " << pitchlab::apps::WithFinalPaths(e.what())
+                << "\n";
       return 1;
     }
   }

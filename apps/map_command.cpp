@@ -1,16 +1,20 @@
 // `pitchlab map`: clouds (PCD) -> elevation map (Eq. 2, 3, inclination), written losslessly, as an
 // ESRI ASCII grid with its projection and as a PNG; with --world, scored against ground truth.
 
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 
 #include <nlohmann/json.hpp>
 
 #include "cli_args.hpp"
 #include "cloud_input.hpp"
 #include "commands.hpp"
+#include "interrupt.hpp"
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/elevation_map.hpp"
@@ -20,6 +24,9 @@
 #include "pitchlab/sensors/scan_pcd.hpp"
 #include "pitchlab/sim/simulation.hpp"
 #include "pitchlab/worlds/world_catalog.hpp"
+#include "output_paths.hpp"
+#include "progress.hpp"
+#include "output_paths.hpp"
 #include "run_folder.hpp"
 #include "world_paths.hpp"
 
@@ -57,7 +64,7 @@ CliArgs MapArgs() {
   args.Positionals("CLOUD", "one or more clouds, any format below", 1, 1000)
       .Option("sensor-origin", "x,y,z", kSensorOriginHelp)
       .Option("cell", "METRES", "cell size [m]", "0.1")
-      .Option("out", "DIR", "output folder (created)")
+      .Option("out", "DIR", "output folder to create (refused when it exists, as run refuses)")
       .Option("area", "xmin,ymin,xmax,ymax", "map area [m] (default: the clouds' extent)")
       .Option("margin", "METRES", "added around the clouds' extent [m]", "0.5")
       .Option("world", "NAME|FILE.xml",
@@ -72,13 +79,16 @@ CliArgs MapArgs() {
               "'inf' disables",
               "1.0")
       .Flag("no-level", "keep the clouds' frame; do not level it by the first cloud's floor")
-      .Flag("json", "print the summary as JSON on stdout");
+      .Flag("json", "print the summary as JSON on stdout")
+      .Flag("quiet", "no progress on stderr");
   return args;
 }
 
 struct LoadedCloud {
   std::vector<Eigen::Vector3f> points;  // world frame
   Eigen::Vector3f sensor_origin;        // approximate laser position in the world
+  std::size_t no_position = 0;          // points the file held without one (NaN), dropped
+  std::string world;                    // the world it was scanned in, when the file says
 };
 
 LoadedCloud LoadCloud(const std::string& path, const std::optional<Eigen::Vector3d>& origin) {
@@ -92,7 +102,71 @@ LoadedCloud LoadCloud(const std::string& path, const std::optional<Eigen::Vector
   // at zero pitch, which moves by a few centimetres while pitching and shifts the clearance rays'
   // ends (the last few metres) by well under a centimetre.
   c.sensor_origin = T * scan.sensor_origin->cast<float>();
+  c.no_position = scan.no_returns;
+  c.world = scan.world;
   return c;
+}
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// A cloud that says which world it was scanned in (pitchlab's PCDs do) must be of --world: else
+// the score compares it with another world's truth.
+void CheckSameWorld(const std::string& path, const std::string& cloud_world,
+                    const std::filesystem::path& world_path) {
+  const std::string world = world_path.stem().string();
+  if (cloud_world.empty() || cloud_world == world) return;
+  throw std::runtime_error("'" + path + "' was scanned in world '" + cloud_world + "', not '" +
+                           world + "' (--world): its score would be against another world's " +
+                           "truth; give --world " + cloud_world + " or leave --world out");
+}
+
+// Why no point went into the map, from the counts of what became of them.
+std::string NothingInserted(const mapping::InsertStats& s, std::size_t points) {
+  return "no point of the clouds went into the map: of " + std::to_string(points) + ", " +
+         std::to_string(s.outside) + " lie outside the map area (--area), " +
+         std::to_string(s.above_band) + " above the height band (--max-height), " +
+         std::to_string(s.underside + s.overhang) + " on undersides or overhangs, " +
+         std::to_string(s.non_finite) + " without a finite position";
+}
+
+// The LMS200's longest range, cm mode's 8191 counts of 1 cm (DESIGN.md): a point farther from the
+// sensor that saw it is not a return, and it is what stretches a map past its size [m].
+constexpr double kLms200MaxRange_m = 81.91;
+
+// The point farthest from the sensor that saw it when that is beyond any LMS200 return (named, so a
+// user can find the stray point or the cloud in other units); empty when every point is in range.
+std::string StrayPoint(const std::vector<LoadedCloud>& clouds,
+                       const std::vector<std::string>& paths) {
+  double farthest = -1;
+  std::size_t cloud = 0, index = 0;
+  for (std::size_t c = 0; c < clouds.size(); ++c) {
+    for (std::size_t i = 0; i < clouds[c].points.size(); ++i) {
+      const double d = (clouds[c].points[i] - clouds[c].sensor_origin).head<2>().norm();
+      if (d > farthest) farthest = d, cloud = c, index = i;
+    }
+  }
+  if (farthest <= kLms200MaxRange_m) return "";
+  const Eigen::Vector3f& p = clouds[cloud].points[index];
+  char text[320];
+  std::snprintf(text, sizeof(text),
+                "the farthest point, %zu of '%s' at (%.6g, %.6g, %.6g) m, lies %.6g m from its "
+                "sensor (an LMS200 reaches %.2f m): crop the clouds or give --area",
+                index, paths[cloud].c_str(), p.x(), p.y(), p.z(), farthest, kLms200MaxRange_m);
+  return text;
+}
+
+// The map's cells must fit the machine's memory, checked before they are allocated (a bad_alloc
+// names nothing a user can act on): empty when they fit, else what they would take.
+std::string MemoryShortfall(const mapping::GridGeometry& g) {
+  const double bytes = double(g.cell_count()) * mapping::ElevationMap::kBytesPerCell;
+  const double memory = double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGE_SIZE));
+  if (memory <= 0 || bytes <= memory) return "";
+  char text[200];
+  std::snprintf(text, sizeof(text),
+                "the map would be %d x %d cells of %g m, %.3g GB, more than this machine's "
+                "%.3g GB; ",
+                g.size_x, g.size_y, g.cell_m, bytes / 1e9, memory / 1e9);
+  return text;
 }
 
 nlohmann::json ErrorJson(const mapping::MapErrorReport& r) {
@@ -115,21 +189,36 @@ nlohmann::json ErrorJson(const mapping::MapErrorReport& r) {
 int RunMap(int argc, char** argv) {
   CliArgs args = MapArgs();
   if (!args.Parse(argc, argv)) return 0;
+  InstallInterruptCleanup("pitchlab map");  // Ctrl-C removes the unfinished folder
   const std::filesystem::path out = args.Get("out");
+  CheckNewFolder("out", out);  // before the work; never into an existing folder (as run)
   const double cell = args.GetNumbers("cell", 1)[0];
   if (!(cell > 0)) throw CliError("--cell must be positive");
   mapping::InsertConfig insert;
-  insert.clearance_length_m = args.GetNumbers("clearance", 1)[0];
+  insert.clearance_length_m = args.GetNumber("clearance", 0.0, kInf);
   insert.max_height_m = args.GetNumbers("max-height", 1)[0];
   if (!(insert.max_height_m > 0)) throw CliError("--max-height must be positive (or inf)");
+  const double margin = args.GetNumber("margin", 0.0, kInf);
+  const bool quiet = args.Flagged("quiet");
+  const auto progress = [quiet](const std::string& text) {
+    if (!quiet) std::fprintf(stderr, "map: %s\n", text.c_str());
+  };
   const auto wall_start = std::chrono::steady_clock::now();
+  const std::optional<std::string> world =
+      args.Has("world") ? std::optional(args.Get("world")) : std::nullopt;
+  const std::optional<std::filesystem::path> world_path =
+      world ? std::optional(worlds::ResolveWorld(*world, WorldsDir())) : std::nullopt;
 
   const std::optional<Eigen::Vector3d> sensor_origin = SensorOriginOption(args);
   std::vector<LoadedCloud> clouds;
   Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
   std::size_t total_points = 0;
+  std::size_t no_position = 0;
   for (const std::string& path : args.positionals()) {
+    progress("reading " + path);
     clouds.push_back(LoadCloud(path, sensor_origin));
+    if (world_path) CheckSameWorld(path, clouds.back().world, *world_path);
+    no_position += clouds.back().no_position;
     for (const Eigen::Vector3f& p : clouds.back().points) {
       lo = lo.cwiseMin(p.head<2>().cast<double>());
       hi = hi.cwiseMax(p.head<2>().cast<double>());
@@ -176,19 +265,40 @@ int RunMap(int argc, char** argv) {
     geometry = mapping::GridGeometry::FromArea(a[0], a[1], a[2] - a[0], a[3] - a[1], cell);
   } else {
     if (total_points == 0) throw std::runtime_error("the clouds hold no points; give --area");
-    geometry = mapping::GridGeometry::Covering(lo, hi, cell, args.GetNumbers("margin", 1)[0]);
+    try {
+      geometry = mapping::GridGeometry::Covering(lo, hi, cell, margin);
+    } catch (const std::invalid_argument&) {  // more than 2^31 cells
+      char extent[160];
+      std::snprintf(extent, sizeof(extent),
+                    "the clouds span %.6g x %.6g m: at --cell %g that is more cells than a map "
+                    "holds (2^31); ",
+                    hi.x() - lo.x(), hi.y() - lo.y(), cell);
+      const std::string stray = StrayPoint(clouds, args.positionals());
+      throw std::runtime_error(extent +
+                               (stray.empty() ? "give a coarser --cell or a smaller --area" : stray));
+    }
+    // A cloud from another scanner, or a merged map, may mean it: a warning, not an error.
+    if (const std::string stray = StrayPoint(clouds, args.positionals()); !stray.empty()) {
+      std::fprintf(stderr, "warning: %s\n", stray.c_str());
+    }
+  }
+  if (const std::string too_big = MemoryShortfall(geometry); !too_big.empty()) {
+    const std::string stray = args.Has("area") ? "" : StrayPoint(clouds, args.positionals());
+    throw std::runtime_error(too_big +
+                             (stray.empty() ? "give a coarser --cell or a smaller --area" : stray));
   }
 
   // The world, when given: its geodetic origin and its true surface.
   std::unique_ptr<sim::Simulation> sim;
   std::optional<mapping::GeodeticOrigin> origin;
-  if (args.Has("world")) {
-    const auto world_path = worlds::ResolveWorld(args.Get("world"), WorldsDir());
-    sim = std::make_unique<sim::Simulation>(world_path.string(), sim::RobotConfig{});
+  if (world_path) {
+    sim = std::make_unique<sim::Simulation>(world_path->string(), sim::RobotConfig{});
     if (const auto& g = sim->world().geodetic_origin)
       origin = mapping::GeodeticOrigin{g->x(), g->y(), g->z()};
   }
 
+  progress("inserting " + std::to_string(total_points) + " points into " +
+           std::to_string(geometry.size_x) + " x " + std::to_string(geometry.size_y) + " cells");
   mapping::ElevationMap map(geometry, origin);
   const auto insert_start = std::chrono::steady_clock::now();
   mapping::InsertStats stats;
@@ -202,18 +312,20 @@ int RunMap(int argc, char** argv) {
     stats.above_band += s.above_band;
     stats.underside += s.underside;
   }
+  stats.non_finite += no_position;  // dropped by the reader (NaN in the file) or by the map
+  if (stats.inserted == 0) throw std::runtime_error(NothingInserted(stats, total_points));
   const double insert_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - insert_start).count();
   const mapping::ElevationLayers layers = mapping::ComputeLayers(map);
 
-  const StagedFolder folder(out);
+  RunFolder folder(out);
   const auto check = [](Result<void> r) {
     if (!r) throw std::runtime_error(r.error().message);
   };
-  check(mapping::SaveElevationMap(map, (folder / "map.plem").string()));
-  check(mapping::WriteEsriAsciiGrid(layers, origin, (folder / "elevation.asc").string()));
+  check(mapping::SaveElevationMap(map, folder.File("map.plem").string()));
+  check(mapping::WriteEsriAsciiGrid(layers, origin, folder.File("elevation.asc").string()));
   check(mapping::WritePng(mapping::RenderElevationImage(layers),
-                          (folder / "elevation.png").string()));
+                          folder.File("elevation.png").string()));
 
   std::size_t known = 0, drops = 0;
   for (mapping::CellState s : layers.state) {
@@ -247,16 +359,19 @@ int RunMap(int argc, char** argv) {
     summary["geodetic_origin"] = {origin->latitude_deg, origin->longitude_deg, origin->height_m};
   }
   if (sim) {
+    progress("ground truth of " + *world + " on the map's grid");
     const std::unique_ptr<sensors::RayCaster> caster =
         sensors::MakeEmbreeRayCaster(sim->model(), sim->data());
+    mapping::TruthConfig truth_config;
+    truth_config.progress = QuarterProgress("map: ground truth", "rows", quiet);
     const mapping::ElevationLayers truth =
-        mapping::ComputeLayers(mapping::ComputeTrueElevationMap(*caster, geometry));
+        mapping::ComputeLayers(mapping::ComputeTrueElevationMap(*caster, geometry, truth_config));
     summary["truth"] = ErrorJson(mapping::CompareToTruth(layers, truth));
-    summary["world"] = args.Get("world");
+    summary["world"] = *world;
   }
   summary["wall_time_s"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  WriteTextFile(folder / "map.json", summary.dump(2) + "\n");
+  WriteTextFile(folder.File("map.json"), summary.dump(2) + "\n");
   folder.Commit();
   if (args.Flagged("json")) {
     std::cout << summary.dump(2) << "\n";

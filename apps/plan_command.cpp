@@ -11,10 +11,13 @@
 
 #include "cli_args.hpp"
 #include "commands.hpp"
+#include "interrupt.hpp"
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/planning/path_io.hpp"
 #include "pitchlab/planning/planner.hpp"
 #include "pitchlab/planning/traversability.hpp"
+#include "output_paths.hpp"
+#include "output_paths.hpp"
 #include "run_folder.hpp"
 #include "traversability_image.hpp"
 
@@ -40,7 +43,7 @@ CliArgs PlanArgs() {
       .Option("algo", "astar|dijkstra", "graph search", "astar")
       .Option("config", "FILE.yaml", "planner config: weights, robot limits, unknown policy")
       .Option("unknown", "forbid|penalise", "unknown cells, overrides --config's")
-      .Option("out", "DIR", "output folder (created)")
+      .Option("out", "DIR", "output folder to create (refused when it exists, as run refuses)")
       .Flag("json", "print the result as JSON on stdout");
   return args;
 }
@@ -67,8 +70,10 @@ nlohmann::json PathJson(const planning::Path& p) {
 int RunPlan(int argc, char** argv) {
   CliArgs args = PlanArgs();
   if (!args.Parse(argc, argv)) return 0;
+  InstallInterruptCleanup("pitchlab plan");  // Ctrl-C removes the unfinished folder
   const std::vector<double> start = args.GetNumbers("start", 2), goal = args.GetNumbers("goal", 2);
   const std::filesystem::path out = args.Get("out");
+  CheckNewFolder("out", out);  // as run and map: never into an existing folder
   planning::PlannerConfig config;
   if (args.Has("config")) config = planning::LoadPlannerConfig(args.Get("config"));
   try {
@@ -109,12 +114,12 @@ int RunPlan(int argc, char** argv) {
   };
   // The pictures of the map and of what the planner may enter, with or without a path: they
   // show why the path went where it did, or why there is none.
-  const auto write_pictures = [&](const StagedFolder& folder, const planning::Path* path) {
+  const auto write_pictures = [&](const RunFolder& folder, const planning::Path* path) {
     mapping::RgbImage elevation = mapping::RenderElevationImage(layers);
-    check(mapping::WritePng(elevation, (folder / "elevation.png").string()));
+    check(mapping::WritePng(elevation, folder.File("elevation.png").string()));
     mapping::RgbImage traversability = RenderTraversability(grid);
     if (path) planning::DrawPath(*path, map->geometry(), traversability);
-    check(mapping::WritePng(traversability, (folder / "traversability.png").string()));
+    check(mapping::WritePng(traversability, folder.File("traversability.png").string()));
     summary["traversability_legend"] = TraversabilityLegend();
   };
   if (!result) {
@@ -128,10 +133,10 @@ int RunPlan(int argc, char** argv) {
                     {"reason", planning::ToString(reason)},
                     {"message", result.error().message}});
     if (on_map) {
-      const StagedFolder folder(out);
+      RunFolder folder(out);
       write_pictures(folder, nullptr);
       summary["files"] = {"traversability.png", "elevation.png", "plan.json"};
-      WriteTextFile(folder / "plan.json", summary.dump(2) + "\n");
+      WriteTextFile(folder.File("plan.json"), summary.dump(2) + "\n");
       folder.Commit();
     }
     if (args.Flagged("json")) std::cout << summary.dump(2) << "\n";
@@ -145,19 +150,19 @@ int RunPlan(int argc, char** argv) {
     return 1;
   }
   summary.update(PathJson(*result));
-  const StagedFolder folder(out);
-  check(planning::WritePathCsv(*result, (folder / "path.csv").string()));
+  RunFolder folder(out);
+  check(planning::WritePathCsv(*result, folder.File("path.csv").string()));
   if (map->geodetic_origin()) {
     check(planning::WritePathGeoJson(*result, map->geodetic_origin(),
-                                     (folder / "path.geojson").string()));
+                                     folder.File("path.geojson").string()));
   } else {
     summary["geojson"] = "skipped: the map has no geodetic origin (map it with --world)";
   }
   mapping::RgbImage image = mapping::RenderElevationImage(layers);
   planning::DrawPath(*result, map->geometry(), image);
-  check(mapping::WritePng(image, (folder / "path.png").string()));
+  check(mapping::WritePng(image, folder.File("path.png").string()));
   write_pictures(folder, &*result);
-  WriteTextFile(folder / "plan.json", summary.dump(2) + "\n");
+  WriteTextFile(folder.File("plan.json"), summary.dump(2) + "\n");
   folder.Commit();
   if (args.Flagged("json")) {
     std::cout << summary.dump(2) << "\n";

@@ -16,7 +16,10 @@
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "hw_backend.hpp"
+#include "interrupt.hpp"
 #include "mission.hpp"
+#include "output_paths.hpp"
+#include "progress.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/elevation_truth.hpp"
 #include "pitchlab/sim/sim_rig.hpp"
@@ -84,6 +87,7 @@ worlds::WorldMetadata LoadMetadata(const std::filesystem::path& world) {
 int RunRun(int argc, char** argv) {
   // backend: hw (config or --backend): the same mission over the hardware drivers.
   if (SelectedBackend(argc, argv) == Backend::kHw) return RunHwMission(argc, argv);
+  InstallInterruptCleanup("pitchlab run");  // first: before any thread starts
   const auto wall_start = std::chrono::steady_clock::now();
   CliArgs args = RunArgs();
   if (!args.Parse(argc, argv)) return 0;
@@ -92,10 +96,7 @@ int RunRun(int argc, char** argv) {
   AppConfig config =
       LoadAppConfig(args.Has("config") ? std::optional(args.Get("config")) : std::nullopt);
   if (args.Has("seed")) {
-    const std::vector<double> seed = args.GetNumbers("seed", 1);
-    if (seed[0] < 0 || seed[0] != std::floor(seed[0]))
-      throw CliError("--seed must be an integer >= 0");
-    config.seed = static_cast<std::uint64_t>(seed[0]);
+    config.seed = args.GetWholeNumber("seed");
     config.sensors.lms200.seed = config.rig.lms200.seed = config.rig.odometry.seed =
         config.rig.imu.seed = config.seed;
   }
@@ -105,6 +106,8 @@ int RunRun(int argc, char** argv) {
   RunSettings settings = ParseRunSettings(config_text, config.source, config.rig.robot.model);
 
   const std::string world = args.Get("world");
+  const std::string out = args.Has("out") ? args.Get("out") : DefaultOut(world, config.seed);
+  CheckNewFolder("out", out);  // before the work, not after a 50-second run
   const std::filesystem::path world_path = worlds::ResolveWorld(world, WorldsDir());
   const worlds::WorldMetadata meta = LoadMetadata(world_path);
   Eigen::Vector3d start(meta.default_start.x_m, meta.default_start.y_m, meta.default_start.yaw_rad);
@@ -130,7 +133,7 @@ int RunRun(int argc, char** argv) {
                              std::to_string(b.y_min_m) + " .. " + std::to_string(b.y_max_m));
   }
 
-  RunFolder folder(args.Has("out") ? args.Get("out") : DefaultOut(world, config.seed));
+  RunFolder folder(out);
   sim::SimRig rig(world_path.string(), config.rig);
   Result<Eigen::Isometry3d> placed = rig.PlaceRobot(start.x(), start.y(), start.z());
   if (!placed) throw std::runtime_error("cannot place the robot: " + placed.error().message);
@@ -148,12 +151,18 @@ int RunRun(int argc, char** argv) {
                                      meta.geodetic_origin->height_m};
   }
   // Ground truth on the same grid: the true map, what is truly traversable, the true optimum.
-  if (!quiet) std::fprintf(stderr, "run: ground truth of %s\n", world.c_str());
+  if (!quiet) {
+    std::fprintf(stderr, "run: ground truth of %s: true surface on %d x %d cells\n", world.c_str(),
+                 mission.map_area.size_x, mission.map_area.size_y);
+  }
+  mapping::TruthConfig truth_config;
+  truth_config.progress = QuarterProgress("run: ground truth", "rows", quiet);
   mapping::ElevationMap truth_map =
-      mapping::ComputeTrueElevationMap(rig.caster(), mission.map_area);
+      mapping::ComputeTrueElevationMap(rig.caster(), mission.map_area, truth_config);
   const mapping::ElevationLayers truth_layers = mapping::ComputeLayers(truth_map, mission.layers);
   const planning::TraversabilityGrid truth_grid =
       planning::BuildTraversability(truth_layers, mission.planner);
+  if (!quiet) std::fprintf(stderr, "run: ground truth: the best path on the true map\n");
   auto optimum = planning::PlanPath(truth_grid, start.head<2>(), goal, mission.algorithm);
   if (!optimum) {
     throw std::runtime_error("the goal is unreachable on the true map: " + optimum.error().message);

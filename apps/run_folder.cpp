@@ -3,12 +3,32 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <map>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
+
+#include "interrupt.hpp"
 
 namespace pitchlab::apps {
 
 namespace fs = std::filesystem;
+
+namespace {
+std::mutex g_names_mutex;
+std::map<std::string, std::string> g_final_names;  // staging folder -> final path, as given
+}  // namespace
+
+std::string WithFinalPaths(std::string message) {
+  std::lock_guard<std::mutex> lock(g_names_mutex);
+  for (const auto& [staging, final_name] : g_final_names) {
+    for (std::size_t at = message.find(staging); at != std::string::npos;
+         at = message.find(staging, at + final_name.size())) {
+      message.replace(at, staging.size(), final_name);
+    }
+  }
+  return message;
+}
 
 RunFolder::RunFolder(fs::path final_path) : final_(std::move(final_path)) {
   if (final_.filename().empty()) final_ = final_.parent_path();
@@ -24,15 +44,27 @@ RunFolder::RunFolder(fs::path final_path) : final_(std::move(final_path)) {
     throw std::runtime_error("cannot create output folder under '" + parent.string() +
                              "': " + ec.message());
   }
+  {
+    std::lock_guard<std::mutex> lock(g_names_mutex);
+    g_final_names[staging_.string()] = final_.string();
+  }
+  cleanup_id_ = RegisterCleanup(
+      [staging = staging_](int) {
+        std::error_code ignored;
+        return fs::remove_all(staging, ignored) > 0;
+      },
+      "the unfinished output folder '" + final_.string() + "'");
 }
 
 RunFolder::~RunFolder() {
+  UnregisterCleanup(cleanup_id_);
   if (committed_) return;
   std::error_code ignored;
   fs::remove_all(staging_, ignored);
 }
 
 fs::path RunFolder::File(const std::string& relative) const {
+  WaitIfInterrupted();  // the watcher is removing the folder: do not make it again
   const fs::path path = staging_ / relative;
   fs::create_directories(path.parent_path());
   return path;
@@ -45,23 +77,7 @@ void RunFolder::Commit() {
     throw std::runtime_error("cannot move the run to '" + final_.string() + "': " + ec.message());
   }
   committed_ = true;
-}
-
-StagedFolder::StagedFolder(const fs::path& out) : out_(out.lexically_normal()) {
-  if (!out_.has_filename()) out_ = out_.parent_path();
-  stage_ = out_.parent_path() / ("." + out_.filename().string() + ".partial");
-  fs::remove_all(stage_);
-  fs::create_directories(stage_);
-}
-
-StagedFolder::~StagedFolder() {
-  std::error_code ignored;
-  fs::remove_all(stage_, ignored);
-}
-
-void StagedFolder::Commit() const {
-  fs::create_directories(out_);
-  for (const auto& e : fs::directory_iterator(stage_)) fs::rename(e.path(), out_ / e.path().filename());
+  UnregisterCleanup(cleanup_id_);
 }
 
 void WriteTextFile(const fs::path& path, const std::string& text) {

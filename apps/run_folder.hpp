@@ -11,7 +11,8 @@ namespace pitchlab::apps {
 class RunFolder {
  public:
   /// Prepares `<parent>/.<name>.partial-<pid>`. Throws std::runtime_error when `final_path`
-  /// already exists (runs are never overwritten) or the staging folder cannot be made.
+  /// already exists (runs are never overwritten) or the staging folder cannot be made. The
+  /// staging folder is registered with RegisterCleanup: SIGINT / SIGTERM remove it too.
   explicit RunFolder(std::filesystem::path final_path);
   ~RunFolder();  ///< removes the staging folder unless committed
   RunFolder(const RunFolder&) = delete;
@@ -26,26 +27,13 @@ class RunFolder {
  private:
   std::filesystem::path final_, staging_;
   bool committed_ = false;
+  int cleanup_id_ = -1;  ///< RegisterCleanup's
 };
 
-/// The output folder of a tool that may write into an existing folder (map, plan): files are
-/// written into a hidden sibling (".NAME.partial") and moved in only when all are written, so a
-/// failure part way leaves neither a half-written folder nor half of a file set.
-class StagedFolder {
- public:
-  explicit StagedFolder(const std::filesystem::path& out);  ///< throws std::filesystem_error
-  ~StagedFolder();  ///< removes the staging folder
-  StagedFolder(const StagedFolder&) = delete;
-  StagedFolder& operator=(const StagedFolder&) = delete;
-
-  /// Where to write the file `name` now.
-  std::filesystem::path operator/(const std::string& name) const { return stage_ / name; }
-  /// Moves every file into the output folder (created; files of the same name replaced).
-  void Commit() const;
-
- private:
-  std::filesystem::path out_, stage_;
-};
+/// `message` with every staging folder of this process's RunFolders replaced by the folder's final
+/// name: an error from a writer names the hidden `.NAME.partial-PID/x` it was writing, which the
+/// failed RunFolder has removed; the user knows NAME.
+std::string WithFinalPaths(std::string message);
 
 /// Writes `text` to `path` (the folder exists); throws std::runtime_error naming the path.
 void WriteTextFile(const std::filesystem::path& path, const std::string& text);

@@ -12,6 +12,7 @@
 #include "app_config.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
+#include "output_paths.hpp"
 #include "pitchlab/sensors/scan_pcd.hpp"
 #include "pitchlab/sim/sim_rig.hpp"
 #include "pitchlab/worlds/world_catalog.hpp"
@@ -66,6 +67,7 @@ int RunScan(int argc, char** argv) {
   CliArgs args = ScanArgs();
   if (!args.Parse(argc, argv)) return 0;
   const std::string out = args.Get("out");
+  CheckOutputFile("out", out);  // before the simulation, not after it
   const bool json = args.Flagged("json");
   const bool quiet = args.Flagged("quiet");
 
@@ -106,6 +108,7 @@ int RunScan(int argc, char** argv) {
   if (!scan) throw std::runtime_error("scan failed: " + scan.error().message);
   const double scan_wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - scan_start).count();
+  scan->world = world_path.stem().string();  // so `map --world` can tell a scan of another world
   if (Result<void> written = sensors::WriteScanPcd(*scan, out); !written) {
     throw std::runtime_error(written.error().message);
   }

@@ -7,8 +7,9 @@ packages=(
   libeigen3-dev libmujoco-dev libembree-dev libpcl-dev libgeographiclib-dev
   libyaml-cpp-dev libexpected-dev libpng-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libboost-graph-dev
-  libjs-three chromium
-  slurmctld slurmd slurm-client munge
+  libjs-three chromium  # the report's 3D view; its headless-browser test
+  slurmctld slurmd slurm-client munge  # scripts/test-slurm.sh
+  clang libclang-rt-dev valgrind  # the hw libFuzzer targets in CTest; scripts/sanitize.sh
 )
 
 missing=()

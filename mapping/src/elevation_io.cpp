@@ -8,6 +8,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "pitchlab/sensors/scan3d.hpp"
+
 namespace pitchlab::mapping {
 namespace {
 
@@ -96,6 +98,49 @@ Result<void> SaveElevationMap(const ElevationMap& map, const std::string& path) 
   return WriteAtomically(path, out);
 }
 
+namespace {
+
+// Why the header's or the cells' values cannot be a map's, or empty when they can: a finite corner
+// within sensors::kMaxCoordinate_m, a finite cell, a geodetic origin on the globe, and finite
+// statistics in every known cell (an unknown cell keeps its +-inf defaults; clearance is +inf
+// where no ray crossed).
+std::string InvalidValues(const GridGeometry& g, const GeodeticOrigin* geo,
+                          const std::vector<CellStats>& cells) {
+  const auto number = [](double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+  };
+  if (!(std::abs(g.x_min_m) <= sensors::kMaxCoordinate_m &&
+        std::abs(g.y_min_m) <= sensors::kMaxCoordinate_m)) {
+    return "corner (" + number(g.x_min_m) + ", " + number(g.y_min_m) +
+           ") m is not finite or lies beyond 100 km";
+  }
+  if (!std::isfinite(g.cell_m)) return "cell size " + number(g.cell_m) + " m is not finite";
+  if (geo && !(std::abs(geo->latitude_deg) <= 90 && std::abs(geo->longitude_deg) <= 180 &&
+               std::isfinite(geo->height_m))) {
+    return "geodetic origin (" + number(geo->latitude_deg) + ", " + number(geo->longitude_deg) +
+           ", " + number(geo->height_m) + ") is not on the globe";
+  }
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    const CellStats& c = cells[i];
+    if (!c.known()) continue;
+    const float values[] = {c.mean_x, c.mean_y, c.mean_z, c.c_xx, c.c_xy, c.c_xz,
+                            c.c_yy,   c.c_yz,   c.c_zz,   c.min_z, c.max_z};
+    for (float v : values) {
+      if (!std::isfinite(v)) {
+        return "cell " + std::to_string(i) + " (column " + std::to_string(i % g.size_x) +
+               ", row " + std::to_string(i / g.size_x) + ") holds a non-finite value (" +
+               number(v) + ")";
+      }
+    }
+    if (std::isnan(c.clearance_z)) return "cell " + std::to_string(i) + " has a NaN clearance";
+  }
+  return "";
+}
+
+}  // namespace
+
 Result<ElevationMap> LoadElevationMap(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return Fail(Error::Code::kNotFound, path + ": cannot open: " + std::strerror(errno));
@@ -130,6 +175,10 @@ Result<ElevationMap> LoadElevationMap(const std::string& path) {
   if (pos + cells_bytes + 8 != bytes.size()) return bad("size does not match the grid");
   std::vector<CellStats> cells(g.cell_count());
   std::memcpy(cells.data(), bytes.data() + pos, cells_bytes);
+  // The hash proves the bytes are as written, not that a writer wrote numbers: a crafted or
+  // foreign file with an infinite cell or a NaN height would plan "paths" of NaN coordinates.
+  if (const std::string why = InvalidValues(g, has_geo ? &geo : nullptr, cells); !why.empty())
+    return bad(why);
   ElevationMap map(g, has_geo ? std::optional<GeodeticOrigin>(geo) : std::nullopt);
   map.SetCells(std::move(cells));
   return map;

@@ -129,6 +129,7 @@ ElevationMap ComputeTrueElevationMap(const sensors::RayCaster& caster, const Gri
         if (std::isfinite(surface_z[r])) hits.emplace_back(x[r], yr, surface_z[r]);
       (void)truth.InsertPoints(hits.data(), hits.size());
     }
+    if (config.progress) config.progress(j + 1, geometry.size_y);
   }
   return truth;
 }

@@ -16,7 +16,12 @@ Result<void> WriteText(const std::string& file, const std::string& text) {
     std::ofstream out(tmp, std::ios::trunc);
     if (!out) return Fail(Error::Code::kInvalidArgument, file + ": cannot write");
     out << text;
-    if (!out.flush()) return Fail(Error::Code::kFailed, file + ": write failed");
+    if (!out.flush()) {
+      out.close();
+      std::error_code ignored;
+      std::filesystem::remove(tmp, ignored);  // a full disk leaves no partial file behind
+      return Fail(Error::Code::kFailed, file + ": write failed");
+    }
   }
   std::error_code ec;
   std::filesystem::rename(tmp, file, ec);
@@ -31,6 +36,28 @@ std::string Num(double v, const char* fmt = "%.4f") {
   return buf;
 }
 
+// A JSON number, or null where the value is not finite ("%f" of NaN is not JSON).
+std::string JsonNum(double v, const char* fmt) { return std::isfinite(v) ? Num(v, fmt) : "null"; }
+
+// A path is written only with finite positions and costs: an empty CSV field or a GeoJSON "[,,]"
+// reads as a path to a user's tools when it is the trace of a corrupt map.
+Result<void> CheckFinite(const Path& path, const std::string& file) {
+  for (std::size_t n = 0; n < path.waypoints.size(); ++n) {
+    const Waypoint& w = path.waypoints[n];
+    if (!std::isfinite(w.x_m) || !std::isfinite(w.y_m)) {
+      return Fail(Error::Code::kInvalidArgument,
+                  file + ": waypoint " + std::to_string(n) + " has no finite position (x " +
+                      std::to_string(w.x_m) + ", y " + std::to_string(w.y_m) +
+                      "): the map's geometry is not finite; nothing written");
+    }
+  }
+  if (!std::isfinite(path.cost) || !std::isfinite(path.length_m)) {
+    return Fail(Error::Code::kInvalidArgument,
+                file + ": the path's cost or length is not finite; nothing written");
+  }
+  return {};
+}
+
 void Disc(mapping::RgbImage& img, double cx, double cy, double r, std::uint8_t R, std::uint8_t G,
           std::uint8_t B) {
   for (int y = int(cy - r) - 1; y <= int(cy + r) + 1; ++y)
@@ -41,6 +68,7 @@ void Disc(mapping::RgbImage& img, double cx, double cy, double r, std::uint8_t R
 }  // namespace
 
 Result<void> WritePathCsv(const Path& path, const std::string& file) {
+  if (Result<void> finite = CheckFinite(path, file); !finite) return finite;
   std::string out = "index,x_m,y_m,z_m,cum_length_m\n";
   double cum = 0;
   for (std::size_t n = 0; n < path.waypoints.size(); ++n) {
@@ -63,6 +91,7 @@ Result<void> WritePathGeoJson(const Path& path,
     return Fail(Error::Code::kInvalidArgument,
                 file + ": the map has no geodetic origin, so the path cannot be placed on WGS84");
   }
+  if (Result<void> finite = CheckFinite(path, file); !finite) return finite;
   const GeographicLib::LocalCartesian enu(origin->latitude_deg, origin->longitude_deg,
                                           origin->height_m);
   std::string coords;
@@ -75,13 +104,13 @@ Result<void> WritePathGeoJson(const Path& path,
   const CostParts& c = path.parts;
   std::string props =
       "\"algorithm\":\"" + std::string(ToString(path.algorithm)) + "\"" +
-      ",\"cost\":" + Num(path.cost, "%.6f") + ",\"cost_roughness\":" + Num(c.roughness, "%.6f") +
-      ",\"cost_length\":" + Num(c.length, "%.6f") +
-      ",\"cost_inclination_x\":" + Num(c.inclination_x, "%.6f") +
-      ",\"cost_inclination_y\":" + Num(c.inclination_y, "%.6f") +
-      ",\"cost_unknown\":" + Num(c.unknown, "%.6f") + ",\"length_m\":" + Num(path.length_m) +
-      ",\"max_step_m\":" + Num(path.max_step_m) +
-      ",\"max_inclination_deg\":" + Num(path.max_inclination_rad * 180 / M_PI);
+      ",\"cost\":" + JsonNum(path.cost, "%.6f") + ",\"cost_roughness\":" + JsonNum(c.roughness, "%.6f") +
+      ",\"cost_length\":" + JsonNum(c.length, "%.6f") +
+      ",\"cost_inclination_x\":" + JsonNum(c.inclination_x, "%.6f") +
+      ",\"cost_inclination_y\":" + JsonNum(c.inclination_y, "%.6f") +
+      ",\"cost_unknown\":" + JsonNum(c.unknown, "%.6f") + ",\"length_m\":" + JsonNum(path.length_m, "%.4f") +
+      ",\"max_step_m\":" + JsonNum(path.max_step_m, "%.4f") +
+      ",\"max_inclination_deg\":" + JsonNum(path.max_inclination_rad * 180 / M_PI, "%.4f");
   const std::string text =
       "{\"type\":\"FeatureCollection\",\"features\":[{\"type\":\"Feature\",\"properties\":{" +
       props + "},\"geometry\":{\"type\":\"LineString\",\"coordinates\":[" + coords + "]}}]}\n";

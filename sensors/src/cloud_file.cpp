@@ -2,6 +2,9 @@
 
 #include "pitchlab/sensors/cloud_file.hpp"
 
+#include <cmath>
+#include <sstream>
+
 #include "cloud_text.hpp"
 #include "pitchlab/sensors/scan_pcd.hpp"
 
@@ -14,7 +17,9 @@ const char* CloudFormatsHelp() {
          "  .xyz .txt   text, one point a line: x y z [m] (spaces, tabs or commas)\n";
 }
 
-Result<Scan3D> ReadCloudFile(const std::string& path) {
+namespace {
+
+Result<Scan3D> ReadByExtension(const std::string& path) {
   const std::string ext = detail::LowerExtension(path);
   if (ext == ".pcd") return ReadScanPcd(path);
   if (ext == ".3d") return Read3dtkScan(path);
@@ -22,6 +27,33 @@ Result<Scan3D> ReadCloudFile(const std::string& path) {
   if (ext == ".xyz" || ext == ".txt") return ReadXyz(path);
   return Fail(Error::Code::kInvalidArgument, "'" + path + "': unknown point-cloud format '" + ext +
                                                  "' (known: .pcd, .3d, .ply, .xyz, .txt)");
+}
+
+}  // namespace
+
+Result<void> CheckPointsPlausible(const Scan3D& scan, const std::string& path) {
+  for (std::size_t i = 0; i < scan.points.size(); ++i) {
+    const ScanPoint& p = scan.points[i];
+    if (std::abs(p.x) <= kMaxCoordinate_m && std::abs(p.y) <= kMaxCoordinate_m &&
+        std::abs(p.z) <= kMaxCoordinate_m) {
+      continue;
+    }
+    std::ostringstream os;
+    os << "'" << path << "': point " << i << " at (" << p.x << ", " << p.y << ", " << p.z
+       << ") m lies more than 100 km from its frame's origin: a corrupt file, or units other "
+          "than metres";
+    return Fail(Error::Code::kInvalidArgument, os.str());
+  }
+  return {};
+}
+
+Result<Scan3D> ReadCloudFile(const std::string& path) {
+  Result<Scan3D> scan = ReadByExtension(path);
+  if (!scan) return scan;
+  if (Result<void> plausible = CheckPointsPlausible(*scan, path); !plausible) {
+    return tl::make_unexpected(plausible.error());
+  }
+  return scan;
 }
 
 void SetSensorOrigin(Scan3D& scan, const Eigen::Vector3d& origin_m) {

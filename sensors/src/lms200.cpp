@@ -21,6 +21,8 @@ constexpr int kTelegramOverheadBytes = 10;
 constexpr int kBitsPerByte = 8 + 2;
 // Depth jump across one beam's footprint above which the return is a mixed pixel [m].
 constexpr double kMixedPixelJump_m = 0.05;
+// Largest range noise a config may ask for [m] (see Lms200Config::Validate).
+constexpr double kMaxNoiseSigma_m = 1.0;
 
 // Seeds of the dropout and the mount streams: the run's seed with fixed bits flipped, so the range
 // noise keeps its draws whichever effects are on (any constants do; these are the first digits of
@@ -50,8 +52,10 @@ void Lms200Config::Validate() const {
   if (Near(resolution_deg, 0.25) && !Near(fov_deg, 100.0)) {
     Invalid("resolution_deg", resolution_deg, "0.25 only with fov_deg 100");
   }
-  if (!(noise_sigma_m >= 0.0) || !std::isfinite(noise_sigma_m)) {
-    Invalid("noise_sigma_m", noise_sigma_m, ">= 0");
+  // A guard against a unit slip: 1 m is 200 times the datasheet's 5 mm and an eighth of mm mode's
+  // range; a wall 4 m away would read anywhere from 1 to 7 m, no longer a range finder.
+  if (!(noise_sigma_m >= 0.0 && noise_sigma_m <= kMaxNoiseSigma_m)) {
+    Invalid("noise_sigma_m", noise_sigma_m, "0 .. 1 [m] (the datasheet's is 0.005)");
   }
   if (!(noise_per_m >= 0.0 && noise_per_m < 0.1)) Invalid("noise_per_m", noise_per_m, "0 .. 0.1");
   if (!(incidence_noise_gain >= 0.0 && incidence_noise_gain <= 10.0)) {

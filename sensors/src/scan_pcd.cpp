@@ -1,6 +1,9 @@
 #include "pitchlab/sensors/scan_pcd.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
+
+#include <cerrno>
 
 #include <cmath>
 #include <cstdio>
@@ -10,11 +13,13 @@
 #include <locale>
 #include <optional>
 #include <sstream>
+#include <string_view>
 
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/io/pcd_io.h>
 
 #include "cloud_text.hpp"
+#include "pcd_checks.hpp"
 #include "pitchlab/sensors/cloud_file.hpp"
 
 namespace pitchlab::sensors {
@@ -66,6 +71,7 @@ pcl::PCLPointCloud2 ToCloud2(const Scan3D& scan) {
 // and what the VIEWPOINT pose is.
 constexpr const char* kOriginKey = "# sensor_origin";
 constexpr const char* kPoseKey = "# pose";
+constexpr const char* kWorldKey = "# world";
 
 std::string HeaderComments(const Scan3D& scan) {
   std::ostringstream os;
@@ -77,12 +83,17 @@ std::string HeaderComments(const Scan3D& scan) {
   }
   const char* pose = scan.has_truth ? "truth" : scan.has_odometry ? "odometry" : "unknown";
   os << kPoseKey << ' ' << pose << '\n';
+  // One word (a file stem): a world name with spaces would not read back as one field.
+  if (!scan.world.empty() && scan.world.find_first_of(" \t\r\n") == std::string::npos) {
+    os << kWorldKey << ' ' << scan.world << '\n';
+  }
   return os.str();
 }
 
 struct Comments {
   std::optional<Eigen::Vector3d> sensor_origin;
   std::optional<std::string> pose;
+  std::string world;
 };
 
 // Our comment lines among the header's (up to the DATA line).
@@ -105,9 +116,36 @@ Result<Comments> ReadComments(const std::string& path) {
       c.sensor_origin = o;
     } else if (line.rfind(kPoseKey, 0) == 0 && f.size() == 3 && f[1] == "pose") {
       c.pose = std::string(f[2]);
+    } else if (line.rfind(kWorldKey, 0) == 0 && f.size() == 3 && f[1] == "world") {
+      c.world = std::string(f[2]);
     }
   }
   return c;
+}
+
+// Writes the parts to a new file `path` with write(2), so a full disk or a file-size limit is an
+// error with its reason (ENOSPC, EFBIG) rather than a stream's bare failure bit; a failure removes
+// the file.
+Result<void> WriteWhole(const std::filesystem::path& path,
+                        std::initializer_list<std::string_view> parts) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return Fail(Error::Code::kFailed, std::strerror(errno));
+  int error = 0;
+  for (std::string_view part : parts) {
+    while (!part.empty() && error == 0) {
+      const ssize_t n = ::write(fd, part.data(), part.size());
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        error = n < 0 ? errno : ENOSPC;
+        break;
+      }
+      part.remove_prefix(static_cast<std::size_t>(n));
+    }
+  }
+  if (::close(fd) != 0 && error == 0) error = errno;  // NFS and quotas report on close
+  if (error == 0) return {};
+  ::unlink(path.c_str());
+  return Fail(Error::Code::kFailed, std::strerror(error));
 }
 
 }  // namespace
@@ -125,17 +163,11 @@ Result<void> WriteScanPcd(const Scan3D& scan, const std::string& path) {
   std::string header = pcl::PCDWriter().generateHeaderBinary(cloud, origin, q.cast<float>());
   header.insert(header.find('\n') + 1, HeaderComments(scan));
   header += "DATA binary\n";  // generateHeaderBinary stops before it, as writeBinary adds it
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out.write(header.data(), static_cast<std::streamsize>(header.size()));
-    out.write(reinterpret_cast<const char*>(cloud.data.data()),
-              static_cast<std::streamsize>(cloud.data.size()));
-    out.close();
-    if (!out) {
-      std::error_code ignored;
-      fs::remove(tmp, ignored);
-      return Fail(Error::Code::kFailed, "cannot write PCD '" + path + "'");
-    }
+  if (Result<void> written = WriteWhole(tmp, {header, std::string_view(reinterpret_cast<const char*>(
+                                                              cloud.data.data()),
+                                                          cloud.data.size())});
+      !written) {
+    return Fail(Error::Code::kFailed, "cannot write PCD '" + path + "': " + written.error().message);
   }
   std::error_code ec;
   fs::rename(tmp, target, ec);
@@ -155,38 +187,49 @@ Result<Scan3D> ReadScanPcd(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) {
     return Fail(Error::Code::kNotFound, "no such PCD file '" + path + "'");
   }
-  // PCL's reader trusts the header (it crashes on a file without fields): check it first.
+  // PCL's reader trusts the header: it allocates what POINTS says, crashes on a compressed size
+  // of 0 or a file without fields, leaves a VIEWPOINT "nan" unset. Check it ourselves first.
+  Result<detail::PcdHeader> header = detail::PeekPcdHeader(path);
+  if (!header) return tl::make_unexpected(header.error());
+  if (Result<void> sized = detail::CheckPcdDataSize(path, header->data, header->data_offset,
+                                                    header->points, header->point_step);
+      !sized) {
+    return tl::make_unexpected(sized.error());
+  }
+  if (Result<void> viewpoint = detail::CheckViewpoint(path, header->origin, header->orientation);
+      !viewpoint) {
+    return tl::make_unexpected(viewpoint.error());
+  }
   int data_type = 0;
   unsigned int data_idx = 0;
   if (reader.readHeader(path, cloud, origin, orientation, pcd_version, data_type, data_idx) != 0 ||
       cloud.fields.empty() || cloud.point_step == 0) {
     return Fail(Error::Code::kInvalidArgument, "'" + path + "' is not a readable PCD file");
   }
-  const std::uintmax_t points = std::uintmax_t(cloud.width) * cloud.height;
-  constexpr int kBinary = 1;  // PCL's data_type: 0 ascii, 1 binary, 2 binary_compressed
-  if (data_type == kBinary &&
-      std::filesystem::file_size(path) < data_idx + points * cloud.point_step) {
-    return Fail(Error::Code::kInvalidArgument,
-                "PCD '" + path + "' is truncated: the header promises " + std::to_string(points) +
-                    " points");
-  }
   if (reader.read(path, cloud, origin, orientation, pcd_version) != 0) {
     return Fail(Error::Code::kInvalidArgument, "'" + path + "' is not a readable PCD file");
   }
-  auto offset_of = [&](const char* name, std::uint8_t type) -> int {
+  // A field's offset when it has `name` and one of `types`, else -1.
+  auto offset_of = [&](const char* name, std::initializer_list<std::uint8_t> types) -> int {
     for (const auto& f : cloud.fields) {
-      if (f.name == name && f.datatype == type) return static_cast<int>(f.offset);
+      for (std::uint8_t type : types) {
+        if (f.name == name && f.datatype == type) return static_cast<int>(f.offset);
+      }
     }
     return -1;
   };
   using F = pcl::PCLPointField;
-  const int ox = offset_of("x", F::FLOAT32), oy = offset_of("y", F::FLOAT32),
-            oz = offset_of("z", F::FLOAT32);
+  // x y z as float32 (ours, PCL's default) or float64 (Open3D, CloudCompare with doubles).
+  const bool doubles = offset_of("x", {F::FLOAT64}) >= 0;
+  const std::uint8_t xyz_type = doubles ? F::FLOAT64 : F::FLOAT32;
+  const int ox = offset_of("x", {xyz_type}), oy = offset_of("y", {xyz_type}),
+            oz = offset_of("z", {xyz_type});
   if (ox < 0 || oy < 0 || oz < 0) {
-    return Fail(Error::Code::kInvalidArgument, "PCD '" + path + "' has no float x y z fields");
+    return Fail(Error::Code::kInvalidArgument,
+                "PCD '" + path + "' has no x y z fields of one float type (4 or 8 bytes)");
   }
-  const int orange = offset_of("range", F::FLOAT32), oring = offset_of("ring", F::UINT16),
-            obeam = offset_of("beam", F::UINT16), ostamp = offset_of("stamp", F::FLOAT64);
+  const int orange = offset_of("range", {F::FLOAT32}), oring = offset_of("ring", {F::UINT16}),
+            obeam = offset_of("beam", {F::UINT16}), ostamp = offset_of("stamp", {F::FLOAT64});
   Scan3D scan;
   const std::size_t n = std::size_t(cloud.width) * cloud.height;
   scan.points.reserve(n);
@@ -196,9 +239,17 @@ Result<Scan3D> ReadScanPcd(const std::string& path) {
       if (off >= 0) std::memcpy(&value, rec + off, sizeof(value));
     };
     ScanPoint p;
-    get(ox, p.x);
-    get(oy, p.y);
-    get(oz, p.z);
+    if (doubles) {
+      double x = 0, y = 0, z = 0;
+      get(ox, x);
+      get(oy, y);
+      get(oz, z);
+      p.x = static_cast<float>(x), p.y = static_cast<float>(y), p.z = static_cast<float>(z);
+    } else {
+      get(ox, p.x);
+      get(oy, p.y);
+      get(oz, p.z);
+    }
     get(orange, p.range_m);
     get(oring, p.line);
     get(obeam, p.beam);
@@ -211,10 +262,12 @@ Result<Scan3D> ReadScanPcd(const std::string& path) {
   }
   if (!scan.points.empty()) scan.stamp_s = scan.points.front().stamp_s;
   scan.T_world_base = Eigen::Isometry3d::Identity();
-  scan.T_world_base.translate(origin.head<3>().cast<double>());
-  scan.T_world_base.rotate(orientation.cast<double>().normalized());
+  // Our reading of the VIEWPOINT, checked above (PCL's leaves values it cannot parse unset).
+  scan.T_world_base.translate(header->origin.head<3>().cast<double>());
+  scan.T_world_base.rotate(header->orientation.cast<double>().normalized());
   Result<Comments> comments = ReadComments(path);
   if (!comments) return tl::make_unexpected(comments.error());
+  scan.world = comments->world;
   if (comments->pose) {
     scan.has_truth = *comments->pose == "truth";
     scan.has_odometry = *comments->pose == "odometry";

@@ -57,6 +57,31 @@ double TerrainHeight(const mjModel* m, const mjData* d, const Eigen::Vector2d& x
   return std::isfinite(best) ? from_z - best : std::nan("");
 }
 
+// In a world without terrain geoms the first static surface from above is taken as ground. It is
+// not, when it is the top of an object with more of the world under it (a roof on its pavement, a
+// desk over the floor, a car on the road): the height from that top down to the next surface
+// below the geom's bottom [m], or NaN when nothing lies under the geom (it is the ground itself).
+double HeightAboveSurfaceBelow(const mjModel* m, const mjData* d, const Eigen::Vector2d& xy,
+                               double from_z, const mjtByte* groups) {
+  constexpr double kInside = 1e-6;  // [m] start just inside the geom, then just below it
+  const mjtNum down[3] = {0, 0, -1};
+  const mjtNum above[3] = {xy.x(), xy.y(), from_z};
+  int geom = -1;
+  const double to_top = mj_ray(m, d, above, down, groups, 1, -1, &geom);
+  if (to_top < 0 || geom < 0) return std::nan("");
+  const double top = from_z - to_top;
+  // From inside its top, a ray leaves the geom through its bottom.
+  const mjtNum inside[3] = {xy.x(), xy.y(), top - kInside};
+  const double to_bottom = mju_rayGeom(d->geom_xpos + 3 * geom, d->geom_xmat + 9 * geom,
+                                       m->geom_size + 3 * geom, inside, down, m->geom_type[geom]);
+  if (to_bottom < 0) return std::nan("");  // one-sided or open: nothing to look under
+  const mjtNum below[3] = {xy.x(), xy.y(), top - kInside - to_bottom - kInside};
+  int under = -1;
+  const double to_under = mj_ray(m, d, below, down, groups, 1, -1, &under);
+  if (to_under < 0) return std::nan("");
+  return top - (below[2] - to_under);
+}
+
 // Least-squares plane z = a + b (x - x0) + c (y - y0) through the ground samples, and the largest
 // deviation of a sample from it [m].
 struct GroundPlane {
@@ -134,6 +159,18 @@ Result<Eigen::Isometry3d> Simulation::PlaceRobot(double x_m, double y_m, double 
   // 2. Nothing may stand in the robot's volume above the ground (upward rays from step height).
   const double envelope_m =
       robot_.mount.t_base_mount_m.z() + robot_.mount.t_mount_laser_m.norm() + 0.1;
+  // 2a. Without terrain geoms, the first surface from above may be an object's top: one higher
+  // above the ground under it than the robot is tall (a roof, a table, a car) is no start; a
+  // lower one (a ramp, a platform) the robot could have driven onto.
+  for (std::size_t i = 0; i < samples.size() && !any_terrain; ++i) {
+    if (const double height = HeightAboveSurfaceBelow(s.m, s.d, samples[i], from_z, groups);
+        height > envelope_m) {
+      return Fail(Error::Code::kInvalidArgument,
+                  "start " + Xy(x_m, y_m) + " is on top of an obstacle, not on the ground: at " +
+                      Xy(samples[i].x(), samples[i].y()) + " the surface is " +
+                      std::to_string(height) + " m above the ground under it (a roof, a table)");
+    }
+  }
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const mjtNum pnt[3] = {samples[i].x(), samples[i].y(), ground[i] + config.max_step_m};
     const mjtNum up[3] = {0, 0, 1};

@@ -53,9 +53,10 @@ mjModel* LoadComposed(const std::string& xml, const std::string& source) {
   unlink(path.c_str());
   if (!written) throw std::runtime_error("world " + source + ": cannot write temp file " + path);
   if (model == nullptr) {
-    throw std::runtime_error("world " + source +
-                             ": MuJoCo cannot load it (with the robot spliced in; " +
-                             "Simulation::composed_xml shows the text): " + error);
+    // The user's file, not our composition, is what the message names: MuJoCo's own error
+    // (element, attribute, line of the composed text) says what it could not take.
+    throw std::runtime_error("world " + source + ": MuJoCo cannot load it with the robot added: " +
+                             error);
   }
   return model;
 }

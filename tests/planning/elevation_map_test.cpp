@@ -188,8 +188,15 @@ TEST(ElevationMap, MergeEqualsInsertingBothClouds) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(0.0f, 2.0f), n(-0.05f, 0.05f);
   std::vector<Eigen::Vector3f> a(5000), b(7000);
-  for (auto& p : a) p = {u(rng), u(rng), 0.1f * p.x() + n(rng)};
-  for (auto& p : b) p = {u(rng) + 1.0f, u(rng), 0.1f * p.x() + n(rng)};
+  // x drawn first: the plane's height needs it (a braced initialiser cannot read its own x).
+  for (auto& p : a) {
+    const float x = u(rng);
+    p = {x, u(rng), 0.1f * x + n(rng)};
+  }
+  for (auto& p : b) {
+    const float x = u(rng) + 1.0f;
+    p = {x, u(rng), 0.1f * x + n(rng)};
+  }
   const GridGeometry ga = GridGeometry::FromArea(0, 0, 3, 2, 0.25);
   const GridGeometry gb = GridGeometry::FromArea(1, 0, 2, 2, 0.25);  // offset by 4 cells
   ElevationMap all(ga), ma(ga), mb(gb);

@@ -99,5 +99,33 @@ TEST(SensorConfig, TheRealismKeysReadBackAndAreChecked) {
   EXPECT_NE(message("lms200: {mount_error_sigma_deg: lots}").find("wrong type"), std::string::npos);
 }
 
+std::string ConfigError(const char* yaml) {
+  try {
+    ParseSensorConfig(yaml, "my.yaml");
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(SensorConfig, AKeyGivenTwiceIsAnErrorNamingBothLines) {
+  EXPECT_NE(ConfigError("lms200:\n  noise_sigma_m: 0.01\n  noise_sigma_m: 0.02\n")
+                .find("my.yaml: lms200.noise_sigma_m is given twice (lines 2 and 3)"),
+            std::string::npos)
+      << ConfigError("lms200:\n  noise_sigma_m: 0.01\n  noise_sigma_m: 0.02\n");
+  // In another module's section too: every config is read through here first.
+  EXPECT_NE(ConfigError("seed: 1\nrun: {max_stops: 3}\nseed: 2\n").find("seed is given twice"),
+            std::string::npos);
+  EXPECT_NE(ConfigError("run: {weights: {a: 1, a: 2}}").find("run.weights.a is given twice"),
+            std::string::npos);
+}
+
+TEST(SensorConfig, AnAbsurdRangeNoiseIsAnError) {
+  EXPECT_NE(ConfigError("lms200: {noise_sigma_m: 1e9}").find("lms200.noise_sigma_m = 1e+09"),
+            std::string::npos)
+      << ConfigError("lms200: {noise_sigma_m: 1e9}");
+  EXPECT_EQ(ConfigError("lms200: {noise_sigma_m: 0.02}"), "no error");
+}
+
 }  // namespace
 }  // namespace pitchlab::sensors

@@ -146,6 +146,29 @@ TEST(Simulation, PlacementOnTopOfAThinWallIsAClearError) {
       << pose.error().message;
 }
 
+// A world of boxes only (no terrain geom): the first surface from above is not always ground.
+constexpr char kTableWorld[] = R"(
+<mujoco model="table">
+  <worldbody>
+    <geom name="floor" type="box" pos="0 0 -0.05" size="10 10 0.05"/>
+    <geom name="table_top" type="box" pos="3 0 0.75" size="1 1 0.02"/>
+    <geom name="block" type="box" pos="-3 0 4" size="2 2 4"/>
+  </worldbody>
+</mujoco>)";
+
+TEST(Simulation, PlacementOnATableTopOrARoofIsAClearError) {
+  auto sim = Simulation::FromString(kTableWorld, "/tmp", Robot(P3Model::kP3AT));
+  for (const double x : {3.0, -3.0}) {  // the table (0.73 m above the floor), the block (8 m)
+    Result<Eigen::Isometry3d> pose = sim->PlaceRobot(x, 0.0, 0.0);
+    ASSERT_FALSE(pose) << x;
+    EXPECT_EQ(pose.error().code, Error::Code::kInvalidArgument);
+    EXPECT_NE(pose.error().message.find("is on top of an obstacle, not on the ground"),
+              std::string::npos)
+        << pose.error().message;
+  }
+  EXPECT_TRUE(sim->PlaceRobot(0.0, 5.0, 0.0));  // the floor itself
+}
+
 TEST(Simulation, PlacementOnAnEvenSlopeSettlesTiltedLikeTheSlope) {
   auto sim = Simulation::FromString(kBoxFloorWorld, "/tmp", Robot(P3Model::kP3AT));
   SimBase base(*sim);  // its wheel servo holds the robot on the slope, as the P3 firmware does

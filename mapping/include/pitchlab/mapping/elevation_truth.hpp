@@ -4,6 +4,7 @@
 // it.
 
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 #include "pitchlab/mapping/elevation_layers.hpp"
@@ -26,6 +27,9 @@ struct TruthConfig {
   /// 0 disables: the first surface from above counts, whatever is below it.
   double min_headroom_m = 0.6;
   int max_overhangs = 3;  ///< overhang layers looked through per vertical line [1]
+  /// Called after each row of cells with (rows done, rows) when set: the truth of a large world
+  /// takes seconds, and a command says how far it is.
+  std::function<void(int done, int rows)> progress;
 };
 
 /// The true elevation map over `geometry`: for each of the k x k vertical lines per cell, the

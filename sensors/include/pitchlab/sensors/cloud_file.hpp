@@ -16,8 +16,13 @@ namespace pitchlab::sensors {
 const char* CloudFormatsHelp();
 
 /// Reads a point cloud, the format chosen by the extension (case-insensitive): .pcd (ReadScanPcd),
-/// .3d (Read3dtkScan), .ply (ReadPly), .xyz / .txt (ReadXyz). An unknown extension is an error.
+/// .3d (Read3dtkScan), .ply (ReadPly), .xyz / .txt (ReadXyz). An unknown extension is an error;
+/// so is a point CheckPointsPlausible rejects.
 [[nodiscard]] Result<Scan3D> ReadCloudFile(const std::string& path);
+
+/// Every point of `scan` (read from `path`) lies within kMaxCoordinate_m of its frame's origin on
+/// each axis; else an error naming the file, the first such point's index and its coordinates.
+[[nodiscard]] Result<void> CheckPointsPlausible(const Scan3D& scan, const std::string& path);
 
 /// A 3DTK "uos" scan `scanNNN.3d` (centimetres, 3DTK's left-handed x right, y up, z forward) with
 /// its odometry `scanNNN.pose` beside it, in REP-103 metres: points in the scanner's frame

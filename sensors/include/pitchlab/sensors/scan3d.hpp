@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -29,6 +30,12 @@ struct MountConfig {
 /// pitch `gamma_rad`, as a point in base_link [m].
 Eigen::Vector3d BeamPointInBase(double rho_m, double theta_rad, double gamma_rad,
                                 const MountConfig& mount);
+
+/// Farthest a coordinate (a point, a pose's translation) may lie from its frame's origin [m]:
+/// float32, which PCD's x y z and the maps' points use, spaces values 7.8 mm apart from 65.5 km
+/// (2^16 m) up, near the LMS200's 10 mm cm-mode resolution; beyond 100 km the numbers cannot
+/// hold what the sensor measured, so a value past it is a corrupt or foreign-unit file.
+constexpr double kMaxCoordinate_m = 1.0e5;
 
 /// One point of a 3D scan, in base_link.
 struct ScanPoint {
@@ -62,6 +69,9 @@ struct Scan3D {
   /// Where the sensor (the laser's mirror centre) stood, in the points' frame [m]; unset when the
   /// source does not say (a foreign PLY or XYZ file). Free-space carving casts rays from it.
   std::optional<Eigen::Vector3d> sensor_origin;
+  /// The world the scan was taken in (a simulated world's name, the stem of its MJCF file), so a
+  /// tool scoring it against a world's truth can tell it is the right one; empty when unknown.
+  std::string world;
 };
 
 /// The largest rotation between any of `attitudes` and the last one [rad]; 0 when empty.

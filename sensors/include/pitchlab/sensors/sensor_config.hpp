@@ -24,7 +24,8 @@ struct SensorConfig {
 /// Reads the sections `lms200`, `pitch_unit`, `scan`, `mount` of a YAML document over the
 /// defaults; other top-level sections belong to other modules and are left alone. A key unknown
 /// inside these sections, a wrong type or an invalid value throws std::invalid_argument naming
-/// `source`, the field and the value.
+/// `source`, the field and the value; so does a key given twice anywhere in the document (every
+/// config is read through here first, so this is the one place that checks it).
 SensorConfig ParseSensorConfig(const std::string& yaml_text, const std::string& source);
 
 /// The same sections as YAML (degrees, metres), readable back by ParseSensorConfig.

@@ -1,0 +1,144 @@
+// Ctrl-C and `kill` to `pitchlab run` and `pitchlab bench`, and a disk that fills up under a run
+// (issue 18): the process says what happened, removes its unfinished (hidden, staged) output, and
+// exits 128 + signal, or 1 naming the file it could not write.
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "cli_support.hpp"
+
+namespace pitchlab {
+namespace {
+
+namespace fs = std::filesystem;
+using cli_test::Slurp;
+
+const fs::path kYard = fs::path(PITCHLAB_SOURCE_DIR) / "tests/data/worlds/yard.xml";
+// A run creates its staging folder within a second of starting (before its ground truth); on a
+// loaded 2-core CI machine, allow far more.
+constexpr auto kStagingAppears = std::chrono::seconds(60);
+
+struct Ended {
+  int exit_code = -1;
+  std::string err;
+};
+
+class InterruptCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = cli_test::FreshTestDir("pitchlab_interrupt");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Starts `pitchlab args...` with stderr into dir_/stderr.txt; `max_file_bytes` > 0 limits the
+  // size of any file it writes (a full disk, portably: writes past it fail with EFBIG).
+  pid_t Start(std::vector<std::string> args, rlim_t max_file_bytes = 0) {
+    args.insert(args.begin(), PITCHLAB_CLI);
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    const std::string err = (dir_ / "stderr.txt").string();
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+      const int fd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      ::dup2(fd, 2);
+      if (max_file_bytes > 0) {
+        ::signal(SIGXFSZ, SIG_IGN);  // kept across exec: the write fails instead of killing
+        const rlimit limit{max_file_bytes, max_file_bytes};
+        ::setrlimit(RLIMIT_FSIZE, &limit);
+      }
+      ::execv(argv[0], argv.data());
+      ::_exit(127);
+    }
+    return pid;
+  }
+  // Waits until a hidden staging folder whose name starts with `prefix` exists under `folder`.
+  static bool StagingAppears(const fs::path& folder, const std::string& prefix) {
+    const auto deadline = std::chrono::steady_clock::now() + kStagingAppears;
+    while (std::chrono::steady_clock::now() < deadline) {
+      if (!Staging(folder, prefix).empty()) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return false;
+  }
+  static std::vector<std::string> Staging(const fs::path& folder, const std::string& prefix) {
+    std::vector<std::string> found;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(folder, ec)) {
+      const std::string name = e.path().filename().string();
+      if (name.rfind(prefix, 0) == 0 && name.find(".partial") != std::string::npos)
+        found.push_back(name);
+    }
+    return found;
+  }
+  Ended Wait(pid_t pid) {
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(dir_ / "stderr.txt")};
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(InterruptCli, RunRemovesItsStagingFolderAndSaysSoOnEitherSignal) {
+  for (const int signal : {SIGINT, SIGTERM}) {
+    const fs::path out = dir_ / ("run" + std::to_string(signal));
+    const pid_t pid = Start({"run", "--world", kYard.string(), "--out", out.string()});
+    ASSERT_TRUE(StagingAppears(dir_, "." + out.filename().string())) << Slurp(dir_ / "stderr.txt");
+    ::kill(pid, signal);
+    const Ended e = Wait(pid);
+    EXPECT_EQ(e.exit_code, 128 + signal) << e.err;
+    EXPECT_NE(e.err.find(signal == SIGINT ? "interrupted by SIGINT" : "interrupted by SIGTERM"),
+              std::string::npos)
+        << e.err;
+    EXPECT_NE(e.err.find("removed the unfinished output folder '" + out.string() + "'"),
+              std::string::npos)
+        << e.err;
+    EXPECT_TRUE(Staging(dir_, "." + out.filename().string()).empty());
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
+TEST_F(InterruptCli, AFullDiskDuringARunNamesTheFileAndLeavesNothing) {
+  const fs::path out = dir_ / "run";
+  // 64 kB: less than the first stop's scan (tens of thousands of 28-byte points).
+  const pid_t pid = Start({"run", "--world", kYard.string(), "--quiet", "--out", out.string()},
+                          64 * 1024);
+  const Ended e = Wait(pid);
+  EXPECT_EQ(e.exit_code, 1) << e.err;
+  EXPECT_NE(e.err.find("cannot write PCD '" + (out / "stops").string()), std::string::npos)
+      << e.err;
+  EXPECT_NE(e.err.find(std::strerror(EFBIG)), std::string::npos) << e.err;
+  EXPECT_TRUE(Staging(dir_, ".run").empty());
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(InterruptCli, BenchStopsItsRunsAndLeavesNoStagingFolder) {
+  const fs::path bench = dir_ / "bench";
+  const pid_t pid = Start({"bench", "--worlds", kYard.string(), "--seeds", "1", "--out",
+                           bench.string(), "--timeout-s", "600"});
+  ASSERT_TRUE(StagingAppears(bench / "runs", ".yard-s1")) << Slurp(dir_ / "stderr.txt");
+  ::kill(pid, SIGTERM);  // the bench alone, as a service manager stops it
+  const Ended e = Wait(pid);
+  EXPECT_EQ(e.exit_code, 128 + SIGTERM) << e.err;
+  EXPECT_NE(e.err.find("interrupted by SIGTERM"), std::string::npos) << e.err;
+  EXPECT_TRUE(Staging(bench / "runs", ".yard-s1").empty());
+  EXPECT_FALSE(fs::exists(bench / "runs" / "yard-s1"));
+}
+
+}  // namespace
+}  // namespace pitchlab
