@@ -30,5 +30,15 @@ fi
 
 echo "setup: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
+# Installing slurmctld/slurmd/munge must not start the system's daemons: pitchlab's tests start
+# private ones, and slurmctld without /etc/slurm/slurm.conf fails to start, which can fail the
+# install. policy-rc.d exit 101 is Debian's "do not start services" (invoke-rc.d(8)); ours is
+# removed afterwards, an existing one is left alone.
+policy=/usr/sbin/policy-rc.d
+if [ ! -e "$policy" ]; then
+  printf '#!/bin/sh\nexit 101\n' > "$policy"
+  chmod +x "$policy"
+  trap 'rm -f "$policy"' EXIT
+fi
 apt-get update -q
 apt-get install -y -q --no-install-recommends "${missing[@]}"
