@@ -322,7 +322,7 @@ std::string UntrustedGuess(const Weakness& weak, RegistrationPath path,
     os << "may be " << u->translation_m << " m / " << u->rotation_deg << " deg off (carry_max_m "
        << config.carry_max_m << ", carry_max_deg " << config.carry_max_deg << ")";
   } else {
-    os << "has no error bound (odometry_uncertainty)";
+    os << "has no error bound (register --prior-error, the run's odometry bound)";
   }
   os << ": the pose is not determined";
   return os.str();
@@ -918,7 +918,7 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
       u && !(u->translation_m >= 0 && std::isfinite(u->translation_m) && u->rotation_deg >= 0 &&
              std::isfinite(u->rotation_deg))) {
     std::ostringstream os;
-    os << "odometry_uncertainty must be finite and >= 0, got " << u->translation_m << " m / "
+    os << "the odometry prior's error bound (--prior-error) must be finite and >= 0, got " << u->translation_m << " m / "
        << u->rotation_deg << " deg";
     return Fail(Error::Code::kInvalidArgument, os.str());
   }
