@@ -196,6 +196,17 @@ int RunEmulate(int argc, char** argv) {
               << "pitch_unit " << paths["pitch_unit"].get<std::string>() << "\n"
               << "base       " << paths["base"].get<std::string>() << std::endl;
   }
+  // What the paths are, on stderr: stdout stays the three paths (or the JSON) for scripts.
+  std::fprintf(stderr,
+               "hw emulate: %s simulated behind three pseudo-terminals, opened like serial "
+               "ports:\n"
+               "  lms200      SICK LMS200 telegrams, 9600 baud after power-on (switches on "
+               "request)\n"
+               "  pitch_unit  the pitching servo's board, %d baud\n"
+               "  base        Pioneer P3 (P2OS/ARCOS packets), %d baud\n"
+               "Name them in a config's hw section and run `pitchlab run --backend hw --config "
+               "FILE --world %s` (hw/README.md). Ctrl-C or SIGTERM stops the emulators.\n",
+               world_path.stem().c_str(), pitch_baud, base_baud, world_path.stem().c_str());
   std::signal(SIGINT, [](int) { g_interrupted = true; });
   std::signal(SIGTERM, [](int) { g_interrupted = true; });
   while (!g_interrupted) std::this_thread::sleep_for(std::chrono::milliseconds(100));

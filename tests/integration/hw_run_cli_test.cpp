@@ -434,6 +434,16 @@ class HwEmulate : public HwRunCli {
   std::unique_ptr<Emulators> emulators_;
 };
 
+// Beside the paths (stdout, for scripts) it says on stderr what each one is, at which rate, and
+// how to stop it (issue 18: three bare pty paths said neither).
+TEST_F(HwEmulate, SaysWhatEachDeviceIsAndHowToStop) {
+  const std::string said = Slurp(dir_ / "emulator.log");
+  for (const char* what : {"SICK LMS200", "pitching servo", "Pioneer P3", "9600 baud",
+                           "--backend hw", "Ctrl-C"}) {
+    EXPECT_NE(said.find(what), std::string::npos) << "no '" << what << "' in:\n" << said;
+  }
+}
+
 TEST_F(HwEmulate, TheBaseAnswersAt9600WhereAP3OpensItsHostPort) {
   Line base(Path("base"), 9600);
   base.Write(kSync0);
