@@ -387,7 +387,10 @@ int RunHwMission(int argc, char** argv) {
 
   MissionObserver observer;
   observer.on_stop = [&](const StopRecord& stop, const MissionResult& so_far) {
-    WriteStopOutputs(folder, stop, so_far, frame.origin);
+    WriteStopOutputs(folder, stop, so_far, frame.origin,
+                     frame.world_file.empty()
+                         ? std::string()
+                         : std::filesystem::path(frame.world_file).stem().string());
   };
   observer.on_progress = [&](const std::string& text) {
     if (quiet) return;

@@ -189,14 +189,8 @@ int RunEmulate(int argc, char** argv) {
   const auto world_path = worlds::ResolveWorld(args.Get("world"), WorldsDir());
   SimulatedDevices devices(world_path.string(), config, pitch_baud, base_baud);
   const nlohmann::json paths = devices.Paths();
-  if (args.Flagged("json")) {
-    std::cout << paths.dump(2) << std::endl;
-  } else {
-    std::cout << "lms200     " << paths["lms200"].get<std::string>() << "\n"
-              << "pitch_unit " << paths["pitch_unit"].get<std::string>() << "\n"
-              << "base       " << paths["base"].get<std::string>() << std::endl;
-  }
-  // What the paths are, on stderr: stdout stays the three paths (or the JSON) for scripts.
+  // What the paths are, on stderr, before the paths: stdout stays the three paths (or the JSON)
+  // for scripts, and a script that has read them has the explanation in its log too.
   std::fprintf(stderr,
                "hw emulate: %s simulated behind three pseudo-terminals, opened like serial "
                "ports:\n"
@@ -207,6 +201,13 @@ int RunEmulate(int argc, char** argv) {
                "Name them in a config's hw section and run `pitchlab run --backend hw --config "
                "FILE --world %s` (hw/README.md). Ctrl-C or SIGTERM stops the emulators.\n",
                world_path.stem().c_str(), pitch_baud, base_baud, world_path.stem().c_str());
+  if (args.Flagged("json")) {
+    std::cout << paths.dump(2) << std::endl;
+  } else {
+    std::cout << "lms200     " << paths["lms200"].get<std::string>() << "\n"
+              << "pitch_unit " << paths["pitch_unit"].get<std::string>() << "\n"
+              << "base       " << paths["base"].get<std::string>() << std::endl;
+  }
   std::signal(SIGINT, [](int) { g_interrupted = true; });
   std::signal(SIGTERM, [](int) { g_interrupted = true; });
   while (!g_interrupted) std::this_thread::sleep_for(std::chrono::milliseconds(100));

@@ -186,7 +186,7 @@ int RunRun(int argc, char** argv) {
   };
   MissionObserver observer;
   observer.on_stop = [&](const StopRecord& stop, const MissionResult& so_far) {
-    WriteStopOutputs(folder, stop, so_far, origin);
+    WriteStopOutputs(folder, stop, so_far, origin, world_path.stem().string());
   };
   observer.on_progress = [&](const std::string& text) {
     if (quiet) return;

@@ -131,11 +131,14 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
 }  // namespace
 
 void WriteStopOutputs(RunFolder& folder, const StopRecord& stop, const MissionResult& so_far,
-                      const std::optional<mapping::GeodeticOrigin>& origin) {
+                      const std::optional<mapping::GeodeticOrigin>& origin,
+                      const std::string& world) {
   char dir[32];
   std::snprintf(dir, sizeof(dir), "stops/%03d/", stop.index);
   const std::string d = dir;
-  Check(sensors::WriteScanPcd(stop.scan, folder.File(d + "scan.pcd").string()));
+  sensors::Scan3D scan = stop.scan;
+  scan.world = world;
+  Check(sensors::WriteScanPcd(scan, folder.File(d + "scan.pcd").string()));
   WriteTextFile(folder.File(d + "registration.json"), RegistrationJson(stop).dump(2));
   if (stop.plan) {
     Check(planning::WritePathCsv(*stop.plan, folder.File(d + "path.csv").string()));
@@ -217,6 +220,7 @@ void WriteFinalOutputs(RunFolder& folder, const RunContext& c, const MissionResu
     q.x = p.x(), q.y = p.y(), q.z = p.z();
     cloud.points.push_back(q);
   }
+  cloud.world = std::filesystem::path(c.world_file).stem().string();  // in the world's frame
   Check(sensors::WriteScanPcd(cloud, folder.File("map_cloud.pcd").string()));
   Check(mapping::SaveElevationMap(r.elevation, folder.File("elevation.plem").string()));
   const mapping::ElevationLayers layers = mapping::ComputeLayers(r.elevation, c.layers);

@@ -31,9 +31,12 @@ struct RunContext {
 };
 
 /// Writes stops/NN/{scan.pcd, registration.json, path.csv, path.geojson, map.png, map_small.png}.
-/// Throws std::runtime_error naming the file on a write failure.
+/// `world`: the world's name (its file's stem; empty when unknown), written into scan.pcd so that
+/// `map --world` can tell a scan of another world. Throws std::runtime_error naming the file on a
+/// write failure.
 void WriteStopOutputs(RunFolder& folder, const StopRecord& stop, const MissionResult& so_far,
-                      const std::optional<mapping::GeodeticOrigin>& origin);
+                      const std::optional<mapping::GeodeticOrigin>& origin,
+                      const std::string& world);
 
 /// metrics.json's content.
 nlohmann::json RunMetrics(const RunContext& context, const MissionResult& result,

@@ -87,7 +87,9 @@ TEST_F(RunCli, AMissionAroundABlockReachesTheGoalAndWritesEveryOutput) {
   for (int k = 0; k < stops; ++k) {
     char stop[32];
     std::snprintf(stop, sizeof(stop), "stops/%03d/", k);
-    ASSERT_TRUE(sensors::ReadScanPcd((run / stop / "scan.pcd").string())) << stop;
+    const auto scan = sensors::ReadScanPcd((run / stop / "scan.pcd").string());
+    ASSERT_TRUE(scan) << stop;
+    EXPECT_EQ(scan->world, "yard") << stop;  // so `map --world` can refuse it for another world
     EXPECT_NO_THROW(nlohmann::json::parse(Slurp(run / stop / "registration.json"))) << stop;
     EXPECT_EQ(Slurp(run / stop / "map.png").substr(1, 3), "PNG") << stop;
   }
@@ -96,6 +98,7 @@ TEST_F(RunCli, AMissionAroundABlockReachesTheGoalAndWritesEveryOutput) {
   const auto cloud = sensors::ReadScanPcd((run / "map_cloud.pcd").string());
   ASSERT_TRUE(cloud);
   EXPECT_GT(cloud->points.size(), 1000u);
+  EXPECT_EQ(cloud->world, "yard");
   EXPECT_TRUE(mapping::LoadElevationMap((run / "elevation.plem").string()));
   EXPECT_NE(Slurp(run / "elevation.asc").find("ncols"), std::string::npos);
   EXPECT_NE(Slurp(run / "elevation.prj").find("PROJCS"), std::string::npos);
