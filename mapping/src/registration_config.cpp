@@ -1,4 +1,5 @@
 #include "pitchlab/mapping/registration_config.hpp"
+#include "pitchlab/sensors/yaml_keys.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -232,6 +233,7 @@ RegistrationConfig ParseRegistrationConfig(const std::string& yaml_text,
   } catch (const YAML::Exception& e) {
     throw std::invalid_argument(source + ": not YAML: " + e.what());
   }
+  sensors::CheckUniqueYamlKeys(yaml_text, source);
   RegistrationConfig config;
   const YAML::Node node = root.IsMap() ? root[kSection] : YAML::Node();
   if (!node) return config;

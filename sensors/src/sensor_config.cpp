@@ -1,4 +1,5 @@
 #include "pitchlab/sensors/sensor_config.hpp"
+#include "pitchlab/sensors/yaml_keys.hpp"
 
 #include <cmath>
 #include <functional>
@@ -61,26 +62,6 @@ struct Vec3 {
   double v[3] = {0, 0, 0};
 };
 
-// yaml-cpp keeps every pair of a mapping and `node[key]` answers the first: a key given twice
-// would silently drop the second value, which is the one a user who appended it meant.
-void CheckUniqueKeys(const YAML::Node& node, const std::string& path, const std::string& source) {
-  if (node.IsSequence()) {
-    for (std::size_t i = 0; i < node.size(); ++i) CheckUniqueKeys(node[i], path, source);
-  }
-  if (!node.IsMap()) return;
-  std::map<std::string, int> first_line;
-  for (const auto& kv : node) {
-    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "<non-scalar key>";
-    const std::string name = path.empty() ? key : path + "." + key;
-    const int line = kv.first.Mark().line + 1;
-    if (auto [it, fresh] = first_line.emplace(key, line); !fresh) {
-      throw std::invalid_argument(source + ": " + name + " is given twice (lines " +
-                                  std::to_string(it->second) + " and " + std::to_string(line) +
-                                  "); keep one");
-    }
-    CheckUniqueKeys(kv.second, name, source);
-  }
-}
 
 }  // namespace
 }  // namespace pitchlab::sensors
@@ -127,7 +108,7 @@ SensorConfig ParseSensorConfig(const std::string& yaml_text, const std::string& 
   }
   if (root.IsNull()) return {};
   if (!root.IsMap()) throw std::invalid_argument(source + ": the top level must be a map");
-  CheckUniqueKeys(root, "", source);
+  CheckUniqueYamlKeys(yaml_text, source);
 
   SensorConfig c;
   auto& l = c.lms200;

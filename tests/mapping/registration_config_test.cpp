@@ -40,6 +40,13 @@ TEST(RegistrationConfig, AnUnknownKeyIsAnErrorNamingIt) {
             "test.yaml: registration.voxel_size is not a known setting");
 }
 
+// yaml-cpp answers the first of two equal keys: the second, the one a user appended, would be
+// dropped without a word (issue 18).
+TEST(RegistrationConfig, AKeyGivenTwiceIsAnErrorNamingBothLines) {
+  EXPECT_EQ(ErrorOf("registration:\n  icp_voxel_m: 0.1\n  icp_voxel_m: 0.2\n"),
+            "test.yaml: registration.icp_voxel_m is given twice (lines 2 and 3); keep one");
+}
+
 TEST(RegistrationConfig, AWrongTypeOrValueIsAnErrorNamingFieldAndValue) {
   EXPECT_EQ(ErrorOf("registration: {icp_max_iterations: lots}"),
             "test.yaml: registration.icp_max_iterations has the wrong type ('lots')");
