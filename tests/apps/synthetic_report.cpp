@@ -1,3 +1,5 @@
+// Test fixture, not a test: builds the small synthetic run (a map, a cloud, trajectories) that
+// run_report_test and report_browser_test write a report from and assert on.
 #include "synthetic_report.hpp"
 
 #include <cmath>
