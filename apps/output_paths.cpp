@@ -17,12 +17,11 @@ namespace fs = std::filesystem;
 // are created with it (`runs/` on a first run), so its nearest existing ancestor is checked; a
 // file's parent must exist (the writers create no folders).
 void CheckParent(const std::string& option, const fs::path& path, bool create_parents) {
-  fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  auto up = [](const fs::path& p) { return p.has_parent_path() ? p.parent_path() : fs::path("."); };
+  fs::path parent = up(path);
   std::error_code ec;
-  while (create_parents && !fs::exists(parent, ec) && parent.has_parent_path() &&
-         parent.parent_path() != parent) {
-    parent = parent.parent_path();
-  }
+  // "runs" (a relative path of one name) has no parent_path: its parent is the working folder.
+  while (create_parents && !fs::exists(parent, ec) && up(parent) != parent) parent = up(parent);
   if (!fs::is_directory(parent, ec)) {
     throw std::runtime_error("--" + option + " '" + path.string() + "': '" + parent.string() +
                              (fs::exists(parent, ec) ? "' is not a folder" : "' does not exist"));
