@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -16,7 +18,7 @@
 #include "pitchlab/planning/path_io.hpp"
 #include "pitchlab/planning/planner.hpp"
 #include "pitchlab/planning/traversability.hpp"
-#include "output_paths.hpp"
+#include "pitchlab/sensors/yaml_keys.hpp"
 #include "output_paths.hpp"
 #include "run_folder.hpp"
 #include "traversability_image.hpp"
@@ -25,6 +27,16 @@ namespace pitchlab::apps {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
+
+// --config: as every pitchlab config, a key given twice is refused (yaml-cpp would keep the first).
+planning::PlannerConfig ReadPlannerConfig(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot read the planner config");
+  std::stringstream text;
+  text << in.rdbuf();
+  sensors::CheckUniqueYamlKeys(text.str(), path);
+  return planning::ParsePlannerConfig(text.str(), path);
+}
 
 CliArgs PlanArgs() {
   CliArgs args(
@@ -75,7 +87,7 @@ int RunPlan(int argc, char** argv) {
   const std::filesystem::path out = args.Get("out");
   CheckNewFolder("out", out);  // as run and map: never into an existing folder
   planning::PlannerConfig config;
-  if (args.Has("config")) config = planning::LoadPlannerConfig(args.Get("config"));
+  if (args.Has("config")) config = ReadPlannerConfig(args.Get("config"));
   try {
     if (args.Has("robot")) config.robot = planning::RobotLimits::Preset(args.Get("robot"));
   } catch (const std::invalid_argument& e) {

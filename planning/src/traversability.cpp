@@ -4,10 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <iterator>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 
 #include "move_cost.hpp"
@@ -319,14 +317,6 @@ PlannerConfig ParsePlannerConfig(const std::string& yaml_text, const std::string
     throw std::runtime_error(source + ": " + e.what());
   }
   return c;
-}
-
-PlannerConfig LoadPlannerConfig(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot read the planner config");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ParsePlannerConfig(ss.str(), path);
 }
 
 const char* ToString(Blocked b) {

@@ -227,6 +227,29 @@ TEST_F(BadInputCli, AMapTooBigForAMapSaysWhetherAStrayPointOrTheCellIsTheCause) 
   EXPECT_EQ(Left({"floor.pcd", "stray.pcd"}), std::vector<std::string>{});
 }
 
+TEST_F(BadInputCli, RunningOutOfMemoryIsAnErrorSayingSo) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer reserves more address space than the limit below allows";
+#else
+  // 10000 x 10000 cells: a few GB, less than the machine has (so map's own check before the
+  // allocation passes) but more than the 2.5 GB of address space the process is given here.
+  const double memory = double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGE_SIZE));
+  if (memory < 16e9) GTEST_SKIP() << "map refuses the area itself on a machine under 16 GB";
+  Pcd("floor.pcd", {"1 0 0", "2 0 0", "1 1 0"});
+  const fs::path out = dir_ / "scratch" / "stdout.txt", err = dir_ / "scratch" / "stderr.txt";
+  const std::string command = "ulimit -v 2500000; exec " + std::string(PITCHLAB_CLI) + " map " +
+                              (dir_ / "floor.pcd").string() +
+                              " --no-level --area 0,0,100,100 --cell 0.01 --out " + Out("m") +
+                              " >" + out.string() + " 2>" + err.string();
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1) << Slurp(err);
+  EXPECT_NE(Slurp(err).find("pitchlab map: error: out of memory"), std::string::npos)
+      << Slurp(err);
+  EXPECT_EQ(Left({"floor.pcd"}), std::vector<std::string>{});
+#endif
+}
+
 TEST_F(BadInputCli, ADuplicateConfigKeyIsAnErrorNamingIt) {
   std::ofstream(dir_ / "dup.yaml") << "lms200:\n  noise_sigma_m: 0.01\n  noise_sigma_m: 0.5\n";
   const CliResult r = Exec("scan --world office --config " + (dir_ / "dup.yaml").string() +
@@ -236,6 +259,25 @@ TEST_F(BadInputCli, ADuplicateConfigKeyIsAnErrorNamingIt) {
       << r.err;
   EXPECT_EQ(r.err.find(kScanStarted), std::string::npos) << r.err;
   EXPECT_EQ(Left({"dup.yaml"}), std::vector<std::string>{});
+}
+
+TEST_F(BadInputCli, ADuplicatePlannerKeyIsAnErrorNamingIt) {
+  std::ofstream(dir_ / "planner.yaml") << "unknown: penalise\nstep_max_m: 0.05\nstep_max_m: 0.2\n";
+  // plan's own --config, read before the map.
+  CliResult r = Exec("plan " + (dir_ / "absent.plem").string() + " --config " +
+                     (dir_ / "planner.yaml").string() + " --start 0,0 --goal 1,1 --out " +
+                     Out("p"));
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("planner.yaml: step_max_m is given twice (lines 2 and 3)"),
+            std::string::npos)
+      << r.err;
+  // The planner section of a run's config.
+  std::ofstream(dir_ / "run.yaml") << "planner:\n  step_max_m: 0.05\n  step_max_m: 0.2\n";
+  r = Exec("run --world office --config " + (dir_ / "run.yaml").string() + " --out " + Out("r"));
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("planner.step_max_m is given twice (lines 2 and 3)"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(Left({"planner.yaml", "run.yaml"}), std::vector<std::string>{});
 }
 
 TEST_F(BadInputCli, BenchResumedWithAnotherConfigIsRefusedBeforeAnyRun) {

@@ -38,7 +38,7 @@ struct RobotLimits {
 /// What unknown cells are to the planner.
 enum class UnknownPolicy { kForbid, kPenalise };
 
-/// Everything a plan is configured by (YAML: see LoadPlannerConfig).
+/// Everything a plan is configured by (YAML: see ParsePlannerConfig).
 struct PlannerConfig {
   CostWeights weights;
   RobotLimits robot = RobotLimits::P3AT();
@@ -57,7 +57,7 @@ struct PlannerConfig {
   void Validate() const;
 };
 
-/// Reads a planner YAML file:
+/// Reads planner YAML (`source_name`, e.g. the file's path, names it in messages):
 ///   robot: p3at                  # preset (p3at | p3dx), then any of its fields overridden:
 ///   step_max_m: 0.089
 ///   max_inclination_deg: 19.3
@@ -67,9 +67,8 @@ struct PlannerConfig {
 ///   unknown_penalty: 1.0
 ///   clearance_m: 0.0             # soft clearance from hazards, and its cost at the footprint
 ///   clearance_cost: 0.0
-/// Missing fields keep their defaults. Throws std::runtime_error naming the file, field and value.
-PlannerConfig LoadPlannerConfig(const std::string& path);
-/// The same from YAML text; `source_name` is used in error messages.
+/// Missing fields keep their defaults. Throws std::runtime_error naming the source, field and
+/// value. A key given twice is the caller's to refuse (sensors::CheckUniqueYamlKeys, as the apps do).
 PlannerConfig ParsePlannerConfig(const std::string& yaml_text, const std::string& source_name);
 
 /// Why a cell may not be entered.
