@@ -46,13 +46,20 @@ Eigen::Isometry3d Exp(const Vector6d& e) {  // the registration's [R(omega), v]
 // Stop k on the loop: 7.5 m east, 5 m north, 7.5 m west, 5 m south, one stop a metre, the
 // heading turning at the corners; the floor undulates by 5 cm.
 Eigen::Isometry3d TruePose(int k) {
+  struct Side {
+    double start_m, x, y, dx, dy, yaw_deg;  // where it starts along the lap, its corner, heading
+  };
+  static const Side kSides[4] = {{0, 0, 0, 1, 0, 0},
+                                 {7.5, 7.5, 0, 0, 1, 90},
+                                 {12.5, 7.5, 5, -1, 0, 180},
+                                 {20, 0, 5, 0, -1, 270}};
   const double s = k % kStopsPerLap;  // metres along the lap
-  double x, y, yaw;
-  if (s < 7.5) x = s, y = 0, yaw = 0;
-  else if (s < 12.5) x = 7.5, y = s - 7.5, yaw = 90;
-  else if (s < 20) x = 7.5 - (s - 12.5), y = 5, yaw = 180;
-  else x = 0, y = 5 - (s - 20), yaw = 270;
-  return pitchlab::mapping::PoseFromXyzRpyDeg(x, y, 0.05 * std::sin(0.7 * k), 0, 0, yaw);
+  int i = 3;
+  while (s < kSides[i].start_m) --i;
+  const Side& side = kSides[i];
+  const double along = s - side.start_m;
+  return pitchlab::mapping::PoseFromXyzRpyDeg(side.x + along * side.dx, side.y + along * side.dy,
+                                              0.05 * std::sin(0.7 * k), 0, 0, side.yaw_deg);
 }
 
 struct Stop {
@@ -92,16 +99,14 @@ Mission MakeMission(int stop_count) {
   const std::vector<int> loop_stops{30, 37, 44, 52, 58, 66, 73, 81, 90, 99};
   const std::vector<int> false_stops{41, 70, 95};
   for (int k = 1; k < stop_count; ++k) {
-    m.stops[k].sequential =
-        Measured(m.truth, k - 1, k, k % 10 == 0, EdgeKind::kSequential, rng, 0);
+    m.stops[k].sequential = Measured(m.truth, k - 1, k, k % 10 == 0, EdgeKind::kSequential, rng, 0);
     if (std::find(loop_stops.begin(), loop_stops.end(), k) != loop_stops.end()) {
       m.stops[k].loops.push_back(
           Measured(m.truth, k % kStopsPerLap, k, false, EdgeKind::kLoop, rng, 0));
     }
     if (std::find(false_stops.begin(), false_stops.end(), k) != false_stops.end()) {
-      m.stops[k].loops.push_back(
-          Measured(m.truth, (k % kStopsPerLap + 3) % kStopsPerLap, k, false, EdgeKind::kLoop,
-                   rng, 2.0));
+      m.stops[k].loops.push_back(Measured(m.truth, (k % kStopsPerLap + 3) % kStopsPerLap, k, false,
+                                          EdgeKind::kLoop, rng, 2.0));
       ++m.stops[k].false_loops;
     }
   }
@@ -172,8 +177,8 @@ void BM_IncrementalMission(benchmark::State& state) {
     Mission no_loops = m;
     for (Stop& s : no_loops.stops) s.loops.clear();
     for (int k = 0; k < 100; ++k) RunStop(dead_reckoning, no_loops, k, ignored);
-    drift_m = pitchlab::mapping::AbsoluteTrajectoryErrorUnaligned(dead_reckoning.Poses(),
-                                                                   m.truth)->rmse_m;
+    drift_m = pitchlab::mapping::AbsoluteTrajectoryErrorUnaligned(dead_reckoning.Poses(), m.truth)
+                  ->rmse_m;
     for (const Stop& s : m.stops) {
       for (std::size_t i = 0; i < s.loops.size() - s.false_loops; ++i) {
         (void)dead_reckoning.AddEdge(s.loops[i]);
@@ -215,8 +220,13 @@ void BM_StopAtScans(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_StopAtScans)
-    ->Arg(25)->Arg(50)->Arg(99)->Arg(100)
-    ->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(10);
+    ->Arg(25)
+    ->Arg(50)
+    ->Arg(99)
+    ->Arg(100)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(10);
 
 // Which earlier nodes may see stop 100: the relative covariances of all 99 (one ceres::Covariance
 // with stop 100 held).

@@ -30,8 +30,8 @@ struct NodeParameters {
 
 NodeParameters ToParameters(const Eigen::Isometry3d& T) {
   const Eigen::Quaterniond q(T.rotation());
-  return {{q.x(), q.y(), q.z(), q.w()}, {T.translation().x(), T.translation().y(),
-                                          T.translation().z()}};
+  return {{q.x(), q.y(), q.z(), q.w()},
+          {T.translation().x(), T.translation().y(), T.translation().z()}};
 }
 
 Eigen::Isometry3d ToIsometry(const NodeParameters& p) {
@@ -84,8 +84,10 @@ std::string EdgeName(const PoseGraphEdge& edge) {
 
 const char* ToString(EdgeKind kind) {
   switch (kind) {
-    case EdgeKind::kSequential: return "sequential";
-    case EdgeKind::kLoop: return "loop";
+    case EdgeKind::kSequential:
+      return "sequential";
+    case EdgeKind::kLoop:
+      return "loop";
   }
   return "unknown";
 }
@@ -96,9 +98,9 @@ void PoseGraphConfig::Validate() const {
                                 std::to_string(loop_kernel_chi2) + ": must be finite and > 0");
   }
   if (!(loop_acceptance_probability > 0 && loop_acceptance_probability < 1)) {
-    throw std::invalid_argument("pose_graph.loop_acceptance_probability = " +
-                                std::to_string(loop_acceptance_probability) +
-                                ": must lie in (0, 1)");
+    throw std::invalid_argument(
+        "pose_graph.loop_acceptance_probability = " + std::to_string(loop_acceptance_probability) +
+        ": must lie in (0, 1)");
   }
   if (max_iterations < 1) {
     throw std::invalid_argument("pose_graph.max_iterations = " + std::to_string(max_iterations) +
@@ -120,7 +122,7 @@ struct PoseGraph::Impl {
 
   static ceres::Problem::Options ProblemOptions() {
     ceres::Problem::Options options;
-    options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;      // quaternion_manifold
+    options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;       // quaternion_manifold
     options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // loop_kernel
     options.enable_fast_removal = true;  // a rejected loop edge leaves again
     return options;
@@ -132,8 +134,7 @@ struct PoseGraph::Impl {
         new RelativePoseCost(edge.T_from_to, sqrt_information));
     NodeParameters& a = nodes[edge.from];
     NodeParameters& b = nodes[edge.to];
-    return problem.AddResidualBlock(cost, with_kernel ? &loop_kernel : nullptr, a.q, a.t, b.q,
-                                    b.t);
+    return problem.AddResidualBlock(cost, with_kernel ? &loop_kernel : nullptr, a.q, a.t, b.q, b.t);
   }
 
   Result<Matrix6d> CheckEdge(const PoseGraphEdge& edge) const {
@@ -166,7 +167,9 @@ struct PoseGraph::Impl {
       const int node = stack.back();
       stack.pop_back();
       for (int next : neighbours[node]) {
-        if (!reached[next]) stack.push_back(next), reached[next] = true;
+        if (reached[next]) continue;
+        reached[next] = true;
+        stack.push_back(next);
       }
     }
     const auto lost = std::find(reached.begin(), reached.end(), false);
@@ -178,10 +181,14 @@ struct PoseGraph::Impl {
   }
 
   Result<OptimizationSummary> Optimize() {
+    OptimizationSummary out;
+    if (nodes.empty()) {  // nothing to move
+      out.converged = true;
+      return out;
+    }
     if (auto connected = CheckConnected(0); !connected) {
       return tl::make_unexpected(connected.error());
     }
-    OptimizationSummary out;
     if (edges.empty()) {  // node 0 alone: nothing to move
       optimised = true;
       optimal_chi2 = 0;
@@ -217,15 +224,18 @@ struct PoseGraph::Impl {
     return 2 * cost;
   }
 
-  void SetAnchor(int anchor, bool held) {
-    NodeParameters& p = nodes[anchor];
-    if (held) {
-      problem.SetParameterBlockConstant(p.q);
-      problem.SetParameterBlockConstant(p.t);
-    } else {
-      problem.SetParameterBlockVariable(p.q);
-      problem.SetParameterBlockVariable(p.t);
-    }
+  void Hold(int node) {
+    problem.SetParameterBlockConstant(nodes[node].q);
+    problem.SetParameterBlockConstant(nodes[node].t);
+  }
+
+  // The gauge: which node is held fixed (node 0, the known start, except while a covariance
+  // relative to another node is computed).
+  void MoveAnchor(int from, int to) {
+    if (from == to) return;
+    problem.SetParameterBlockVariable(nodes[from].q);
+    problem.SetParameterBlockVariable(nodes[from].t);
+    Hold(to);
   }
 
   // Marginal covariances of the positions of `targets` with `anchor` held instead of node 0.
@@ -240,13 +250,13 @@ struct PoseGraph::Impl {
     options.algorithm_type = ceres::SPARSE_QR;
     options.num_threads = 1;
     ceres::Covariance covariance(options);
-    if (anchor != 0) SetAnchor(0, false), SetAnchor(anchor, true);
+    MoveAnchor(0, anchor);
     const bool computed = covariance.Compute(blocks, &problem);
-    if (anchor != 0) SetAnchor(anchor, false), SetAnchor(0, true);
+    MoveAnchor(anchor, 0);
     if (!computed) {
-      return Fail(Error::Code::kFailed,
-                  "pose graph: the covariance relative to node " + std::to_string(anchor) +
-                      " could not be computed (rank-deficient Jacobian)");
+      return Fail(Error::Code::kFailed, "pose graph: the covariance relative to node " +
+                                            std::to_string(anchor) +
+                                            " could not be computed (rank-deficient Jacobian)");
     }
     std::vector<Eigen::Matrix3d> out(targets.size());
     for (std::size_t i = 0; i < targets.size(); ++i) {
@@ -287,7 +297,7 @@ Result<int> PoseGraph::AddNode(const Eigen::Isometry3d& T_map_base) {
   NodeParameters& p = impl_->nodes.emplace_back(ToParameters(T_map_base));
   impl_->problem.AddParameterBlock(p.q, 4, &impl_->quaternion_manifold);
   impl_->problem.AddParameterBlock(p.t, 3);
-  if (index == 0) impl_->SetAnchor(0, true);  // the start is known
+  if (index == 0) impl_->Hold(0);  // the start is known
   impl_->optimised = false;
   return index;
 }
@@ -348,54 +358,68 @@ Result<Eigen::Matrix3d> PoseGraph::RelativePositionCovariance(int anchor, int no
   const int n = NodeCount();
   if (anchor < 0 || anchor >= n || node < 0 || node >= n || anchor == node) {
     return Fail(Error::Code::kInvalidArgument,
-                "pose graph: relative covariance of node " + std::to_string(node) +
-                    " to node " + std::to_string(anchor) + ": needs two distinct nodes of " +
-                    std::to_string(n));
+                "pose graph: relative covariance of node " + std::to_string(node) + " to node " +
+                    std::to_string(anchor) + ": needs two distinct nodes of " + std::to_string(n));
   }
   auto covariances = impl_->PositionCovariances(anchor, {node});
   if (!covariances) return tl::make_unexpected(covariances.error());
   return covariances->front();
 }
 
-Result<std::vector<LoopCandidate>> PoseGraph::LoopCandidates(
-    int node, const LoopCandidateQuery& query) const {
-  const Impl& g = *impl_;
-  if (node < 0 || node >= NodeCount()) {
-    return Fail(Error::Code::kInvalidArgument, "loop candidates: no node " + std::to_string(node));
+namespace {
+
+Result<void> CheckQuery(const LoopCandidateQuery& query) {
+  if (std::isfinite(query.max_distance_m) && query.max_distance_m > 0 && query.probability > 0 &&
+      query.probability < 1 && std::isfinite(query.min_travel_m) && query.min_travel_m >= 0) {
+    return {};
   }
-  if (!(std::isfinite(query.max_distance_m) && query.max_distance_m > 0) ||
-      !(query.probability > 0 && query.probability < 1) ||
-      !(std::isfinite(query.min_travel_m) && query.min_travel_m >= 0)) {
-    return Fail(Error::Code::kInvalidArgument,
-                "loop candidates: max_distance_m = " + std::to_string(query.max_distance_m) +
-                    " (finite, > 0), probability = " + std::to_string(query.probability) +
-                    " (in (0, 1)), min_travel_m = " + std::to_string(query.min_travel_m) +
-                    " (finite, >= 0)");
-  }
-  std::vector<bool> joined(node, false);  // nodes an edge already joins to `node`
-  for (const Impl::StoredEdge& s : g.edges) {
+  return Fail(Error::Code::kInvalidArgument,
+              "loop candidates: max_distance_m = " + std::to_string(query.max_distance_m) +
+                  " (finite, > 0), probability = " + std::to_string(query.probability) +
+                  " (in (0, 1)), min_travel_m = " + std::to_string(query.min_travel_m) +
+                  " (finite, >= 0)");
+}
+
+}  // namespace
+
+// Earlier nodes not joined to `node` by an edge and at least min_travel_m back along the
+// estimated trajectory, latest first.
+std::vector<int> PoseGraph::EarlierUnjoined(int node, double min_travel_m) const {
+  std::vector<bool> joined(node, false);
+  for (const Impl::StoredEdge& s : impl_->edges) {
     if (s.edge.to == node && s.edge.from < node) joined[s.edge.from] = true;
     if (s.edge.from == node && s.edge.to < node) joined[s.edge.to] = true;
   }
   const std::vector<Eigen::Isometry3d> poses = Poses();
-  std::vector<int> earlier;
-  double travel_m = 0;  // along the estimated trajectory, from `node` back to i
+  std::vector<int> out;
+  double travel_m = 0;  // from `node` back to i
   for (int i = node - 1; i >= 0; --i) {
     travel_m += (poses[i + 1].translation() - poses[i].translation()).norm();
-    if (!joined[i] && travel_m >= query.min_travel_m) earlier.push_back(i);
+    if (!joined[i] && travel_m >= min_travel_m) out.push_back(i);
   }
+  return out;
+}
+
+Result<std::vector<LoopCandidate>> PoseGraph::LoopCandidates(
+    int node, const LoopCandidateQuery& query) const {
+  if (node < 0 || node >= NodeCount()) {
+    return Fail(Error::Code::kInvalidArgument, "loop candidates: no node " + std::to_string(node));
+  }
+  if (auto ok = CheckQuery(query); !ok) return tl::make_unexpected(ok.error());
+  const std::vector<int> earlier = EarlierUnjoined(node, query.min_travel_m);
   std::vector<LoopCandidate> out;
   if (earlier.empty()) return out;
   auto covariances = impl_->PositionCovariances(node, earlier);
   if (!covariances) return tl::make_unexpected(covariances.error());
   // The relative position lies within k sigma along the most uncertain axis with `probability`.
   const double k = std::sqrt(ChiSquareQuantile(3, query.probability));
+  const Eigen::Vector3d here = Pose(node).translation();
   for (std::size_t i = 0; i < earlier.size(); ++i) {
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen((*covariances)[i],
-                                                                Eigen::EigenvaluesOnly);
+                                                               Eigen::EigenvaluesOnly);
     LoopCandidate c;
     c.node = earlier[i];
-    c.distance_m = (poses[earlier[i]].translation() - poses[node].translation()).norm();
+    c.distance_m = (Pose(earlier[i]).translation() - here).norm();
     c.uncertainty_m = k * std::sqrt(std::max(0.0, eigen.eigenvalues()(2)));
     if (c.distance_m - c.uncertainty_m <= query.max_distance_m) out.push_back(c);
   }

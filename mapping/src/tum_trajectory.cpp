@@ -39,9 +39,9 @@ Result<void> CheckPose(const StampedPose& p, std::size_t index, double previous_
     return Fail(Error::Code::kInvalidArgument, where + " is not a rotation and translation");
   }
   if (index > 0 && !(p.stamp_s > previous_stamp_s)) {
-    return Fail(Error::Code::kInvalidArgument,
-                where + ": stamp " + std::to_string(p.stamp_s) + " s is not after the previous " +
-                    std::to_string(previous_stamp_s) + " s");
+    return Fail(Error::Code::kInvalidArgument, where + ": stamp " + std::to_string(p.stamp_s) +
+                                                   " s is not after the previous " +
+                                                   std::to_string(previous_stamp_s) + " s");
   }
   return {};
 }
@@ -144,8 +144,7 @@ Result<void> WriteTumTrajectory(const std::string& path, const std::vector<Stamp
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) {
-      return Fail(Error::Code::kInvalidArgument,
-                  path + ": cannot write: " + std::strerror(errno));
+      return Fail(Error::Code::kInvalidArgument, path + ": cannot write: " + std::strerror(errno));
     }
     out.write(text->data(), static_cast<std::streamsize>(text->size()));
     if (!out.flush()) {

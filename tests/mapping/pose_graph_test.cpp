@@ -82,7 +82,7 @@ std::vector<PoseGraphEdge> SquareOdometry(const std::vector<Eigen::Isometry3d>& 
   for (int k = 0; k + 1 < kSquareNodes; ++k) {
     Vector6d sigmas = kPrecise;
     Vector6d error = Draw(kPrecise, rng);
-    if (k == kSlipEdge) sigmas(3) = 0.3, error(3) = 0.5;  // forward, the corridor's axis
+    if (k == kSlipEdge) sigmas(3) = 0.3, error(3) = 0.5;            // forward, the corridor's axis
     if (k == kTurnEdge) sigmas(2) = 2 * kDeg, error(2) = 3 * kDeg;  // yaw
     edges.push_back(EdgeFrom(truth, k, k + 1, error, sigmas, EdgeKind::kSequential));
   }
@@ -188,8 +188,8 @@ TEST(PoseGraph, TheChiSquareRiseIsTheInnovationsMahalanobisDistance) {
   ASSERT_TRUE(graph.AddNode(Eigen::Isometry3d::Identity()));
   ASSERT_TRUE(graph.AddNode(PoseFromXyzRpyDeg(1, 0, 0, 0, 0, 0)));
   const Vector6d s1 = Sigmas(0.01, 0.02), s2 = Sigmas(0.01, 0.01);
-  ASSERT_TRUE(graph.AddEdge({0, 1, PoseFromXyzRpyDeg(1, 0, 0, 0, 0, 0), InformationOf(s1),
-                             EdgeKind::kSequential}));
+  ASSERT_TRUE(graph.AddEdge(
+      {0, 1, PoseFromXyzRpyDeg(1, 0, 0, 0, 0, 0), InformationOf(s1), EdgeKind::kSequential}));
   const auto decision = graph.TryAddLoopEdge(
       {0, 1, PoseFromXyzRpyDeg(1.05, 0, 0, 0, 0, 0), InformationOf(s2), EdgeKind::kLoop});
   ASSERT_TRUE(decision) << decision.error().message;
@@ -210,9 +210,8 @@ TEST(PoseGraph, AnAcceptedLoopBeyondTheKernelThresholdSettlesUnderTheKernel) {
   ASSERT_TRUE(graph.AddNode(PoseFromXyzRpyDeg(1, 0, 0, 0, 0, 0)));
   ASSERT_TRUE(graph.AddEdge({0, 1, PoseFromXyzRpyDeg(1, 0, 0, 0, 0, 0),
                              InformationOf(Sigmas(0.01, 0.01)), EdgeKind::kSequential}));
-  const auto decision =
-      graph.TryAddLoopEdge({0, 1, PoseFromXyzRpyDeg(1.42, 0, 0, 0, 0, 0),
-                            InformationOf(Sigmas(0.01, 0.1)), EdgeKind::kLoop});
+  const auto decision = graph.TryAddLoopEdge({0, 1, PoseFromXyzRpyDeg(1.42, 0, 0, 0, 0, 0),
+                                              InformationOf(Sigmas(0.01, 0.1)), EdgeKind::kLoop});
   ASSERT_TRUE(decision) << decision.error().message;
   EXPECT_TRUE(decision->accepted);
   EXPECT_NEAR(decision->chi2_increase, 0.42 * 0.42 / 0.0101, 1e-4);
@@ -237,8 +236,8 @@ TEST(PoseGraph, EdgeChiSquareIsThePointToPlaneCostOfTheRegistrationsHessian) {
   std::uniform_real_distribution<double> u(-1, 1);
   std::vector<PlanePair> pairs;
   for (int i = 0; i < 400; ++i) {  // points 2-6 m out on randomly oriented surfaces
-    const Eigen::Vector3d p = Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized() *
-                              (4 + 2 * u(rng));
+    const Eigen::Vector3d p =
+        Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized() * (4 + 2 * u(rng));
     pairs.push_back({p, Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized()});
   }
   const double sigma_m = 0.005;  // the LMS200's range noise (DESIGN.md)
@@ -306,10 +305,10 @@ TEST(PoseGraph, RobustKernelBoundsAWrongLoopsPull) {
       ASSERT_TRUE(graph.AddNode(Eigen::Isometry3d::Identity()));
       ASSERT_TRUE(graph.AddNode(PoseFromXyzRpyDeg(1, 0, 0, 0, 0, 0)));
       const Matrix6d information = InformationOf(Sigmas(0.01, 0.01));
-      ASSERT_TRUE(graph.AddEdge({0, 1, PoseFromXyzRpyDeg(1, 0, 0, 0, 0, 0), information,
-                                 EdgeKind::kSequential}));
-      ASSERT_TRUE(graph.AddEdge({0, 1, PoseFromXyzRpyDeg(claim_m, 0, 0, 0, 0, 0), information,
-                                 kind}));
+      ASSERT_TRUE(graph.AddEdge(
+          {0, 1, PoseFromXyzRpyDeg(1, 0, 0, 0, 0, 0), information, EdgeKind::kSequential}));
+      ASSERT_TRUE(
+          graph.AddEdge({0, 1, PoseFromXyzRpyDeg(claim_m, 0, 0, 0, 0, 0), information, kind}));
       ASSERT_TRUE(graph.Optimize());
       const double x = graph.Pose(1).translation().x();
       const double expected = kind == EdgeKind::kLoop ? 1 + a * 0.01 : (1 + claim_m) / 2;
@@ -347,8 +346,8 @@ PoseGraph Chain(int nodes, double sigma_t) {
   for (int k = 0; k < nodes; ++k) {
     EXPECT_TRUE(graph.AddNode(PoseFromXyzRpyDeg(k, 0, 0, 0, 0, 0)));
     if (k > 0) {
-      EXPECT_TRUE(graph.AddEdge({k - 1, k, PoseFromXyzRpyDeg(1, 0, 0, 0, 0, 0), information,
-                                 EdgeKind::kSequential}));
+      EXPECT_TRUE(graph.AddEdge(
+          {k - 1, k, PoseFromXyzRpyDeg(1, 0, 0, 0, 0, 0), information, EdgeKind::kSequential}));
     }
   }
   return graph;
@@ -362,7 +361,8 @@ TEST(PoseGraph, RelativeCovarianceAddsAlongAChainAndHalvesWithAParallelEdge) {
     ASSERT_TRUE(C) << C.error().message;
     const double per_edge = 0.01 * std::abs(anchor - node);
     EXPECT_TRUE(C->isApprox(per_edge * Eigen::Matrix3d::Identity(), 1e-6))
-        << anchor << " -> " << node << ":\n" << *C;
+        << anchor << " -> " << node << ":\n"
+        << *C;
   }
   // A second, equal registration of 1 -> 2: that step's covariance halves.
   ASSERT_TRUE(graph.AddEdge({1, 2, PoseFromXyzRpyDeg(1, 0, 0, 0, 0, 0),
@@ -385,9 +385,9 @@ PoseGraph OutAndBack(double sigma_t) {
   for (std::size_t k = 0; k < truth.size(); ++k) {
     EXPECT_TRUE(graph.AddNode(truth[k]));
     if (k > 0) {
-      EXPECT_TRUE(graph.AddEdge({static_cast<int>(k) - 1, static_cast<int>(k),
-                                 truth[k - 1].inverse() * truth[k], information,
-                                 EdgeKind::kSequential}));
+      EXPECT_TRUE(
+          graph.AddEdge({static_cast<int>(k) - 1, static_cast<int>(k),
+                         truth[k - 1].inverse() * truth[k], information, EdgeKind::kSequential}));
     }
   }
   return graph;
@@ -433,6 +433,20 @@ TEST(PoseGraph, SameCallsGiveTheSamePosesBitForBit) {
     poses = graph.Poses();
   }
   for (int i = 0; i < kSquareNodes; ++i) EXPECT_EQ(runs[0][i].matrix(), runs[1][i].matrix());
+}
+
+TEST(PoseGraph, AnEmptyGraphOrALoneStartHasNothingToOptimise) {
+  PoseGraph graph;
+  ASSERT_TRUE(graph.Optimize());
+  EXPECT_FALSE(graph.LoopCandidates(0, {}));
+  ASSERT_TRUE(graph.AddNode(PoseFromXyzRpyDeg(1, 2, 0, 0, 0, 30)));
+  const auto summary = graph.Optimize();
+  ASSERT_TRUE(summary);
+  EXPECT_EQ(summary->iterations, 0);
+  EXPECT_TRUE(graph.Pose(0).isApprox(PoseFromXyzRpyDeg(1, 2, 0, 0, 0, 30), 1e-15));
+  const auto none = graph.LoopCandidates(0, {});
+  ASSERT_TRUE(none);
+  EXPECT_TRUE(none->empty());
 }
 
 TEST(PoseGraph, BadEdgesAndNodesAreErrorsNamingThem) {

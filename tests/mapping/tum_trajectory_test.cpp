@@ -46,9 +46,10 @@ TEST(TumTrajectory, WritesOneLineOfEightNumbersPerPose) {
       {2.0, PoseFromXyzRpyDeg(1, -2, 0.25, 0, 0, 180)}};  // half a turn: q = (0, 0, 1, 0)
   const auto text = FormatTumTrajectory(poses);
   ASSERT_TRUE(text) << text.error().message;
-  EXPECT_EQ(*text, "# timestamp tx ty tz qx qy qz qw\n"
-                   "0.5 0 0 0 0 0 0 1\n"
-                   "2 1 -2 0.25 0 0 1 6.123233995736766e-17\n");
+  EXPECT_EQ(*text,
+            "# timestamp tx ty tz qx qy qz qw\n"
+            "0.5 0 0 0 0 0 0 1\n"
+            "2 1 -2 0.25 0 0 1 6.123233995736766e-17\n");
 }
 
 TEST(TumTrajectory, ReadsALineAsTimestampPositionAndScalarLastQuaternion) {
@@ -71,8 +72,7 @@ TEST(TumTrajectory, WriteThenReadGivesTheSamePoses) {
     EXPECT_EQ((*read)[i].stamp_s, poses[i].stamp_s) << i;  // bit for bit
     EXPECT_EQ((*read)[i].T_map_base.translation(), poses[i].T_map_base.translation()) << i;
     // matrix -> quaternion -> matrix rounds in the last bits only.
-    EXPECT_TRUE((*read)[i].T_map_base.linear().isApprox(poses[i].T_map_base.linear(), 1e-15))
-        << i;
+    EXPECT_TRUE((*read)[i].T_map_base.linear().isApprox(poses[i].T_map_base.linear(), 1e-15)) << i;
   }
 }
 
@@ -95,8 +95,7 @@ TEST(TumTrajectory, QuaternionsAreWrittenWithNonNegativeW) {
 void ExpectRefused(const std::string& text, const std::string& message_part) {
   const auto poses = ParseTumTrajectory(text, "traj.txt");
   ASSERT_FALSE(poses) << "accepted: " << text;
-  EXPECT_NE(poses.error().message.find(message_part), std::string::npos)
-      << poses.error().message;
+  EXPECT_NE(poses.error().message.find(message_part), std::string::npos) << poses.error().message;
 }
 
 TEST(TumTrajectory, BadLinesAreRefusedNamingTheLine) {

@@ -71,10 +71,10 @@ struct PoseGraphConfig {
 
 /// What one optimisation did.
 struct OptimizationSummary {
-  int iterations = 0;        ///< Levenberg-Marquardt iterations run [1]
-  double chi2_before = 0;    ///< the graph's chi-square at the start [1]
-  double chi2_after = 0;     ///< and at the end [1]
-  bool converged = false;    ///< false: stopped at max_iterations (poses still improved)
+  int iterations = 0;      ///< Levenberg-Marquardt iterations run [1]
+  double chi2_before = 0;  ///< the graph's chi-square at the start [1]
+  double chi2_after = 0;   ///< and at the end [1]
+  bool converged = false;  ///< false: stopped at max_iterations (poses still improved)
 };
 
 /// What TryAddLoopEdge decided.
@@ -109,7 +109,8 @@ struct LoopCandidate {
   double uncertainty_m = 0;  ///< the bound: that many metres nearer is still plausible [m]
 };
 
-/// The pose graph. Node 0 is fixed: the start is known.
+/// The pose graph. Node 0 is fixed: the start is known. Not for concurrent use, const calls
+/// included (a covariance query holds another node in Ceres' problem while it runs).
 class PoseGraph {
  public:
   explicit PoseGraph(const PoseGraphConfig& config = {});  ///< validates; throws invalid_argument
@@ -151,6 +152,8 @@ class PoseGraph {
   double Chi2() const;
 
  private:
+  std::vector<int> EarlierUnjoined(int node, double min_travel_m) const;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

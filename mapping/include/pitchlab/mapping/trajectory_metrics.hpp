@@ -26,11 +26,11 @@ struct AbsoluteTrajectoryError {
 
 /// Relative pose error over pairs of poses: E = (T_true_i^-1 T_true_j)^-1 (T_est_i^-1 T_est_j).
 struct RelativePoseError {
-  int pairs = 0;                  ///< pairs compared [1]
-  double translation_rmse = 0;    ///< RMS of |translation of E| [m] (per metre: [m/m])
-  double translation_max = 0;     ///< [m] (per metre: [m/m])
-  double rotation_rmse_deg = 0;   ///< RMS of the angle of E [deg] (per metre: [deg/m])
-  double rotation_max_deg = 0;    ///< [deg] (per metre: [deg/m])
+  int pairs = 0;                 ///< pairs compared [1]
+  double translation_rmse = 0;   ///< RMS of |translation of E| [m] (per metre: [m/m])
+  double translation_max = 0;    ///< [m] (per metre: [m/m])
+  double rotation_rmse_deg = 0;  ///< RMS of the angle of E [deg] (per metre: [deg/m])
+  double rotation_max_deg = 0;   ///< [deg] (per metre: [deg/m])
 };
 
 /// ATE with no alignment: the estimate's map frame is the truth's (the start is known). Errors:
