@@ -461,6 +461,7 @@ TEST(PoseGraph, BadEdgesAndNodesAreErrorsNamingThem) {
   const Eigen::Isometry3d step = PoseFromXyzRpyDeg(1, 0, 0, 0, 0, 0);
   EXPECT_NE(message({0, 2, step, information}).find("no such node"), std::string::npos);
   EXPECT_NE(message({1, 1, step, information}).find("joins a node to itself"), std::string::npos);
+  EXPECT_NE(message({0, 1, step}).find("not positive definite"), std::string::npos);  // unset
   Matrix6d free_axis = information;
   free_axis(3, 3) = 0;  // a corridor's axis
   EXPECT_NE(message({0, 1, step, free_axis}).find("not positive definite"), std::string::npos);

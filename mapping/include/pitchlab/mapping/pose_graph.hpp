@@ -42,10 +42,11 @@ struct PoseGraphEdge {
   int from = 0;                                                 ///< target node
   int to = 0;                                                   ///< source node
   Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();  ///< measured T_target_source
-  /// Weight of the error e above [1/rad^2, 1/m^2]: symmetric positive definite. A registration
-  /// whose `information` leaves a direction free (a corridor's axis) gives none there: pass the
-  /// inverse of its `covariance`, which bounds that direction by the guess it was kept at.
-  Matrix6d information = Matrix6d::Identity();
+  /// Weight of the error e above [1/rad^2, 1/m^2]: symmetric positive definite (the zero default
+  /// is refused: a weight is never implied). A registration whose `information` leaves a
+  /// direction free (a corridor's axis) gives none there: pass the inverse of its `covariance`,
+  /// which bounds that direction by the guess it was kept at.
+  Matrix6d information = Matrix6d::Zero();
   EdgeKind kind = EdgeKind::kSequential;
 };
 
