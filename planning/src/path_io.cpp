@@ -7,26 +7,13 @@
 #include <filesystem>
 #include <fstream>
 
+#include "atomic_file.hpp"
+
 namespace pitchlab::planning {
 namespace {
 
 Result<void> WriteText(const std::string& file, const std::string& text) {
-  const std::string tmp = file + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    if (!out) return Fail(Error::Code::kInvalidArgument, file + ": cannot write");
-    out << text;
-    if (!out.flush()) {
-      out.close();
-      std::error_code ignored;
-      std::filesystem::remove(tmp, ignored);  // a full disk leaves no partial file behind
-      return Fail(Error::Code::kFailed, file + ": write failed");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) return Fail(Error::Code::kFailed, file + ": rename failed: " + ec.message());
-  return {};
+  return WriteFileAtomically(file, text);
 }
 
 std::string Num(double v, const char* fmt = "%.4f") {

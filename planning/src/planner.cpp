@@ -49,6 +49,7 @@ inline double RawEdgeCost(const TraversabilityGrid& T, std::size_t a, std::size_
       parts->roughness += w.roughness * T.roughness_m[b];
       parts->inclination_x += w.inclination_x * std::abs(T.phi_x_rad[b]);
       parts->inclination_y += w.inclination_y * std::abs(T.phi_y_rad[b]);
+      if (!T.occupancy_cost.empty()) parts->occupancy += T.occupancy_cost[b];
     }
   }
   return cost;
