@@ -353,7 +353,7 @@ int RunMap(int argc, char** argv) {
   check(planning::WriteOccupancyGrid(planning::ToOccupancy(traversability),
                                      folder.File("traversability.yaml").string()));
   std::size_t lethal = 0;
-  for (planning::Blocked b : traversability.blocked) lethal += planning::IsHazard(b);
+  for (planning::Blocked b : traversability.blocked) lethal += planning::IsFootprintHazard(b);
   check(mapping::WritePng(mapping::RenderElevationImage(layers),
                           folder.File("elevation.png").string()));
 

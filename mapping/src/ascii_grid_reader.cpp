@@ -1,5 +1,6 @@
 // ESRI ASCII grid reader (dem_io.hpp): strict, every error names the file and the line.
 
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -99,8 +100,8 @@ Result<AsciiGrid> ReadAsciiGrid(const std::string& path) {
     if (!(tokens >> key)) continue;
     const std::string lower = Lower(key);
     double value = 0;
-    if (!IsHeaderKey(lower)) {
-      if (!ParseNumber(key, &value))
+    if (!IsHeaderKey(lower)) {  // a word is a header field misspelt; anything else, data
+      if (std::isalpha(static_cast<unsigned char>(key[0])) && !ParseNumber(key, &value))
         return bad(number, "'" + key + "' is neither a header field (ncols, nrows, xllcorner, "
                            "yllcorner, cellsize, NODATA_value) nor a number");
       first_data = line, first_data_line = number;

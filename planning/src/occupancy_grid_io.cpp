@@ -137,7 +137,7 @@ struct Pgm {
 
 Result<Pgm> ParsePgm(const std::string& bytes, const std::string& file) {
   std::size_t pos = 0;
-  int line = 1;
+  int line = 1, token_line = 1;  // where the reader is; where the last token stood
   // The next header token, skipping whitespace and # comments.
   const auto token = [&]() {
     for (;;) {
@@ -151,6 +151,7 @@ Result<Pgm> ParsePgm(const std::string& bytes, const std::string& file) {
     }
     const std::size_t start = pos;
     while (pos < bytes.size() && !std::isspace(static_cast<unsigned char>(bytes[pos]))) ++pos;
+    if (pos > start) token_line = line;
     return bytes.substr(start, pos - start);
   };
   const std::string magic = token();
@@ -189,7 +190,7 @@ Result<Pgm> ParsePgm(const std::string& bytes, const std::string& file) {
       char* end = nullptr;
       const long v = std::strtol(t.c_str(), &end, 10);
       if (t.empty())
-        return Bad(file, line, "the image ends after " + std::to_string(k) + " of " +
+        return Bad(file, token_line, "the image ends after " + std::to_string(k) + " of " +
                                    std::to_string(n) + " pixels");
       if (*end != '\0' || v < 0 || v > p.maxval)
         return Bad(file, line, "pixel '" + t + "' is not 0.." + std::to_string(p.maxval));

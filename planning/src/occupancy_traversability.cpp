@@ -22,7 +22,7 @@ OccupancyGrid ToOccupancy(const TraversabilityGrid& T) {
   const double full = FullScaleCost(T.config);
   for (std::size_t k = 0; k < grid.value.size(); ++k) {
     const Blocked b = T.blocked[k];
-    if (IsHazard(b)) {
+    if (IsFootprintHazard(b)) {
       grid.value[k] = kOccupancyLethal;
     } else if (b == Blocked::kFree || b == Blocked::kNearHazard) {
       // Free under kPenalise but never seen: unknown to a navigation stack all the same.

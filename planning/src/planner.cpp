@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <iomanip>
 #include <sstream>
 #include <stdexcept>
 
@@ -64,7 +65,7 @@ int MoveBetween(const CellIndex& a, const CellIndex& b) {
 
 std::string Where(const Eigen::Vector2d& p) {
   std::ostringstream os;
-  os << "(" << p.x() << ", " << p.y() << ")";
+  os << std::setprecision(10) << "(" << p.x() << ", " << p.y() << ")";  // UTM eastings whole
   return os.str();
 }
 

@@ -95,11 +95,11 @@ std::vector<std::size_t> HazardBorder(const TraversabilityGrid& T) {
   for (int j = 0; j < g.size_y; ++j)
     for (int i = 0; i < g.size_x; ++i) {
       const std::size_t k = g.Linear({i, j});
-      if (!IsHazard(T.blocked[k])) continue;
+      if (!IsFootprintHazard(T.blocked[k])) continue;
       bool edge = false;
       for (const auto& [di, dj] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
         const CellIndex nb{i + di, j + dj};
-        edge |= g.Contains(nb) && !IsHazard(T.blocked[g.Linear(nb)]);
+        edge |= g.Contains(nb) && !IsFootprintHazard(T.blocked[g.Linear(nb)]);
       }
       if (edge) border.push_back(k);
     }
@@ -430,7 +430,7 @@ void FinishTraversability(TraversabilityGrid& T) {
   T.min_enter_cost = std::isfinite(min_cost) ? min_cost : 0.0f;
 }
 
-bool IsHazard(Blocked b) {
+bool IsFootprintHazard(Blocked b) {
   return b == Blocked::kDrop || b == Blocked::kStep || b == Blocked::kTooSteep ||
          b == Blocked::kOccupied;
 }

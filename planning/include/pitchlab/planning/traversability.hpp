@@ -99,7 +99,7 @@ enum class Blocked : std::uint8_t {
   kOccupied,    ///< an obstacle in an occupancy grid (occupancy_grid.hpp)
 };
 /// A cell the robot's footprint must keep off (step, drop, too steep, occupied).
-bool IsHazard(Blocked b);
+bool IsFootprintHazard(Blocked b);
 const char* ToString(Blocked b);
 
 /// The 8 moves of a cell, in the order of TraversabilityGrid::moves: x and y steps [cell].
