@@ -221,6 +221,10 @@ int RunPlan(int argc, char** argv) {
     if (args.Flagged("json")) std::cout << summary.dump(2) << "\n";
     std::cerr << "pitchlab plan: no path (" << planning::ToString(reason)
               << "): " << result.error().message << "\n";
+    if (on_map && config.unknown == planning::UnknownPolicy::kForbid) {
+      std::cerr << "unknown cells are forbidden (the default): --unknown penalise plans through "
+                   "them at a cost, as `pitchlab run` does\n";
+    }
     if (on_map) {
       std::cerr << "wrote " << out.string() << "/{" << JoinFiles(files)
                 << "}: traversability.png shows what blocks the way (red step, orange too "

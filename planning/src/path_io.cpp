@@ -95,7 +95,9 @@ Result<void> WritePathGeoJson(const Path& path,
       ",\"cost_length\":" + JsonNum(c.length, "%.6f") +
       ",\"cost_inclination_x\":" + JsonNum(c.inclination_x, "%.6f") +
       ",\"cost_inclination_y\":" + JsonNum(c.inclination_y, "%.6f") +
-      ",\"cost_unknown\":" + JsonNum(c.unknown, "%.6f") + ",\"length_m\":" + JsonNum(path.length_m, "%.4f") +
+      ",\"cost_unknown\":" + JsonNum(c.unknown, "%.6f") +
+      ",\"cost_occupancy\":" + JsonNum(c.occupancy, "%.6f") +
+      ",\"length_m\":" + JsonNum(path.length_m, "%.4f") +
       ",\"max_step_m\":" + JsonNum(path.max_step_m, "%.4f") +
       ",\"max_inclination_deg\":" + JsonNum(path.max_inclination_rad * 180 / M_PI, "%.4f");
   const std::string text =

@@ -78,7 +78,8 @@ TEST(UserMapsCli, PlansOnADemWithoutPrjInItsOwnMetres) {
 
 TEST(UserMapsCli, PlansOnAMapServerOccupancyGrid) {
   const fs::path dir = cli_test::FreshTestDir("pitchlab_user_maps");
-  // 40 x 20 cells of 0.1 m, free but for a wall at x 2.0-2.1 m below y 1.4 m (rows 0-13).
+  // 40 x 20 cells of 0.1 m, free but for a wall in column 20 (x 2.0-2.1 m) below y 1.4 m
+  // (rows 0-13; image rows 6-19 from the top).
   std::ostringstream pgm;
   pgm << "P2\n40 20\n255\n";
   for (int row = 0; row < 20; ++row)
@@ -92,8 +93,10 @@ TEST(UserMapsCli, PlansOnAMapServerOccupancyGrid) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_TRUE(j["found"].get<bool>());
-  // Round the wall's end: up and down at least 1.4 + footprint - 0.5 m each way, and 3 m across.
-  EXPECT_GT(j["length_m"].get<double>(), 3.0 + 2 * (1.4 + 0.25 - 0.5));
+  // Round the wall's end: the P3-AT's footprint (centres closer than 0.2985 m to the wall or
+  // the edge blocked) leaves rows 16-17 free at columns 18-22, so from cell (5, 5) up to row 16,
+  // 5 columns along it and down to (35, 5): 22 diagonal and 8 straight moves of 0.1 m.
+  EXPECT_NEAR(j["length_m"].get<double>(), 0.1 * (22 * M_SQRT2 + 8), 1e-4);
   EXPECT_TRUE(fs::exists(dir / "p" / "traversability.png"));
   EXPECT_TRUE(fs::exists(dir / "p" / "path.png"));
   EXPECT_FALSE(fs::exists(dir / "p" / "elevation.png"));  // no heights in an occupancy grid
