@@ -16,6 +16,7 @@
 #include "cloud_input.hpp"
 #include "commands.hpp"
 #include "interrupt.hpp"
+#include "output_paths.hpp"
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/elevation_map.hpp"
@@ -27,7 +28,6 @@
 #include "pitchlab/sensors/scan_pcd.hpp"
 #include "pitchlab/sim/simulation.hpp"
 #include "pitchlab/worlds/world_catalog.hpp"
-#include "output_paths.hpp"
 #include "progress.hpp"
 #include "run_folder.hpp"
 #include "world_paths.hpp"
@@ -43,32 +43,33 @@ std::string DefaultClearance() {
 }
 
 CliArgs MapArgs() {
-  CliArgs args("map",
-               "Builds an elevation map from point clouds (any format sensors read: PCD, 3DTK\n"
-               ".3d, PLY, XYZ; points moved into the world by each file's pose) and writes\n"
-               "DIR/map.plem (lossless), DIR/elevation.png, DIR/map.json, ESRI ASCII rasters\n"
-               "with their .prj (georeferenced with --world): DIR/elevation.asc [m],\n"
-               "DIR/inclination.asc (the cell plane's tilt [deg]), DIR/roughness.asc (Eq. 3 [m]),\n"
-               "and the traversability for --robot as a ROS map_server occupancy grid,\n"
-               "DIR/traversability.yaml + .pgm (raw mode: 0 free, 1..99 the cost of entering,\n"
-               "100 lethal: step, drop, too steep; 255 unknown; Nav2's static layer reads the\n"
-               "costs with trinary_costmap: false, and inflates by its own footprint). With\n"
-               "--world, the map is georeferenced and scored against the world's true surface.\n"
-               "\n"
-               "Levelling: without --world (whose frame is the simulator's, z up) nothing tells\n"
-               "where gravity points, and a scanner mounted a few degrees off tilts the whole map\n"
-               "(a flat floor reads as a slope). The map frame is then turned about its origin so\n"
-               "that the floor under the first cloud's sensor is level: a robust plane fit of the\n"
-               "points below the sensor within 0.5-4 m of it. It assumes the first scan stood on\n"
-               "level ground; map.json reports the plane (normal, tilt removed, residual, points).\n"
-               "--no-level keeps the clouds' frame (their poses came levelled by an IMU).\n"
-               "\n"
-               "Height band: points higher than --max-height above the ground under the sensor\n"
-               "that saw them are not ground (a ceiling, a canopy), unless the laser saw their\n"
-               "surface from above: terrain rising ahead may climb 35 % (the P3-AT's grade) of\n"
-               "its distance higher. Points on a surface the laser saw from below (a ceiling, a\n"
-               "desk's underside) are never ground. Cells whose only points were those stay\n"
-               "unknown.");
+  CliArgs args(
+      "map",
+      "Builds an elevation map from point clouds (any format sensors read: PCD, 3DTK\n"
+      ".3d, PLY, XYZ; points moved into the world by each file's pose) and writes\n"
+      "DIR/map.plem (lossless), DIR/elevation.png, DIR/map.json, ESRI ASCII rasters\n"
+      "with their .prj (georeferenced with --world): DIR/elevation.asc [m],\n"
+      "DIR/inclination.asc (the cell plane's tilt [deg]), DIR/roughness.asc (Eq. 3 [m]),\n"
+      "and the traversability for --robot as a ROS map_server occupancy grid,\n"
+      "DIR/traversability.yaml + .pgm (raw mode: 0 free, 1..99 the cost of entering,\n"
+      "100 lethal: step, drop, too steep; 255 unknown; Nav2's static layer reads the\n"
+      "costs with trinary_costmap: false, and inflates by its own footprint). With\n"
+      "--world, the map is georeferenced and scored against the world's true surface.\n"
+      "\n"
+      "Levelling: without --world (whose frame is the simulator's, z up) nothing tells\n"
+      "where gravity points, and a scanner mounted a few degrees off tilts the whole map\n"
+      "(a flat floor reads as a slope). The map frame is then turned about its origin so\n"
+      "that the floor under the first cloud's sensor is level: a robust plane fit of the\n"
+      "points below the sensor within 0.5-4 m of it. It assumes the first scan stood on\n"
+      "level ground; map.json reports the plane (normal, tilt removed, residual, points).\n"
+      "--no-level keeps the clouds' frame (their poses came levelled by an IMU).\n"
+      "\n"
+      "Height band: points higher than --max-height above the ground under the sensor\n"
+      "that saw them are not ground (a ceiling, a canopy), unless the laser saw their\n"
+      "surface from above: terrain rising ahead may climb 35 % (the P3-AT's grade) of\n"
+      "its distance higher. Points on a surface the laser saw from below (a ceiling, a\n"
+      "desk's underside) are never ground. Cells whose only points were those stay\n"
+      "unknown.");
   args.Positionals("CLOUD", "one or more clouds, any format below", 1, 1000)
       .Option("sensor-origin", "x,y,z", kSensorOriginHelp)
       .Option("cell", "METRES", "cell size [m]", "0.1")
@@ -349,7 +350,8 @@ int RunMap(int argc, char** argv) {
   planning::PlannerConfig planner;
   planner.robot = robot;
   planner.unknown = planning::UnknownPolicy::kForbid;
-  const planning::TraversabilityGrid traversability = planning::BuildTraversability(layers, planner);
+  const planning::TraversabilityGrid traversability =
+      planning::BuildTraversability(layers, planner);
   check(planning::WriteOccupancyGrid(planning::ToOccupancy(traversability),
                                      folder.File("traversability.yaml").string()));
   std::size_t lethal = 0;

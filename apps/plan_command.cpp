@@ -12,12 +12,12 @@
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "interrupt.hpp"
+#include "output_paths.hpp"
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/planning/occupancy_grid.hpp"
 #include "pitchlab/planning/path_io.hpp"
 #include "pitchlab/planning/planner.hpp"
 #include "pitchlab/planning/traversability.hpp"
-#include "output_paths.hpp"
 #include "plan_input.hpp"
 #include "run_folder.hpp"
 #include "traversability_image.hpp"
@@ -72,7 +72,8 @@ CliArgs PlanArgs() {
       "A grid coarser than the robot (a DEM's 3 m or 30 m cells) holds one height under the\n"
       "whole robot: a rise between neighbouring cells is read as a slope (blocked beyond the\n"
       "robot's inclination), not as a step, and a warning says what the map cannot show.\n"
-      "\n" + PlannerDefaults());
+      "\n" +
+          PlannerDefaults());
   args.Positionals("MAP", "map file: .plem, .asc or .yaml (see above)", 1, 1)
       .Option("start", "x,y", "start in the map's own coordinates (see above)")
       .Option("goal", "x,y", "goal in the map's own coordinates")
@@ -186,7 +187,8 @@ int RunPlan(int argc, char** argv) {
   summary["input"] = in.about;
   summary["start"] = start;
   summary["goal"] = goal;
-  if (start_m != Eigen::Vector2d(start[0], start[1]) || goal_m != Eigen::Vector2d(goal[0], goal[1])) {
+  if (start_m != Eigen::Vector2d(start[0], start[1]) ||
+      goal_m != Eigen::Vector2d(goal[0], goal[1])) {
     summary["start_map_m"] = {start_m.x(), start_m.y()};
     summary["goal_map_m"] = {goal_m.x(), goal_m.y()};
   }
@@ -243,8 +245,9 @@ int RunPlan(int argc, char** argv) {
     check(planning::WritePathGeoJson(*result, in.origin, folder.File("path.geojson").string()));
     files.push_back("path.geojson");
   } else {
-    summary["geojson"] = "skipped: the map is not georeferenced (a .plem mapped without --world, "
-                         "a DEM without a .prj, an occupancy grid)";
+    summary["geojson"] =
+        "skipped: the map is not georeferenced (a .plem mapped without --world, "
+        "a DEM without a .prj, an occupancy grid)";
   }
   for (const std::string& f : WritePictures(in, &*result, folder)) files.push_back(f);
   files.push_back("plan.json");

@@ -43,15 +43,13 @@ PlanInput FromElevationMap(const mapping::ElevationMap& map, const planning::Pla
 PlanInput FromDem(const std::string& path, const planning::PlannerConfig& c) {
   auto dem = std::make_shared<mapping::Dem>(OrThrow(mapping::LoadDem(path)));
   PlanInput in = FromElevationMap(dem->map, c);
-  in.about = {{"kind", "DEM (ESRI ASCII grid)"},
-              {"crs", dem->crs.name},
-              {"coordinates", CrsKind(dem->crs.kind)},
-              {"file_cell", dem->grid.cell_size},
-              {"nodata_cells", dem->nodata_cells},
-              {"resampled", dem->resampled}};
+  in.about = {{"kind", "DEM (ESRI ASCII grid)"},       {"crs", dem->crs.name},
+              {"coordinates", CrsKind(dem->crs.kind)}, {"file_cell", dem->grid.cell_size},
+              {"nodata_cells", dem->nodata_cells},     {"resampled", dem->resampled}};
   if (dem->resampled) {
-    in.about["map_frame"] = "east-north-up metres at the grid's centre (the geodetic origin), "
-                            "resampled bilinearly; --start/--goal in the file's coordinates";
+    in.about["map_frame"] =
+        "east-north-up metres at the grid's centre (the geodetic origin), "
+        "resampled bilinearly; --start/--goal in the file's coordinates";
     in.to_map = [dem](const Eigen::Vector2d& p) { return dem->FileToMap(p); };
   } else {
     in.about["map_frame"] = "the file's own x, y [m], every cell as written";
@@ -84,7 +82,8 @@ PlanInput LoadPlanInput(const std::string& path, const planning::PlannerConfig& 
   } else if (ext == ".yaml" || ext == ".yml") {
     in = FromOccupancyGrid(path, config);
   } else {
-    throw CliError("MAP '" + path + "' must be a .plem (pitchlab map), an .asc (ESRI ASCII "
+    throw CliError("MAP '" + path +
+                   "' must be a .plem (pitchlab map), an .asc (ESRI ASCII "
                    "grid, with its .prj) or a .yaml (map_server occupancy grid)");
   }
   in.about["file"] = path;

@@ -18,13 +18,14 @@ namespace pitchlab::apps {
 struct PlanInput {
   std::optional<mapping::ElevationLayers> layers;  ///< none for an occupancy grid
   planning::TraversabilityGrid grid;
-  std::optional<mapping::GeodeticOrigin> origin;   ///< for GeoJSON; none when not georeferenced
+  std::optional<mapping::GeodeticOrigin> origin;  ///< for GeoJSON; none when not georeferenced
   /// What was read and how the map frame relates to the file's coordinates (plan.json "input").
   nlohmann::json about;
   /// The map-frame point [m] of a point in the file's own coordinates (identity but for a
   /// resampled DEM, whose file is in longitude/latitude or a projection).
-  std::function<Eigen::Vector2d(const Eigen::Vector2d&)> to_map =
-      [](const Eigen::Vector2d& p) { return p; };
+  std::function<Eigen::Vector2d(const Eigen::Vector2d&)> to_map = [](const Eigen::Vector2d& p) {
+    return p;
+  };
 };
 
 /// Reads `path` by its extension (.plem, .asc, .yaml / .yml) and builds the planning graph with

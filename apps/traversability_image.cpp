@@ -133,7 +133,8 @@ std::string HazardErrorsLegend() {
 
 std::string TraversabilityLegend() {
   return "Green: free (darker costs more to enter); checkered: unknown; red: step; orange: too "
-         "steep; magenta: drop; black: occupied (an occupancy grid's obstacle); pale red: closer to a hazard than half the robot's width plus "
+         "steep; magenta: drop; black: occupied (an occupancy grid's obstacle); pale red: closer "
+         "to a hazard than half the robot's width plus "
          "the safety margin.";
 }
 

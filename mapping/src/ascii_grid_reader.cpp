@@ -65,15 +65,15 @@ Result<AsciiGrid> GridFromHeader(const std::map<std::string, Field>& h, const st
   g.nrows = static_cast<int>(h.at("nrows").value);
   g.cell_size = h.at("cellsize").value;
   if (!(g.cell_size > 0))
-    return bad(h.at("cellsize").line, "'cellsize' must be positive, not " +
-                                          std::to_string(g.cell_size));
+    return bad(h.at("cellsize").line,
+               "'cellsize' must be positive, not " + std::to_string(g.cell_size));
   for (const std::string axis : {"x", "y"}) {
     const bool corner = h.count(axis + "llcorner"), centre = h.count(axis + "llcenter");
     if (corner == centre)
       return bad(end, "give exactly one of '" + axis + "llcorner' and '" + axis + "llcenter'");
     // A centre reference lies half a cell inside the corner.
-    const double v = corner ? h.at(axis + "llcorner").value
-                            : h.at(axis + "llcenter").value - 0.5 * g.cell_size;
+    const double v =
+        corner ? h.at(axis + "llcorner").value : h.at(axis + "llcenter").value - 0.5 * g.cell_size;
     (axis == "x" ? g.xll_corner : g.yll_corner) = v;
   }
   if (h.count("nodata_value")) g.nodata_value = h.at("nodata_value").value;
@@ -102,8 +102,9 @@ Result<AsciiGrid> ReadAsciiGrid(const std::string& path) {
     double value = 0;
     if (!IsHeaderKey(lower)) {  // a word is a header field misspelt; anything else, data
       if (std::isalpha(static_cast<unsigned char>(key[0])) && !ParseNumber(key, &value))
-        return bad(number, "'" + key + "' is neither a header field (ncols, nrows, xllcorner, "
-                           "yllcorner, cellsize, NODATA_value) nor a number");
+        return bad(number, "'" + key +
+                               "' is neither a header field (ncols, nrows, xllcorner, "
+                               "yllcorner, cellsize, NODATA_value) nor a number");
       first_data = line, first_data_line = number;
       break;
     }

@@ -41,11 +41,10 @@ bool IsLocalTransverseMercator(const DemCrs& crs) {
 class FileProjection {
  public:
   explicit FileProjection(const DemCrs& crs)
-      : crs_(crs),
-        tm_(crs.semi_major_m, 1.0 / crs.inverse_flattening, crs.scale_factor) {
+      : crs_(crs), tm_(crs.semi_major_m, 1.0 / crs.inverse_flattening, crs.scale_factor) {
     double x0 = 0;
-    tm_.Forward(crs.central_meridian_deg, crs.latitude_of_origin_deg, crs.central_meridian_deg,
-                x0, y_origin_);
+    tm_.Forward(crs.central_meridian_deg, crs.latitude_of_origin_deg, crs.central_meridian_deg, x0,
+                y_origin_);
   }
   void ToGeodetic(double x, double y, double* lat, double* lon) const {
     if (crs_.kind == Kind::kGeographic) {
@@ -78,7 +77,8 @@ double SampleBilinear(const AsciiGrid& g, double x, double y) {
   if (!(col >= -0.5 && col <= g.ncols - 0.5 && row_south >= -0.5 && row_south <= g.nrows - 0.5))
     return std::nan("");
   // Between the outer edge and the first centre the edge cell's value holds (clamped).
-  const double c = std::clamp(col, 0.0, g.ncols - 1.0), r = std::clamp(row_south, 0.0, g.nrows - 1.0);
+  const double c = std::clamp(col, 0.0, g.ncols - 1.0),
+               r = std::clamp(row_south, 0.0, g.nrows - 1.0);
   const int c0 = static_cast<int>(std::floor(c)), r0 = static_cast<int>(std::floor(r));
   const int c1 = std::min(c0 + 1, g.ncols - 1), r1 = std::min(r0 + 1, g.nrows - 1);
   const double tc = c - c0, tr = r - r0;
@@ -145,12 +145,14 @@ ElevationMap Resample(const AsciiGrid& g, const DemCrs& crs, double mean_height_
   const double w = g.ncols * g.cell_size, t = g.nrows * g.cell_size;
   for (int k = 0; k <= 64; ++k) {
     const double f = k / 64.0;
-    for (const Eigen::Vector2d& p :
-         {to_enu(g.xll_corner + f * w, g.yll_corner), to_enu(g.xll_corner + f * w, g.yll_corner + t),
-          to_enu(g.xll_corner, g.yll_corner + f * t), to_enu(g.xll_corner + w, g.yll_corner + f * t)})
+    for (const Eigen::Vector2d& p : {to_enu(g.xll_corner + f * w, g.yll_corner),
+                                     to_enu(g.xll_corner + f * w, g.yll_corner + t),
+                                     to_enu(g.xll_corner, g.yll_corner + f * t),
+                                     to_enu(g.xll_corner + w, g.yll_corner + f * t)})
       lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
   }
-  const double nx = std::ceil((hi.x() - lo.x()) / cell_m), ny = std::ceil((hi.y() - lo.y()) / cell_m);
+  const double nx = std::ceil((hi.x() - lo.x()) / cell_m),
+               ny = std::ceil((hi.y() - lo.y()) / cell_m);
   const GridGeometry geometry =
       GridGeometry::FromArea(lo.x(), lo.y(), nx * cell_m, ny * cell_m, cell_m);  // throws >2^31
   ElevationMap map(geometry, origin);
@@ -200,13 +202,15 @@ Result<Dem> LoadDem(const std::string& asc_path) {
   // corners within longitude/latitude range is in degrees, whatever the missing .prj would say.
   if (dem.crs.name == "no .prj" && g.cell_size < 0.01 && std::abs(g.xll_corner) <= 360 &&
       std::abs(g.yll_corner) <= 90)
-    return bad("cell size " + std::to_string(g.cell_size) + " looks like degrees, but no .prj "
+    return bad("cell size " + std::to_string(g.cell_size) +
+               " looks like degrees, but no .prj "
                "says so: put the grid's .prj beside it (GEOGCS for longitude/latitude)");
   if (dem.crs.kind == Kind::kGeographic &&
       !(std::abs(g.yll_corner) <= 90 && std::abs(g.yll_corner + g.nrows * g.cell_size) <= 90 &&
         std::abs(g.xll_corner) <= 360 && std::abs(g.xll_corner + g.ncols * g.cell_size) <= 360))
-    return bad("its .prj says longitude/latitude, but the grid reaches beyond +-90 deg latitude "
-               "or +-360 deg longitude");
+    return bad(
+        "its .prj says longitude/latitude, but the grid reaches beyond +-90 deg latitude "
+        "or +-360 deg longitude");
   const auto [mean, valid] = MeanOfValid(g);
   dem.nodata_cells = g.values.size() - valid;
   if (valid == 0) return bad("every cell is NODATA");
@@ -214,8 +218,8 @@ Result<Dem> LoadDem(const std::string& asc_path) {
     if (dem.crs.kind == Kind::kLocal) {
       dem.map = PlaceExactly(g, std::nullopt);
     } else if (IsLocalTransverseMercator(dem.crs)) {
-      dem.map = PlaceExactly(g, GeodeticOrigin{dem.crs.latitude_of_origin_deg,
-                                               dem.crs.central_meridian_deg, mean});
+      dem.map = PlaceExactly(
+          g, GeodeticOrigin{dem.crs.latitude_of_origin_deg, dem.crs.central_meridian_deg, mean});
     } else {
       dem.map = Resample(g, dem.crs, mean);
       dem.resampled = true;

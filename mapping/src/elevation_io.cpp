@@ -207,8 +207,8 @@ Result<void> WriteEsriAsciiGrid(const ElevationLayers& L,
                                 const std::optional<GeodeticOrigin>& origin,
                                 const std::string& asc_path, RasterLayer layer) {
   const GridGeometry& g = L.geometry;
-  const bool height = layer == RasterLayer::kMean || layer == RasterLayer::kMin ||
-                      layer == RasterLayer::kMax;
+  const bool height =
+      layer == RasterLayer::kMean || layer == RasterLayer::kMin || layer == RasterLayer::kMax;
   const double z_offset = (origin && height) ? origin->height_m : 0.0;
   std::string out;
   out.reserve(g.cell_count() * 10 + 256);

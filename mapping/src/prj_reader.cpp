@@ -142,8 +142,7 @@ Result<DemCrs> ParsePrj(const std::string& wkt, const std::string& source) {
   }
   if (root.keyword == "GEOGCS") {
     // Degrees: pi / 180 radians per unit (ESRI writes 0.0174532925199433).
-    if (!(std::abs(unit_factor - M_PI / 180) < 1e-9))
-      return bad("GEOGCS unit is not the degree");
+    if (!(std::abs(unit_factor - M_PI / 180) < 1e-9)) return bad("GEOGCS unit is not the degree");
     const WktNode* primem = root.Child("PRIMEM");
     if (primem && primem->Number(1) != 0)
       return bad("prime meridian '" + primem->values.front() + "' is not Greenwich");
@@ -157,7 +156,8 @@ Result<DemCrs> ParsePrj(const std::string& wkt, const std::string& source) {
                                  ? Lowered(projection->values.front())
                                  : std::string("none");
   if (method != "transverse_mercator" && method != "transverse mercator")
-    return bad("projection '" + method + "' is not supported (Transverse Mercator, UTM, "
+    return bad("projection '" + method +
+               "' is not supported (Transverse Mercator, UTM, "
                "longitude/latitude or local metres are): reproject the grid, e.g. `gdalwarp "
                "-t_srs EPSG:326NN` for UTM zone NN north");
   if (!(std::abs(unit_factor - 1.0) < 1e-9))
@@ -175,8 +175,9 @@ Result<DemCrs> ParsePrj(const std::string& wkt, const std::string& source) {
   }
   if (!(crs.scale_factor > 0.5 && crs.scale_factor < 1.5) ||
       !(std::abs(crs.central_meridian_deg) <= 360) || !(std::abs(crs.latitude_of_origin_deg) < 90))
-    return bad("Transverse Mercator parameters out of range (scale factor, central meridian or "
-               "latitude of origin)");
+    return bad(
+        "Transverse Mercator parameters out of range (scale factor, central meridian or "
+        "latitude of origin)");
   crs.kind = DemCrs::Kind::kTransverseMercator;
   if (const WktNode* geogcs = root.Child("GEOGCS")) ReadEllipsoid(*geogcs, &crs);
   return crs;

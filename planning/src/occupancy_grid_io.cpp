@@ -56,7 +56,8 @@ Result<T> Scalar(const YAML::Node& value, const std::string& key, const std::str
     if (!value.IsScalar()) throw YAML::Exception(value.Mark(), "");
     return value.as<T>();
   } catch (const YAML::Exception&) {
-    return Bad(file, LineOf(value), "'" + key + "' has an invalid value '" + YAML::Dump(value) + "'");
+    return Bad(file, LineOf(value),
+               "'" + key + "' has an invalid value '" + YAML::Dump(value) + "'");
   }
 }
 
@@ -76,8 +77,9 @@ Result<MapYaml> ParseMapYaml(const std::string& text, const std::string& file) {
     const YAML::Node& v = kv.second;
     const int line = LineOf(kv.first);
     if (seen.count(key))
-      return Bad(file, line, "'" + key + "' is given twice (lines " +
-                                 std::to_string(seen[key]) + " and " + std::to_string(line) + ")");
+      return Bad(file, line,
+                 "'" + key + "' is given twice (lines " + std::to_string(seen[key]) + " and " +
+                     std::to_string(line) + ")");
     seen[key] = line;
     if (key == "image") {
       auto s = Scalar<std::string>(v, key, file);
@@ -86,8 +88,9 @@ Result<MapYaml> ParseMapYaml(const std::string& text, const std::string& file) {
     } else if (key == "resolution" || key == "occupied_thresh" || key == "free_thresh") {
       auto d = Scalar<double>(v, key, file);
       if (!d) return tl::make_unexpected(d.error());
-      (key == "resolution" ? y.resolution
-                           : key == "occupied_thresh" ? y.occupied_thresh : y.free_thresh) = *d;
+      (key == "resolution"        ? y.resolution
+       : key == "occupied_thresh" ? y.occupied_thresh
+                                  : y.free_thresh) = *d;
     } else if (key == "negate") {
       auto n = Scalar<std::string>(v, key, file);
       if (!n) return tl::make_unexpected(n.error());
@@ -101,8 +104,7 @@ Result<MapYaml> ParseMapYaml(const std::string& text, const std::string& file) {
         return Bad(file, line, "'mode' must be trinary, scale or raw, not '" + *m + "'");
       y.mode = *m == "trinary" ? Mode::kTrinary : *m == "scale" ? Mode::kScale : Mode::kRaw;
     } else if (key == "origin") {
-      if (!v.IsSequence() || v.size() != 3)
-        return Bad(file, line, "'origin' must be [x, y, yaw]");
+      if (!v.IsSequence() || v.size() != 3) return Bad(file, line, "'origin' must be [x, y, yaw]");
       for (int i = 0; i < 3; ++i) {
         auto d = Scalar<double>(v[i], key, file);
         if (!d) return tl::make_unexpected(d.error());
@@ -110,12 +112,15 @@ Result<MapYaml> ParseMapYaml(const std::string& text, const std::string& file) {
         y.origin[i] = *d;
       }
       if (y.origin[2] != 0)
-        return Bad(file, line, "origin yaw " + std::to_string(y.origin[2]) +
-                                   " rad: a rotated grid is not supported (pitchlab's maps are "
-                                   "axis-aligned); rotate the image instead");
+        return Bad(file, line,
+                   "origin yaw " + std::to_string(y.origin[2]) +
+                       " rad: a rotated grid is not supported (pitchlab's maps are "
+                       "axis-aligned); rotate the image instead");
     } else {
-      return Bad(file, line, "unknown key '" + key + "' (a map_server YAML has image, "
-                             "resolution, origin, negate, occupied_thresh, free_thresh, mode)");
+      return Bad(file, line,
+                 "unknown key '" + key +
+                     "' (a map_server YAML has image, "
+                     "resolution, origin, negate, occupied_thresh, free_thresh, mode)");
     }
   }
   for (const char* key :
@@ -156,8 +161,9 @@ Result<Pgm> ParsePgm(const std::string& bytes, const std::string& file) {
   };
   const std::string magic = token();
   if (magic != "P5" && magic != "P2")
-    return Bad(file, line, "not a PGM image (magic '" + magic.substr(0, 8) +
-                               "', expected P5 or P2); convert it, e.g. `convert map.png map.pgm`");
+    return Bad(file, line,
+               "not a PGM image (magic '" + magic.substr(0, 8) +
+                   "', expected P5 or P2); convert it, e.g. `convert map.png map.pgm`");
   Pgm p;
   int* fields[3] = {&p.width, &p.height, &p.maxval};
   const char* names[3] = {"width", "height", "maxval"};
@@ -167,8 +173,9 @@ Result<Pgm> ParsePgm(const std::string& bytes, const std::string& file) {
     const long v = std::strtol(t.c_str(), &end, 10);
     const long limit = f == 2 ? 65535 : 1'000'000;  // PGM's maxval; a million pixels a side
     if (t.empty() || *end != '\0' || v < 1 || v > limit)
-      return Bad(file, line, std::string("PGM ") + names[f] + " '" + t + "' is not 1.." +
-                                 std::to_string(limit));
+      return Bad(
+          file, line,
+          std::string("PGM ") + names[f] + " '" + t + "' is not 1.." + std::to_string(limit));
     *fields[f] = static_cast<int>(v);
   }
   const std::size_t n = static_cast<std::size_t>(p.width) * p.height;
@@ -177,9 +184,10 @@ Result<Pgm> ParsePgm(const std::string& bytes, const std::string& file) {
     ++pos;  // the single whitespace after maxval
     const std::size_t bpp = p.maxval < 256 ? 1 : 2;
     if (bytes.size() - std::min(pos, bytes.size()) < n * bpp)
-      return Bad(file, line, "the image ends after " +
-                                 std::to_string((bytes.size() - std::min(pos, bytes.size())) / bpp) +
-                                 " of " + std::to_string(n) + " pixels");
+      return Bad(file, line,
+                 "the image ends after " +
+                     std::to_string((bytes.size() - std::min(pos, bytes.size())) / bpp) + " of " +
+                     std::to_string(n) + " pixels");
     for (std::size_t k = 0; k < n; ++k) {
       const auto* b = reinterpret_cast<const unsigned char*>(bytes.data() + pos + k * bpp);
       p.pixels[k] = bpp == 1 ? b[0] : (b[0] << 8 | b[1]);  // 16-bit PGM is big-endian
@@ -190,8 +198,9 @@ Result<Pgm> ParsePgm(const std::string& bytes, const std::string& file) {
       char* end = nullptr;
       const long v = std::strtol(t.c_str(), &end, 10);
       if (t.empty())
-        return Bad(file, token_line, "the image ends after " + std::to_string(k) + " of " +
-                                   std::to_string(n) + " pixels");
+        return Bad(
+            file, token_line,
+            "the image ends after " + std::to_string(k) + " of " + std::to_string(n) + " pixels");
       if (*end != '\0' || v < 0 || v > p.maxval)
         return Bad(file, line, "pixel '" + t + "' is not 0.." + std::to_string(p.maxval));
       p.pixels[k] = static_cast<int>(v);
@@ -204,7 +213,8 @@ Result<Pgm> ParsePgm(const std::string& bytes, const std::string& file) {
 
 // map_server's reading of one pixel (see the header).
 std::int8_t Occupancy(int pixel, int maxval, const MapYaml& y) {
-  if (y.mode == Mode::kRaw) return pixel <= 100 ? static_cast<std::int8_t>(pixel) : kOccupancyUnknown;
+  if (y.mode == Mode::kRaw)
+    return pixel <= 100 ? static_cast<std::int8_t>(pixel) : kOccupancyUnknown;
   const double p = y.negate ? double(pixel) / maxval : double(maxval - pixel) / maxval;
   if (p > y.occupied_thresh) return kOccupancyLethal;
   if (p < y.free_thresh) return 0;

@@ -55,8 +55,7 @@ TraversabilityGrid BuildTraversability(const OccupancyGrid& grid, const PlannerC
     if (v >= kOccupancyLethal) {
       T.blocked[k] = Blocked::kOccupied;
     } else if (v < 0) {
-      T.blocked[k] =
-          config.unknown == UnknownPolicy::kForbid ? Blocked::kUnknown : Blocked::kFree;
+      T.blocked[k] = config.unknown == UnknownPolicy::kForbid ? Blocked::kUnknown : Blocked::kFree;
       T.enter_cost[k] = static_cast<float>(config.unknown_penalty);
     } else {
       T.z_m[k] = 0.0f;

@@ -91,7 +91,8 @@ Result<void> WritePathGeoJson(const Path& path,
   const CostParts& c = path.parts;
   std::string props =
       "\"algorithm\":\"" + std::string(ToString(path.algorithm)) + "\"" +
-      ",\"cost\":" + JsonNum(path.cost, "%.6f") + ",\"cost_roughness\":" + JsonNum(c.roughness, "%.6f") +
+      ",\"cost\":" + JsonNum(path.cost, "%.6f") +
+      ",\"cost_roughness\":" + JsonNum(c.roughness, "%.6f") +
       ",\"cost_length\":" + JsonNum(c.length, "%.6f") +
       ",\"cost_inclination_x\":" + JsonNum(c.inclination_x, "%.6f") +
       ",\"cost_inclination_y\":" + JsonNum(c.inclination_y, "%.6f") +

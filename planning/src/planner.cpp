@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <memory>
-#include <iomanip>
 #include <sstream>
 #include <stdexcept>
 

@@ -129,10 +129,10 @@ TEST_F(MapPlanCli, MapWritesRastersAndAnOccupancyGridThatPlanReads) {
   EXPECT_GT(free, 100u);
   // The same plan as on the .plem, through the bridge: 1.5 m ahead of the robot.
   const fs::path plan_dir = dir_ / "plan_occupancy";
-  const CliResult plan = Run("plan " + (map_dir / "traversability.yaml").string() + " --start " +
-                             Point(start_x_, start_y_) + " --goal " +
-                             Point(start_x_ + 1.5, start_y_) +
-                             " --unknown penalise --json --out " + plan_dir.string());
+  const CliResult plan =
+      Run("plan " + (map_dir / "traversability.yaml").string() + " --start " +
+          Point(start_x_, start_y_) + " --goal " + Point(start_x_ + 1.5, start_y_) +
+          " --unknown penalise --json --out " + plan_dir.string());
   ASSERT_EQ(plan.exit_code, 0) << plan.err;
   EXPECT_TRUE(nlohmann::json::parse(plan.out)["found"].get<bool>());
   EXPECT_GE(nlohmann::json::parse(plan.out)["length_m"].get<double>(), 1.4);

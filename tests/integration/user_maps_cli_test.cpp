@@ -26,8 +26,11 @@ TEST(UserMapsCli, PlansOnARealGeographicDemAndWritesWgs84GeoJson) {
   // 1.7 km east across the West Bijou escarpment, 1 arc-second (~24 x 31 m) SRTM cells.
   const double start_lon = -104.3380, start_lat = 39.5110, goal_lon = -104.3180, goal_lat = 39.5110;
   const CliResult r = cli_test::RunPitchlab(
-      "plan " + kDemDir + "west_bijou_escarpment_snippet.asc --start -104.3380,39.5110 --goal "
-      "-104.3180,39.5110 --json --out " + (dir / "p").string(), dir);
+      "plan " + kDemDir +
+          "west_bijou_escarpment_snippet.asc --start -104.3380,39.5110 --goal "
+          "-104.3180,39.5110 --json --out " +
+          (dir / "p").string(),
+      dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_TRUE(j["found"].get<bool>());
@@ -57,9 +60,12 @@ TEST(UserMapsCli, PlansOnADemWithoutPrjInItsOwnMetres) {
   const fs::path dir = cli_test::FreshTestDir("pitchlab_user_maps");
   // Down the West Bijou gully's western side, 67 m as the crow flies (3 m cells; the file's
   // easting/northing, no .prj; its floor and walls are steeper than the P3-AT's 19.3 deg).
-  const CliResult r = cli_test::RunPitchlab(
-      "plan " + kDemDir + "west_bijou_gully.asc --start 559727,4380461 --goal 559736,4380395 "
-      "--json --out " + (dir / "p").string(), dir);
+  const CliResult r =
+      cli_test::RunPitchlab("plan " + kDemDir +
+                                "west_bijou_gully.asc --start 559727,4380461 --goal 559736,4380395 "
+                                "--json --out " +
+                                (dir / "p").string(),
+                            dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_FALSE(j["input"]["resampled"].get<bool>());
@@ -87,9 +93,10 @@ TEST(UserMapsCli, PlansOnAMapServerOccupancyGrid) {
   std::ofstream(dir / "room.pgm") << pgm.str();
   std::ofstream(dir / "room.yaml") << "image: room.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n"
                                       "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
-  const CliResult r = cli_test::RunPitchlab(
-      "plan " + (dir / "room.yaml").string() + " --start 0.5,0.5 --goal 3.5,0.5 --json --out " +
-          (dir / "p").string(), dir);
+  const CliResult r = cli_test::RunPitchlab("plan " + (dir / "room.yaml").string() +
+                                                " --start 0.5,0.5 --goal 3.5,0.5 --json --out " +
+                                                (dir / "p").string(),
+                                            dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_TRUE(j["found"].get<bool>());

@@ -23,7 +23,9 @@ mapping::ElevationLayers Terrace(double cell_m, double rise_m) {
   return mapping::ComputeLayers(map);
 }
 
-Blocked At(const TraversabilityGrid& T, int i, int j) { return T.blocked[T.geometry.Linear({i, j})]; }
+Blocked At(const TraversabilityGrid& T, int i, int j) {
+  return T.blocked[T.geometry.Linear({i, j})];
+}
 
 TEST(CoarseGrid, HalfAMetreBetweenThreeMetreCellsIsASlopeNotAStep) {
   const PlannerConfig p3at;  // step 0.089 m, 19.3 deg, 0.497 x 0.508 m

@@ -79,15 +79,20 @@ TEST(AsciiGrid, BadFilesNameTheFileAndTheLine) {
   const struct {
     std::string text, where, what;
   } cases[] = {
-      {"ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\n1 2\n", ":5:", "missing header field 'cellsize'"},
+      {"ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\n1 2\n",
+       ":5:", "missing header field 'cellsize'"},
       {"ncols 2\nncols 2\n", ":2:", "given twice"},
-      {"ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 x\n", ":6:", "'x' is not a finite number"},
-      {"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3\n", ":7:", "the file ends after 3"},
+      {"ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 x\n",
+       ":6:", "'x' is not a finite number"},
+      {"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3\n",
+       ":7:", "the file ends after 3"},
       {"ncols 1\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n", ":6:", "more values"},
       {"ncols 1\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 0\n1\n", ":5:", "must be positive"},
       {"ncols 1.5\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n1\n", ":1:", "whole number"},
-      {"ncols 1\nnrows 1\nxllcorner 0\nxllcenter 0\nyllcorner 0\ncellsize 1\n1\n", ":7:", "exactly one"},
-      {"ncols 1\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\ndx 1\n1\n", ":6:", "'dx' is neither"},
+      {"ncols 1\nnrows 1\nxllcorner 0\nxllcenter 0\nyllcorner 0\ncellsize 1\n1\n",
+       ":7:", "exactly one"},
+      {"ncols 1\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\ndx 1\n1\n",
+       ":6:", "'dx' is neither"},
       {"ncols 1\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n1e999\n", ":6:", "not a finite"},
   };
   for (const auto& c : cases) {

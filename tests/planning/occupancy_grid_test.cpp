@@ -30,7 +30,8 @@ void WriteText(const fs::path& path, const std::string& text) {
 std::string Yaml(const std::string& image, const std::string& extra = "") {
   return "image: " + image +
          "\nresolution: 0.5\norigin: [-1.0, 2.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\n"
-         "free_thresh: 0.196\n" + extra;
+         "free_thresh: 0.196\n" +
+         extra;
 }
 
 std::int8_t At(const OccupancyGrid& g, int i, int j) { return g.value[g.geometry.Linear({i, j})]; }
@@ -71,7 +72,7 @@ TEST(OccupancyGrid, ScaleNegateAndRawModes) {
   WriteText(dir / "negate.yaml", negate);
   const Result<OccupancyGrid> neg = LoadOccupancyGrid((dir / "negate.yaml").string());
   ASSERT_TRUE(neg) << neg.error().message;
-  EXPECT_EQ(At(*neg, 0, 0), 86);  // p = 150 / 255 = 0.588 -> 99 * 0.864 = 85.5
+  EXPECT_EQ(At(*neg, 0, 0), 86);                // p = 150 / 255 = 0.588 -> 99 * 0.864 = 85.5
   EXPECT_EQ(At(*neg, 1, 0), kOccupancyLethal);  // p = 1
   WriteText(dir / "r.pgm", "P2 4 1 255 0 37 100 255\n");
   WriteText(dir / "raw.yaml", Yaml(fs::absolute(dir / "r.pgm").string(), "mode: raw\n"));
@@ -95,11 +96,14 @@ TEST(OccupancyGrid, BadFilesNameTheFileAndTheLine) {
       {Yaml("ok.pgm", "resolution: 1\n"), "", yaml + ":7:", "given twice (lines 2 and 7)"},
       {Yaml("ok.pgm", "mode: fancy\n"), "", yaml + ":7:", "trinary, scale or raw"},
       {"image: ok.pgm\nresolution: -1\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\n"
-       "free_thresh: 0.196\n", "", yaml + ":2:", "positive"},
+       "free_thresh: 0.196\n",
+       "", yaml + ":2:", "positive"},
       {"image: ok.pgm\nresolution: 1\norigin: [0, 0, 0.5]\nnegate: 0\noccupied_thresh: 0.65\n"
-       "free_thresh: 0.196\n", "", yaml + ":3:", "rotated grid"},
+       "free_thresh: 0.196\n",
+       "", yaml + ":3:", "rotated grid"},
       {"image: ok.pgm\nresolution: 1\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.1\n"
-       "free_thresh: 0.196\n", "", yaml + ":6:", "0 <= free_thresh < occupied_thresh"},
+       "free_thresh: 0.196\n",
+       "", yaml + ":6:", "0 <= free_thresh < occupied_thresh"},
       {"image: [ok.pgm\n", "", yaml + ":", "not valid YAML"},
       {Yaml("b.pgm"), "P6 2 2 255\n", "b.pgm:1:", "not a PGM image"},
       {Yaml("b.pgm"), "P2\n2 2\n255\n0 0\n0\n", "b.pgm:5:", "the image ends after 3 of 4"},

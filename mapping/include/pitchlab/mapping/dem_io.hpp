@@ -55,14 +55,14 @@ struct DemCrs {
     kTransverseMercator,  ///< PROJCS with Transverse_Mercator (UTM among them) [m]
   };
   Kind kind = Kind::kLocal;
-  std::string name;                      ///< the WKT's name, or "local" / "no .prj"
-  double semi_major_m = 6378137.0;       ///< ellipsoid a [m] (WGS84's unless the .prj says)
+  std::string name;                           ///< the WKT's name, or "local" / "no .prj"
+  double semi_major_m = 6378137.0;            ///< ellipsoid a [m] (WGS84's unless the .prj says)
   double inverse_flattening = 298.257223563;  ///< ellipsoid 1/f [1]
-  double central_meridian_deg = 0;       ///< [deg]
-  double latitude_of_origin_deg = 0;     ///< [deg]
-  double scale_factor = 1;               ///< [1]
-  double false_easting_m = 0;            ///< [m]
-  double false_northing_m = 0;           ///< [m]
+  double central_meridian_deg = 0;            ///< [deg]
+  double latitude_of_origin_deg = 0;          ///< [deg]
+  double scale_factor = 1;                    ///< [1]
+  double false_easting_m = 0;                 ///< [m]
+  double false_northing_m = 0;                ///< [m]
 };
 
 /// Parses `.prj` text. Fails (kInvalidArgument) naming `source` on WKT that is none of the kinds
@@ -72,10 +72,10 @@ struct DemCrs {
 
 /// A DEM read as an elevation map (one point per cell at the cell's centre and height).
 struct Dem {
-  ElevationMap map;     ///< geodetic origin set when the grid is georeferenced
-  DemCrs crs;           ///< from the `.prj`, kLocal without one
-  AsciiGrid grid;       ///< the file as read
-  bool resampled = false;      ///< false: every cell is the file's cell, value for value
+  ElevationMap map;              ///< geodetic origin set when the grid is georeferenced
+  DemCrs crs;                    ///< from the `.prj`, kLocal without one
+  AsciiGrid grid;                ///< the file as read
+  bool resampled = false;        ///< false: every cell is the file's cell, value for value
   std::size_t nodata_cells = 0;  ///< file cells without a value (unknown in the map) [1]
 
   /// The map-frame point [m] of a point in the file's coordinates (x, y [m] or lon, lat [deg]).

@@ -24,8 +24,8 @@ namespace pitchlab::planning {
 
 /// An occupancy grid in the map_server frame: row 0 the southern (the YAML origin's) row.
 struct OccupancyGrid {
-  mapping::GridGeometry geometry;   ///< x_min/y_min the origin, cell_m the resolution
-  std::vector<std::int8_t> value;   ///< per cell (GridGeometry::Linear): -1 unknown, 0..100 [%]
+  mapping::GridGeometry geometry;  ///< x_min/y_min the origin, cell_m the resolution
+  std::vector<std::int8_t> value;  ///< per cell (GridGeometry::Linear): -1 unknown, 0..100 [%]
 };
 
 inline constexpr std::int8_t kOccupancyUnknown = -1;
