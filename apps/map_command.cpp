@@ -1,5 +1,6 @@
-// `pitchlab map`: clouds (PCD) -> elevation map (Eq. 2, 3, inclination), written losslessly, as an
-// ESRI ASCII grid with its projection and as a PNG; with --world, scored against ground truth.
+// `pitchlab map`: clouds (PCD) -> elevation map (Eq. 2, 3, inclination), written losslessly, as
+// ESRI ASCII rasters (elevation, inclination, roughness) with their projection, as a map_server
+// occupancy grid (traversability) and as a PNG; with --world, scored against ground truth.
 
 #include <unistd.h>
 
@@ -15,18 +16,19 @@
 #include "cloud_input.hpp"
 #include "commands.hpp"
 #include "interrupt.hpp"
+#include "output_paths.hpp"
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/elevation_map.hpp"
 #include "pitchlab/mapping/elevation_truth.hpp"
 #include "pitchlab/mapping/ground_level.hpp"
+#include "pitchlab/planning/occupancy_grid.hpp"
+#include "pitchlab/planning/traversability.hpp"
 #include "pitchlab/sensors/ray_caster.hpp"
 #include "pitchlab/sensors/scan_pcd.hpp"
 #include "pitchlab/sim/simulation.hpp"
 #include "pitchlab/worlds/world_catalog.hpp"
-#include "output_paths.hpp"
 #include "progress.hpp"
-#include "output_paths.hpp"
 #include "run_folder.hpp"
 #include "world_paths.hpp"
 
@@ -41,26 +43,33 @@ std::string DefaultClearance() {
 }
 
 CliArgs MapArgs() {
-  CliArgs args("map",
-               "Builds an elevation map from point clouds (any format sensors read: PCD, 3DTK\n"
-               ".3d, PLY, XYZ; points moved into the world by each file's pose) and writes DIR/map.plem (lossless), DIR/elevation.asc\n"
-               "+ .prj (georeferenced raster), DIR/elevation.png and DIR/map.json. With --world,\n"
-               "the map is georeferenced and scored against the world's true surface.\n"
-               "\n"
-               "Levelling: without --world (whose frame is the simulator's, z up) nothing tells\n"
-               "where gravity points, and a scanner mounted a few degrees off tilts the whole map\n"
-               "(a flat floor reads as a slope). The map frame is then turned about its origin so\n"
-               "that the floor under the first cloud's sensor is level: a robust plane fit of the\n"
-               "points below the sensor within 0.5-4 m of it. It assumes the first scan stood on\n"
-               "level ground; map.json reports the plane (normal, tilt removed, residual, points).\n"
-               "--no-level keeps the clouds' frame (their poses came levelled by an IMU).\n"
-               "\n"
-               "Height band: points higher than --max-height above the ground under the sensor\n"
-               "that saw them are not ground (a ceiling, a canopy), unless the laser saw their\n"
-               "surface from above: terrain rising ahead may climb 35 % (the P3-AT's grade) of\n"
-               "its distance higher. Points on a surface the laser saw from below (a ceiling, a\n"
-               "desk's underside) are never ground. Cells whose only points were those stay\n"
-               "unknown.");
+  CliArgs args(
+      "map",
+      "Builds an elevation map from point clouds (any format sensors read: PCD, 3DTK\n"
+      ".3d, PLY, XYZ; points moved into the world by each file's pose) and writes\n"
+      "DIR/map.plem (lossless), DIR/elevation.png, DIR/map.json, ESRI ASCII rasters\n"
+      "with their .prj (georeferenced with --world): DIR/elevation.asc [m],\n"
+      "DIR/inclination.asc (the cell plane's tilt [deg]), DIR/roughness.asc (Eq. 3 [m]),\n"
+      "and the traversability for --robot as a ROS map_server occupancy grid,\n"
+      "DIR/traversability.yaml + .pgm (raw mode: 0 free, 1..99 the cost of entering,\n"
+      "100 lethal: step, drop, too steep; 255 unknown; Nav2's static layer reads the\n"
+      "costs with trinary_costmap: false, and inflates by its own footprint). With\n"
+      "--world, the map is georeferenced and scored against the world's true surface.\n"
+      "\n"
+      "Levelling: without --world (whose frame is the simulator's, z up) nothing tells\n"
+      "where gravity points, and a scanner mounted a few degrees off tilts the whole map\n"
+      "(a flat floor reads as a slope). The map frame is then turned about its origin so\n"
+      "that the floor under the first cloud's sensor is level: a robust plane fit of the\n"
+      "points below the sensor within 0.5-4 m of it. It assumes the first scan stood on\n"
+      "level ground; map.json reports the plane (normal, tilt removed, residual, points).\n"
+      "--no-level keeps the clouds' frame (their poses came levelled by an IMU).\n"
+      "\n"
+      "Height band: points higher than --max-height above the ground under the sensor\n"
+      "that saw them are not ground (a ceiling, a canopy), unless the laser saw their\n"
+      "surface from above: terrain rising ahead may climb 35 % (the P3-AT's grade) of\n"
+      "its distance higher. Points on a surface the laser saw from below (a ceiling, a\n"
+      "desk's underside) are never ground. Cells whose only points were those stay\n"
+      "unknown.");
   args.Positionals("CLOUD", "one or more clouds, any format below", 1, 1000)
       .Option("sensor-origin", "x,y,z", kSensorOriginHelp)
       .Option("cell", "METRES", "cell size [m]", "0.1")
@@ -78,6 +87,9 @@ CliArgs MapArgs() {
               "0.6 m tall, plus 0.4 m for the ground's unevenness and the pose's tilt error; "
               "'inf' disables",
               "1.0")
+      .Option("robot", "p3at|p3dx",
+              "robot whose limits (step, inclination) make traversability.pgm's lethal cells",
+              "p3at")
       .Flag("no-level", "keep the clouds' frame; do not level it by the first cloud's floor")
       .Flag("json", "print the summary as JSON on stdout")
       .Flag("quiet", "no progress on stderr");
@@ -199,6 +211,12 @@ int RunMap(int argc, char** argv) {
   insert.max_height_m = args.GetNumbers("max-height", 1)[0];
   if (!(insert.max_height_m > 0)) throw CliError("--max-height must be positive (or inf)");
   const double margin = args.GetNumber("margin", 0.0, kInf);
+  planning::RobotLimits robot;
+  try {
+    robot = planning::RobotLimits::Preset(args.Get("robot"));
+  } catch (const std::invalid_argument& e) {
+    throw CliError(std::string("--robot: ") + e.what());
+  }
   const bool quiet = args.Flagged("quiet");
   const auto progress = [quiet](const std::string& text) {
     if (!quiet) std::fprintf(stderr, "map: %s\n", text.c_str());
@@ -324,6 +342,20 @@ int RunMap(int argc, char** argv) {
   };
   check(mapping::SaveElevationMap(map, folder.File("map.plem").string()));
   check(mapping::WriteEsriAsciiGrid(layers, origin, folder.File("elevation.asc").string()));
+  check(mapping::WriteEsriAsciiGrid(layers, origin, folder.File("inclination.asc").string(),
+                                    mapping::RasterLayer::kInclination));
+  check(mapping::WriteEsriAsciiGrid(layers, origin, folder.File("roughness.asc").string(),
+                                    mapping::RasterLayer::kRoughness));
+  // Unknown cells stay unknown in the occupancy grid: a navigation stack decides what they are.
+  planning::PlannerConfig planner;
+  planner.robot = robot;
+  planner.unknown = planning::UnknownPolicy::kForbid;
+  const planning::TraversabilityGrid traversability =
+      planning::BuildTraversability(layers, planner);
+  check(planning::WriteOccupancyGrid(planning::ToOccupancy(traversability),
+                                     folder.File("traversability.yaml").string()));
+  std::size_t lethal = 0;
+  for (planning::Blocked b : traversability.blocked) lethal += planning::IsFootprintHazard(b);
   check(mapping::WritePng(mapping::RenderElevationImage(layers),
                           folder.File("elevation.png").string()));
 
@@ -354,7 +386,12 @@ int RunMap(int argc, char** argv) {
       {"known_cells", known},
       {"drop_cells", drops},
       {"insert_time_s", insert_s},
-      {"files", {"map.plem", "elevation.asc", "elevation.prj", "elevation.png", "map.json"}}};
+      {"robot", robot.name},
+      {"lethal_cells", lethal},
+      {"files",
+       {"map.plem", "elevation.asc", "elevation.prj", "inclination.asc", "inclination.prj",
+        "roughness.asc", "roughness.prj", "traversability.yaml", "traversability.pgm",
+        "elevation.png", "map.json"}}};
   if (origin) {
     summary["geodetic_origin"] = {origin->latitude_deg, origin->longitude_deg, origin->height_m};
   }
@@ -379,10 +416,11 @@ int RunMap(int argc, char** argv) {
   }
   std::printf(
       "elevation map %d x %d cells of %.3f m: %zu of %zu points inserted, %zu cells known, "
-      "%zu drop cells\nwrote %s/{map.plem, elevation.asc, elevation.prj, elevation.png, "
+      "%zu drop cells, %zu lethal for %s\nwrote %s/{map.plem, elevation.asc, inclination.asc, "
+      "roughness.asc (each with its .prj), traversability.yaml + .pgm, elevation.png, "
       "map.json}\n",
-      geometry.size_x, geometry.size_y, cell, stats.inserted, total_points, known, drops,
-      out.string().c_str());
+      geometry.size_x, geometry.size_y, cell, stats.inserted, total_points, known, drops, lethal,
+      robot.name.c_str(), out.string().c_str());
   if (levelling.contains("tilt_removed_deg")) {
     std::printf("levelled by the first cloud's floor: %.2f deg of tilt removed (floor plane "
                 "residual %.4f m over %zu points, sensor %.3f m above it)\n",

@@ -1,5 +1,5 @@
-// `pitchlab plan`: least-cost path (Eq. 4-5, Algorithm 2) on an elevation map, written as CSV,
-// GeoJSON (WGS84) and drawn on the map picture.
+// `pitchlab plan`: least-cost path (Eq. 4-5, Algorithm 2) on an elevation map, a DEM or an
+// occupancy grid, written as CSV, GeoJSON (WGS84) and drawn on the map picture.
 
 #include <chrono>
 #include <cmath>
@@ -14,12 +14,14 @@
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "interrupt.hpp"
+#include "output_paths.hpp"
 #include "pitchlab/mapping/elevation_io.hpp"
+#include "pitchlab/planning/occupancy_grid.hpp"
 #include "pitchlab/planning/path_io.hpp"
 #include "pitchlab/planning/planner.hpp"
 #include "pitchlab/planning/traversability.hpp"
 #include "pitchlab/sensors/yaml_keys.hpp"
-#include "output_paths.hpp"
+#include "plan_input.hpp"
 #include "run_folder.hpp"
 #include "traversability_image.hpp"
 
@@ -38,23 +40,61 @@ planning::PlannerConfig ReadPlannerConfig(const std::string& path) {
   return planning::ParsePlannerConfig(text.str(), path);
 }
 
+// The planner's defaults as --help states them, from the library's own values.
+std::string PlannerDefaults() {
+  const planning::PlannerConfig c;
+  char text[900];
+  std::snprintf(
+      text, sizeof(text),
+      "Defaults (a --config file may set any of them; --robot and --unknown override it):\n"
+      "  robot %s: step %g m, inclination %.1f deg, %g m wide, %g m long\n"
+      "  weights: roughness %g, length %g, inclination_x %g, inclination_y %g\n"
+      "  unknown: forbid (unknown_penalty %g when penalise); `pitchlab run` plans with\n"
+      "    penalise: a map from scans has unknown cells under and around the robot (the laser\n"
+      "    does not see its own footprint), so give --unknown penalise on such maps\n"
+      "  clearance_m %g, clearance_cost %g (off); algorithm astar (exact, as dijkstra)\n",
+      c.robot.name.c_str(), c.robot.step_max_m, c.robot.max_inclination_rad * kRadToDeg,
+      c.robot.width_m, c.robot.length_m, c.weights.roughness, c.weights.length,
+      c.weights.inclination_x, c.weights.inclination_y, c.unknown_penalty, c.clearance_m,
+      c.clearance_cost);
+  return text;
+}
+
 CliArgs PlanArgs() {
   CliArgs args(
       "plan",
       "Plans the least-cost path (Eq. 5: W_T*T + W_P*P + W_phix*phi_x + W_phiy*phi_y per\n"
-      "edge, 8-connected cells) on an elevation map written by `pitchlab map`, and writes\n"
-      "DIR/path.csv, DIR/path.geojson (when the map is georeferenced), DIR/path.png and\n"
-      "DIR/plan.json, and always DIR/traversability.png (what the robot may enter and why\n"
-      "not) and DIR/elevation.png. No path: the reason is printed and the exit code is 1;\n"
-      "when start and goal lie on the map, DIR still gets the two pictures and plan.json\n"
-      "(found: false), to show why; otherwise no DIR is made.");
-  args.Positionals("MAP.plem", "elevation map", 1, 1)
-      .Option("start", "x,y", "start in the map frame [m]")
-      .Option("goal", "x,y", "goal in the map frame [m]")
-      .Option("robot", "p3at|p3dx", "robot preset (step, inclination, width); overrides --config's")
+      "edge, 8-connected cells) on a map and writes DIR/path.csv, DIR/path.geojson (WGS84,\n"
+      "when the map is georeferenced), DIR/path.png and DIR/plan.json, and always\n"
+      "DIR/traversability.png (what the robot may enter and why not) and, for maps with\n"
+      "heights, DIR/elevation.png. No path: the reason is printed and the exit code is 1;\n"
+      "when start and goal lie on the map, DIR still gets the pictures and plan.json\n"
+      "(found: false), to show why; otherwise no DIR is made.\n"
+      "\n"
+      "MAP is one of:\n"
+      "  MAP.plem   an elevation map written by `pitchlab map`\n"
+      "  MAP.asc    a DEM, ESRI ASCII grid, with its MAP.prj when georeferenced (longitude/\n"
+      "             latitude, UTM or another Transverse Mercator; none: local metres); a\n"
+      "             georeferenced grid is resampled onto square metres at its centre\n"
+      "  MAP.yaml   a ROS map_server occupancy grid (PGM image; trinary, scale or raw):\n"
+      "             occupied cells are obstacles, grey levels costs, unknown cells unknown\n"
+      "--start and --goal are in the map's own coordinates: the map frame of a .plem, the\n"
+      "grid's x, y of a DEM (easting, northing, or longitude, latitude in degrees), the\n"
+      "YAML's frame of an occupancy grid.\n"
+      "\n"
+      "A grid coarser than the robot (a DEM's 3 m or 30 m cells) holds one height under the\n"
+      "whole robot: a rise between neighbouring cells is read as a slope (blocked beyond the\n"
+      "robot's inclination), not as a step, and a warning says what the map cannot show.\n"
+      "\n" +
+          PlannerDefaults());
+  args.Positionals("MAP", "map file: .plem, .asc or .yaml (see above)", 1, 1)
+      .Option("start", "x,y", "start in the map's own coordinates (see above)")
+      .Option("goal", "x,y", "goal in the map's own coordinates")
+      .Option("robot", "p3at|p3dx",
+              "robot preset (step, inclination, size); default p3at, or --config's")
       .Option("algo", "astar|dijkstra", "graph search", "astar")
       .Option("config", "FILE.yaml", "planner config: weights, robot limits, unknown policy")
-      .Option("unknown", "forbid|penalise", "unknown cells, overrides --config's")
+      .Option("unknown", "forbid|penalise", "unknown cells; default forbid, or --config's")
       .Option("out", "DIR", "output folder to create (refused when it exists, as run refuses)")
       .Flag("json", "print the result as JSON on stdout");
   return args;
@@ -69,7 +109,8 @@ nlohmann::json PathJson(const planning::Path& p) {
             {"length", p.parts.length},
             {"inclination_x", p.parts.inclination_x},
             {"inclination_y", p.parts.inclination_y},
-            {"unknown", p.parts.unknown}}},
+            {"unknown", p.parts.unknown},
+            {"occupancy", p.parts.occupancy}}},
           {"length_m", p.length_m},
           {"waypoints", p.waypoints.size()},
           {"max_step_m", p.max_step_m},
@@ -77,15 +118,8 @@ nlohmann::json PathJson(const planning::Path& p) {
           {"expanded", p.expanded}};
 }
 
-}  // namespace
-
-int RunPlan(int argc, char** argv) {
-  CliArgs args = PlanArgs();
-  if (!args.Parse(argc, argv)) return 0;
-  InstallInterruptCleanup("pitchlab plan");  // Ctrl-C removes the unfinished folder
-  const std::vector<double> start = args.GetNumbers("start", 2), goal = args.GetNumbers("goal", 2);
-  const std::filesystem::path out = args.Get("out");
-  CheckNewFolder("out", out);  // as run and map: never into an existing folder
+// The planner config from --config, --robot and --unknown (CliError on a bad value).
+planning::PlannerConfig PlanConfig(const CliArgs& args) {
   planning::PlannerConfig config;
   if (args.Has("config")) config = ReadPlannerConfig(args.Get("config"));
   try {
@@ -99,41 +133,87 @@ int RunPlan(int argc, char** argv) {
     config.unknown =
         u == "forbid" ? planning::UnknownPolicy::kForbid : planning::UnknownPolicy::kPenalise;
   }
+  return config;
+}
+
+// The pictures of the map and of what the planner may enter, with or without a path: they show
+// why the path went where it did, or why there is none. Returns the files written.
+std::vector<std::string> WritePictures(const PlanInput& in, const planning::Path* path,
+                                       const RunFolder& folder) {
+  const auto check = [](Result<void> r) {
+    if (!r) throw std::runtime_error(r.error().message);
+  };
+  std::vector<std::string> files;
+  mapping::RgbImage traversability = RenderTraversability(in.grid);
+  if (path) planning::DrawPath(*path, in.grid.geometry, traversability);
+  check(mapping::WritePng(traversability, folder.File("traversability.png").string()));
+  files.push_back("traversability.png");
+  if (in.layers) {
+    check(mapping::WritePng(mapping::RenderElevationImage(*in.layers),
+                            folder.File("elevation.png").string()));
+    files.push_back("elevation.png");
+  }
+  if (path) {  // the path on the elevation picture, or on the traversability one without heights
+    mapping::RgbImage image =
+        in.layers ? mapping::RenderElevationImage(*in.layers) : RenderTraversability(in.grid);
+    planning::DrawPath(*path, in.grid.geometry, image);
+    check(mapping::WritePng(image, folder.File("path.png").string()));
+    files.push_back("path.png");
+  }
+  return files;
+}
+
+std::string JoinFiles(const std::vector<std::string>& files) {
+  std::string text;
+  for (const std::string& f : files) text += (text.empty() ? "" : ", ") + f;
+  return text;
+}
+
+}  // namespace
+
+int RunPlan(int argc, char** argv) {
+  CliArgs args = PlanArgs();
+  if (!args.Parse(argc, argv)) return 0;
+  InstallInterruptCleanup("pitchlab plan");  // Ctrl-C removes the unfinished folder
+  const std::vector<double> start = args.GetNumbers("start", 2), goal = args.GetNumbers("goal", 2);
+  const std::filesystem::path out = args.Get("out");
+  CheckNewFolder("out", out);  // as run and map: never into an existing folder
+  const planning::PlannerConfig config = PlanConfig(args);
   planning::Algorithm algorithm;
   try {
     algorithm = planning::ParseAlgorithm(args.Get("algo"));
   } catch (const std::invalid_argument& e) {
     throw CliError(std::string("--algo: ") + e.what());
   }
-  Result<mapping::ElevationMap> map = mapping::LoadElevationMap(args.positionals()[0]);
-  if (!map) throw std::runtime_error(map.error().message);
 
   const auto t0 = std::chrono::steady_clock::now();
-  const mapping::ElevationLayers layers = mapping::ComputeLayers(*map);
-  const planning::TraversabilityGrid grid = planning::BuildTraversability(layers, config);
+  const PlanInput in = LoadPlanInput(args.positionals()[0], config);
   const auto t1 = std::chrono::steady_clock::now();
-  const auto result = planning::PlanPath(grid, {start[0], start[1]}, {goal[0], goal[1]}, algorithm);
+  const Eigen::Vector2d start_m = in.to_map({start[0], start[1]});
+  const Eigen::Vector2d goal_m = in.to_map({goal[0], goal[1]});
+  const auto result = planning::PlanPath(in.grid, start_m, goal_m, algorithm);
   const auto t2 = std::chrono::steady_clock::now();
 
   nlohmann::json summary;
   summary["robot"] = config.robot.name;
+  summary["unknown"] = config.unknown == planning::UnknownPolicy::kForbid ? "forbid" : "penalise";
+  summary["input"] = in.about;
   summary["start"] = start;
   summary["goal"] = goal;
+  if (start_m != Eigen::Vector2d(start[0], start[1]) ||
+      goal_m != Eigen::Vector2d(goal[0], goal[1])) {
+    summary["start_map_m"] = {start_m.x(), start_m.y()};
+    summary["goal_map_m"] = {goal_m.x(), goal_m.y()};
+  }
   summary["traversability_time_s"] = std::chrono::duration<double>(t1 - t0).count();
   summary["search_time_s"] = std::chrono::duration<double>(t2 - t1).count();
-  const auto check = [](Result<void> r) {
-    if (!r) throw std::runtime_error(r.error().message);
-  };
-  // The pictures of the map and of what the planner may enter, with or without a path: they
-  // show why the path went where it did, or why there is none.
-  const auto write_pictures = [&](const RunFolder& folder, const planning::Path* path) {
-    mapping::RgbImage elevation = mapping::RenderElevationImage(layers);
-    check(mapping::WritePng(elevation, folder.File("elevation.png").string()));
-    mapping::RgbImage traversability = RenderTraversability(grid);
-    if (path) planning::DrawPath(*path, map->geometry(), traversability);
-    check(mapping::WritePng(traversability, folder.File("traversability.png").string()));
-    summary["traversability_legend"] = TraversabilityLegend();
-  };
+  summary["warnings"] = nlohmann::json::array();
+  if (const std::string w = planning::CoarseGridWarning(in.grid.geometry, config.robot);
+      !w.empty()) {
+    summary["warnings"].push_back(w);
+    std::cerr << "pitchlab plan: warning: " << w << "\n";
+  }
+  summary["traversability_legend"] = TraversabilityLegend();
   if (!result) {
     // No path: the reason on stderr (and stdout with --json), exit 1. Start and goal on the map:
     // the pictures and plan.json are written so the user can see what blocks the way; a start
@@ -144,36 +224,47 @@ int RunPlan(int argc, char** argv) {
     summary.update({{"found", false},
                     {"reason", planning::ToString(reason)},
                     {"message", result.error().message}});
+    std::vector<std::string> files;
     if (on_map) {
       RunFolder folder(out);
-      write_pictures(folder, nullptr);
-      summary["files"] = {"traversability.png", "elevation.png", "plan.json"};
+      files = WritePictures(in, nullptr, folder);
+      files.push_back("plan.json");
+      summary["files"] = files;
       WriteTextFile(folder.File("plan.json"), summary.dump(2) + "\n");
       folder.Commit();
     }
     if (args.Flagged("json")) std::cout << summary.dump(2) << "\n";
     std::cerr << "pitchlab plan: no path (" << planning::ToString(reason)
               << "): " << result.error().message << "\n";
+    if (on_map && config.unknown == planning::UnknownPolicy::kForbid) {
+      std::cerr << "unknown cells are forbidden (the default): --unknown penalise plans through "
+                   "them at a cost, as `pitchlab run` does\n";
+    }
     if (on_map) {
-      std::cerr << "wrote " << out.string()
-                << "/{traversability.png, elevation.png, plan.json}: traversability.png shows what "
-                   "blocks the way (red step, orange too steep, magenta drop, checkered unknown)\n";
+      std::cerr << "wrote " << out.string() << "/{" << JoinFiles(files)
+                << "}: traversability.png shows what blocks the way (red step, orange too "
+                   "steep, magenta drop, black occupied, checkered unknown)\n";
     }
     return 1;
   }
   summary.update(PathJson(*result));
   RunFolder folder(out);
+  const auto check = [](Result<void> r) {
+    if (!r) throw std::runtime_error(r.error().message);
+  };
+  std::vector<std::string> files = {"path.csv"};
   check(planning::WritePathCsv(*result, folder.File("path.csv").string()));
-  if (map->geodetic_origin()) {
-    check(planning::WritePathGeoJson(*result, map->geodetic_origin(),
-                                     folder.File("path.geojson").string()));
+  if (in.origin) {
+    check(planning::WritePathGeoJson(*result, in.origin, folder.File("path.geojson").string()));
+    files.push_back("path.geojson");
   } else {
-    summary["geojson"] = "skipped: the map has no geodetic origin (map it with --world)";
+    summary["geojson"] =
+        "skipped: the map is not georeferenced (a .plem mapped without --world, "
+        "a DEM without a .prj, an occupancy grid)";
   }
-  mapping::RgbImage image = mapping::RenderElevationImage(layers);
-  planning::DrawPath(*result, map->geometry(), image);
-  check(mapping::WritePng(image, folder.File("path.png").string()));
-  write_pictures(folder, &*result);
+  for (const std::string& f : WritePictures(in, &*result, folder)) files.push_back(f);
+  files.push_back("plan.json");
+  summary["files"] = files;
   WriteTextFile(folder.File("plan.json"), summary.dump(2) + "\n");
   folder.Commit();
   if (args.Flagged("json")) {
@@ -181,13 +272,12 @@ int RunPlan(int argc, char** argv) {
   } else {
     std::printf(
         "path (%s): cost %.4f (roughness %.4f, length %.4f, incl. x %.4f, incl. y %.4f, "
-        "unknown %.4f), %.2f m, %zu waypoints, max step %.3f m, max inclination %.1f deg\n"
-        "wrote %s/{path.csv, path.geojson, path.png, traversability.png, elevation.png, "
-        "plan.json}\n",
+        "unknown %.4f, occupancy %.4f), %.2f m, %zu waypoints, max step %.3f m, max inclination "
+        "%.1f deg\nwrote %s/{%s}\n",
         planning::ToString(algorithm), result->cost, result->parts.roughness, result->parts.length,
         result->parts.inclination_x, result->parts.inclination_y, result->parts.unknown,
-        result->length_m, result->waypoints.size(), result->max_step_m,
-        result->max_inclination_rad * kRadToDeg, out.string().c_str());
+        result->parts.occupancy, result->length_m, result->waypoints.size(), result->max_step_m,
+        result->max_inclination_rad * kRadToDeg, out.string().c_str(), JoinFiles(files).c_str());
   }
   return 0;
 }

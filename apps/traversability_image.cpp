@@ -82,6 +82,9 @@ mapping::RgbImage RenderTraversability(const planning::TraversabilityGrid& T,
           case Blocked::kNearHazard:
             c = {240, 175, 175};
             break;
+          case Blocked::kOccupied:
+            c = {30, 30, 30};
+            break;
           case Blocked::kUnknown:
             break;
         }
@@ -130,7 +133,8 @@ std::string HazardErrorsLegend() {
 
 std::string TraversabilityLegend() {
   return "Green: free (darker costs more to enter); checkered: unknown; red: step; orange: too "
-         "steep; magenta: drop; pale red: closer to a hazard than half the robot's width plus "
+         "steep; magenta: drop; black: occupied (an occupancy grid's obstacle); pale red: closer "
+         "to a hazard than half the robot's width plus "
          "the safety margin.";
 }
 

@@ -70,6 +70,8 @@ double LayerValue(const ElevationLayers& L, std::size_t k, RasterLayer layer) {
       return L.max_z[k];
     case RasterLayer::kRoughness:
       return L.roughness[k];
+    case RasterLayer::kInclination:
+      return L.Tilt(k) * (180.0 / M_PI);
   }
   return std::nan("");
 }
@@ -205,7 +207,9 @@ Result<void> WriteEsriAsciiGrid(const ElevationLayers& L,
                                 const std::optional<GeodeticOrigin>& origin,
                                 const std::string& asc_path, RasterLayer layer) {
   const GridGeometry& g = L.geometry;
-  const double z_offset = (origin && layer != RasterLayer::kRoughness) ? origin->height_m : 0.0;
+  const bool height =
+      layer == RasterLayer::kMean || layer == RasterLayer::kMin || layer == RasterLayer::kMax;
+  const double z_offset = (origin && height) ? origin->height_m : 0.0;
   std::string out;
   out.reserve(g.cell_count() * 10 + 256);
   char buf[128];

@@ -7,26 +7,13 @@
 #include <filesystem>
 #include <fstream>
 
+#include "atomic_file.hpp"
+
 namespace pitchlab::planning {
 namespace {
 
 Result<void> WriteText(const std::string& file, const std::string& text) {
-  const std::string tmp = file + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    if (!out) return Fail(Error::Code::kInvalidArgument, file + ": cannot write");
-    out << text;
-    if (!out.flush()) {
-      out.close();
-      std::error_code ignored;
-      std::filesystem::remove(tmp, ignored);  // a full disk leaves no partial file behind
-      return Fail(Error::Code::kFailed, file + ": write failed");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) return Fail(Error::Code::kFailed, file + ": rename failed: " + ec.message());
-  return {};
+  return WriteFileAtomically(file, text);
 }
 
 std::string Num(double v, const char* fmt = "%.4f") {
@@ -104,11 +91,14 @@ Result<void> WritePathGeoJson(const Path& path,
   const CostParts& c = path.parts;
   std::string props =
       "\"algorithm\":\"" + std::string(ToString(path.algorithm)) + "\"" +
-      ",\"cost\":" + JsonNum(path.cost, "%.6f") + ",\"cost_roughness\":" + JsonNum(c.roughness, "%.6f") +
+      ",\"cost\":" + JsonNum(path.cost, "%.6f") +
+      ",\"cost_roughness\":" + JsonNum(c.roughness, "%.6f") +
       ",\"cost_length\":" + JsonNum(c.length, "%.6f") +
       ",\"cost_inclination_x\":" + JsonNum(c.inclination_x, "%.6f") +
       ",\"cost_inclination_y\":" + JsonNum(c.inclination_y, "%.6f") +
-      ",\"cost_unknown\":" + JsonNum(c.unknown, "%.6f") + ",\"length_m\":" + JsonNum(path.length_m, "%.4f") +
+      ",\"cost_unknown\":" + JsonNum(c.unknown, "%.6f") +
+      ",\"cost_occupancy\":" + JsonNum(c.occupancy, "%.6f") +
+      ",\"length_m\":" + JsonNum(path.length_m, "%.4f") +
       ",\"max_step_m\":" + JsonNum(path.max_step_m, "%.4f") +
       ",\"max_inclination_deg\":" + JsonNum(path.max_inclination_rad * 180 / M_PI, "%.4f");
   const std::string text =

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -49,6 +50,7 @@ inline double RawEdgeCost(const TraversabilityGrid& T, std::size_t a, std::size_
       parts->roughness += w.roughness * T.roughness_m[b];
       parts->inclination_x += w.inclination_x * std::abs(T.phi_x_rad[b]);
       parts->inclination_y += w.inclination_y * std::abs(T.phi_y_rad[b]);
+      if (!T.occupancy_cost.empty()) parts->occupancy += T.occupancy_cost[b];
     }
   }
   return cost;
@@ -63,7 +65,7 @@ int MoveBetween(const CellIndex& a, const CellIndex& b) {
 
 std::string Where(const Eigen::Vector2d& p) {
   std::ostringstream os;
-  os << "(" << p.x() << ", " << p.y() << ")";
+  os << std::setprecision(10) << "(" << p.x() << ", " << p.y() << ")";  // UTM eastings whole
   return os.str();
 }
 

@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iterator>
 #include <limits>
 #include <stdexcept>
 
+#include "finish_traversability.hpp"
 #include "move_cost.hpp"
 
 namespace pitchlab::planning {
@@ -44,12 +46,19 @@ constexpr double kResidualPerStep = 0.25;
 // Steps within a cell (something sticking up or down from its mean, or points off their plane by
 // a step's residual), or this cell standing higher than an observed neighbour by more than
 // step_max: the upper side of a step is the hazard cell (a wall, a curb's top, a cliff's edge),
-// so gaps keep their true width before inflation.
-bool HasStep(const ElevationLayers& L, int i, int j, double step_max) {
+// so gaps keep their true width before inflation. On a grid coarser than the robot
+// (CoarserThanRobot) a rise between neighbours d apart is a slope: kTooSteep beyond
+// d tan(max_inclination) (and step_max), and a cell's own points may spread by a slope at that
+// limit over its half diagonal as well as by a step.
+Blocked StepOrSlope(const ElevationLayers& L, int i, int j, const RobotLimits& robot) {
   const GridGeometry& g = L.geometry;
   const std::size_t k = g.Linear({i, j});
+  const double step_max = robot.step_max_m;
+  const bool coarse = CoarserThanRobot(g, robot);
+  const double max_grade = std::tan(robot.max_inclination_rad);
+  const double in_cell = step_max + (coarse ? M_SQRT1_2 * g.cell_m * max_grade : 0.0);
   const float z = L.mean_z[k];
-  if (L.max_z[k] - z > step_max || z - L.min_z[k] > step_max) return true;
+  if (L.max_z[k] - z > in_cell || z - L.min_z[k] > in_cell) return Blocked::kStep;
   // NaN: no verdict; layers built by hand may leave the residual out. A step over the limit
   // inside the cell, both sides seen, puts its points at least that far apart; without that
   // spread the residual is noise, or two views of the same ground a pose error apart (the real
@@ -57,19 +66,23 @@ bool HasStep(const ElevationLayers& L, int i, int j, double step_max) {
   // row of "steps" across a flat floor).
   if (k < L.plane_residual.size() && L.plane_residual[k] > kResidualPerStep * step_max &&
       L.max_z[k] - L.min_z[k] > step_max)
-    return true;
+    return Blocked::kStep;
   for (int dj = -1; dj <= 1; ++dj)
     for (int di = -1; di <= 1; ++di) {
       const CellIndex nb{i + di, j + dj};
       if ((di == 0 && dj == 0) || !g.Contains(nb)) continue;
       const std::size_t kn = g.Linear(nb);
-      if (L.state[kn] == CellState::kObserved && z - L.mean_z[kn] > step_max) return true;
+      if (L.state[kn] != CellState::kObserved) continue;
+      const double rise = z - L.mean_z[kn];
+      if (!coarse) {
+        if (rise > step_max) return Blocked::kStep;
+        continue;
+      }
+      const double slope_rise = std::hypot(di, dj) * g.cell_m * max_grade;
+      if (rise > std::max(step_max, slope_rise))
+        return slope_rise >= step_max ? Blocked::kTooSteep : Blocked::kStep;
     }
-  return false;
-}
-
-bool IsHazard(Blocked b) {
-  return b == Blocked::kDrop || b == Blocked::kStep || b == Blocked::kTooSteep;
+  return Blocked::kFree;
 }
 
 // The hazard cells that border a non-hazard cell: the only ones a disc around them can reach
@@ -80,11 +93,11 @@ std::vector<std::size_t> HazardBorder(const TraversabilityGrid& T) {
   for (int j = 0; j < g.size_y; ++j)
     for (int i = 0; i < g.size_x; ++i) {
       const std::size_t k = g.Linear({i, j});
-      if (!IsHazard(T.blocked[k])) continue;
+      if (!IsFootprintHazard(T.blocked[k])) continue;
       bool edge = false;
       for (const auto& [di, dj] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
         const CellIndex nb{i + di, j + dj};
-        edge |= g.Contains(nb) && !IsHazard(T.blocked[g.Linear(nb)]);
+        edge |= g.Contains(nb) && !IsFootprintHazard(T.blocked[g.Linear(nb)]);
       }
       if (edge) border.push_back(k);
     }
@@ -243,8 +256,8 @@ float MoveCostOf(const TraversabilityGrid& T, std::size_t k, int b) {
   return MoveCostAt(T, c.i, c.j, b);
 }
 
-RobotLimits RobotLimits::P3AT() { return {"p3at", 0.089, std::atan(0.35), 0.497}; }
-RobotLimits RobotLimits::P3DX() { return {"p3dx", 0.025, std::atan(0.25), 0.381}; }
+RobotLimits RobotLimits::P3AT() { return {"p3at", 0.089, std::atan(0.35), 0.497, 0.508}; }
+RobotLimits RobotLimits::P3DX() { return {"p3dx", 0.025, std::atan(0.25), 0.381, 0.455}; }
 RobotLimits RobotLimits::Preset(const std::string& name) {
   if (name == "p3at") return P3AT();
   if (name == "p3dx") return P3DX();
@@ -265,6 +278,7 @@ void PlannerConfig::Validate() const {
   check(robot.max_inclination_rad > 0 && robot.max_inclination_rad < M_PI / 2, "max_inclination",
         robot.max_inclination_rad);
   check(robot.width_m >= 0, "width_m", robot.width_m);
+  check(robot.length_m > 0, "length_m", robot.length_m);
   check(unknown_penalty >= 0, "unknown_penalty", unknown_penalty);
   check(clearance_m >= 0 && clearance_m <= 10, "clearance_m", clearance_m);
   check(clearance_cost >= 0, "clearance_cost", clearance_cost);
@@ -292,6 +306,7 @@ PlannerConfig ParsePlannerConfig(const std::string& yaml_text, const std::string
   Read(root, "max_inclination_deg", source, &incl_deg);
   c.robot.max_inclination_rad = incl_deg * kDegToRad;
   Read(root, "width_m", source, &c.robot.width_m);
+  Read(root, "length_m", source, &c.robot.length_m);
   if (const YAML::Node w = root["weights"]) {
     Read(w, "roughness", source, &c.weights.roughness);
     Read(w, "length", source, &c.weights.length);
@@ -333,6 +348,8 @@ const char* ToString(Blocked b) {
       return "too steep";
     case Blocked::kNearHazard:
       return "closer to a hazard than half the robot's width";
+    case Blocked::kOccupied:
+      return "occupied";
   }
   return "?";
 }
@@ -375,8 +392,8 @@ TraversabilityGrid BuildTraversability(const ElevationLayers& L, const PlannerCo
                                            w.inclination_y * std::abs(T.phi_y_rad[k]));
       if (incl_known && L.Tilt(k) > config.robot.max_inclination_rad) {
         T.blocked[k] = Blocked::kTooSteep;
-      } else if (HasStep(L, i, j, config.robot.step_max_m)) {
-        T.blocked[k] = Blocked::kStep;
+      } else if (const Blocked b = StepOrSlope(L, i, j, config.robot); b != Blocked::kFree) {
+        T.blocked[k] = b;
       } else if (!incl_known) {
         // Seen, but the scan did not determine its slope (one or two far points, grazing lines:
         // LayerConfig's support rule): as steep as anything for all we know, so the unknown
@@ -386,6 +403,11 @@ TraversabilityGrid BuildTraversability(const ElevationLayers& L, const PlannerCo
         T.enter_cost[k] += static_cast<float>(config.unknown_penalty);
       }
     }
+  FinishTraversability(T);
+  return T;
+}
+
+void FinishTraversability(TraversabilityGrid& T) {
   const std::vector<std::size_t> border = HazardBorder(T);
   InflateHazards(T, border);
   AddClearanceCosts(T, border);
@@ -393,10 +415,32 @@ TraversabilityGrid BuildTraversability(const ElevationLayers& L, const PlannerCo
   ComputeMoveCosts(T);
   ComputeMoveCostRange(T);
   float min_cost = std::numeric_limits<float>::infinity();
-  for (std::size_t k = 0; k < n; ++k)
+  for (std::size_t k = 0; k < T.geometry.cell_count(); ++k)
     if (T.Free(k)) min_cost = std::min(min_cost, T.enter_cost[k]);
   T.min_enter_cost = std::isfinite(min_cost) ? min_cost : 0.0f;
-  return T;
+}
+
+bool IsFootprintHazard(Blocked b) {
+  return b == Blocked::kDrop || b == Blocked::kStep || b == Blocked::kTooSteep ||
+         b == Blocked::kOccupied;
+}
+
+bool CoarserThanRobot(const GridGeometry& geometry, const RobotLimits& robot) {
+  return geometry.cell_m > std::max(robot.width_m, robot.length_m);
+}
+
+std::string CoarseGridWarning(const GridGeometry& g, const RobotLimits& robot) {
+  if (!CoarserThanRobot(g, robot)) return "";
+  char text[640];
+  std::snprintf(text, sizeof(text),
+                "the map's %g m cells are coarser than the robot (%s, %g x %g m): each cell is "
+                "one height under the whole robot, so a rise between neighbouring cells is read "
+                "as a slope (too steep beyond %.1f deg), not as a step (%g m); rocks, curbs, "
+                "ditches and walls narrower than a cell are not in the map, and the footprint's "
+                "margin (%g m) is less than a cell: check the path on the ground",
+                g.cell_m, robot.name.c_str(), robot.length_m, robot.width_m,
+                robot.max_inclination_rad * 180 / M_PI, robot.step_max_m, 0.5 * robot.width_m);
+  return text;
 }
 
 }  // namespace pitchlab::planning

@@ -14,7 +14,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "pitchlab/mapping/dem_io.hpp"
 #include "pitchlab/mapping/elevation_io.hpp"
+#include "pitchlab/planning/occupancy_grid.hpp"
 
 #include "cli_support.hpp"
 
@@ -104,6 +106,36 @@ TEST_F(MapPlanCli, ScanMapPlanWritesFilesThatParse) {
   EXPECT_EQ(Slurp(plan_dir / "path.png").substr(0, 8), "\x89PNG\r\n\x1a\n");
   for (const auto& e : fs::directory_iterator(dir_))
     EXPECT_EQ(e.path().filename().string().find(".partial"), std::string::npos) << e.path();
+}
+
+TEST_F(MapPlanCli, MapWritesRastersAndAnOccupancyGridThatPlanReads) {
+  ASSERT_EQ(map_run_.exit_code, 0) << map_run_.err;
+  const fs::path map_dir = dir_ / "map";
+  const auto map = mapping::LoadElevationMap((map_dir / "map.plem").string());
+  ASSERT_TRUE(map) << map.error().message;
+  for (const char* raster : {"inclination", "roughness"}) {
+    const auto grid = mapping::ReadAsciiGrid((map_dir / (std::string(raster) + ".asc")).string());
+    ASSERT_TRUE(grid) << grid.error().message;
+    EXPECT_EQ(grid->ncols, map->geometry().size_x);
+    EXPECT_EQ(Slurp(map_dir / (std::string(raster) + ".prj")), Slurp(map_dir / "elevation.prj"));
+  }
+  // The map_server grid: the map's geometry, the office floor free, its walls lethal.
+  const auto occupancy = planning::LoadOccupancyGrid((map_dir / "traversability.yaml").string());
+  ASSERT_TRUE(occupancy) << occupancy.error().message;
+  EXPECT_TRUE(occupancy->geometry.SameAs(map->geometry()));
+  std::size_t lethal = 0, free = 0;
+  for (std::int8_t v : occupancy->value) lethal += v == 100, free += v >= 0 && v < 100;
+  EXPECT_EQ(lethal, nlohmann::json::parse(map_run_.out)["lethal_cells"].get<std::size_t>());
+  EXPECT_GT(free, 100u);
+  // The same plan as on the .plem, through the bridge: 1.5 m ahead of the robot.
+  const fs::path plan_dir = dir_ / "plan_occupancy";
+  const CliResult plan =
+      Run("plan " + (map_dir / "traversability.yaml").string() + " --start " +
+          Point(start_x_, start_y_) + " --goal " + Point(start_x_ + 1.5, start_y_) +
+          " --unknown penalise --json --out " + plan_dir.string());
+  ASSERT_EQ(plan.exit_code, 0) << plan.err;
+  EXPECT_TRUE(nlohmann::json::parse(plan.out)["found"].get<bool>());
+  EXPECT_GE(nlohmann::json::parse(plan.out)["length_m"].get<double>(), 1.4);
 }
 
 TEST_F(MapPlanCli, BadInputOrNoPathGivesAClearErrorANonZeroExitAndPicturesOnlyForNoPath) {

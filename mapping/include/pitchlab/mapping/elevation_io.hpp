@@ -33,13 +33,20 @@ namespace pitchlab::mapping {
 [[nodiscard]] Result<ElevationMap> LoadElevationMap(const std::string& path);
 
 /// Which layer a raster holds.
-enum class RasterLayer { kMean, kMin, kMax, kRoughness };
+enum class RasterLayer {
+  kMean,         ///< Eq. 2 cell elevation [m]
+  kMin,          ///< lowest point [m]
+  kMax,          ///< highest point [m]
+  kRoughness,    ///< Eq. 3 T [m]
+  kInclination,  ///< the cell plane's tilt, ElevationLayers::Tilt [deg] (GIS slope rasters' unit)
+};
 
 /// Writes `layer` as an ESRI ASCII grid (rows north to south, NODATA -9999 for unknown and drop
-/// cells, xll/yll the grid's outer corner) and a `.prj` beside it (same stem). With a geodetic
-/// origin the frame is a Transverse Mercator centred on it (WGS84, scale 1, false easting and
-/// northing 0: it matches the map's local ENU frame to well under a millimetre over kilometres)
-/// and heights are offset by the origin's height; without one a LOCAL_CS in metres.
+/// cells and for an inclination the scan does not support, xll/yll the grid's outer corner) and a
+/// `.prj` beside it (same stem). With a geodetic origin the frame is a Transverse Mercator
+/// centred on it (WGS84, scale 1, false easting and northing 0: it matches the map's local ENU
+/// frame to well under a millimetre over kilometres) and heights are offset by the origin's
+/// height; without one a LOCAL_CS in metres.
 [[nodiscard]] Result<void> WriteEsriAsciiGrid(const ElevationLayers& layers,
                                               const std::optional<GeodeticOrigin>& origin,
                                               const std::string& asc_path,

@@ -30,7 +30,10 @@ struct CostParts {
   double inclination_x = 0;  ///< sum W_phix * |phi_x| [1]
   double inclination_y = 0;  ///< sum W_phiy * |phi_y| [1]
   double unknown = 0;        ///< sum of unknown-cell penalties [1]
-  double Total() const { return roughness + length + inclination_x + inclination_y + unknown; }
+  double occupancy = 0;  ///< sum of an occupancy grid's grey-level costs (occupancy_grid.hpp) [1]
+  double Total() const {
+    return roughness + length + inclination_x + inclination_y + unknown + occupancy;
+  }
 };
 
 /// A found path.

@@ -26,6 +26,9 @@ struct RobotLimits {
   double step_max_m = 0.089;  ///< highest step between neighbouring cells (or within one) [m]
   double max_inclination_rad = 0.3367;  ///< slip/tip limit of the cell's plane tilt [rad]
   double width_m = 0.497;               ///< footprint width: no path through a narrower gap [m]
+  /// Footprint length [m]. With the width, what makes a grid coarser than the robot
+  /// (CoarserThanRobot).
+  double length_m = 0.508;
 
   /// Pioneer 3-AT (datasheet: 8.9 cm step, 35 % grade, 50.8 x 49.7 cm).
   static RobotLimits P3AT();
@@ -62,6 +65,7 @@ struct PlannerConfig {
 ///   step_max_m: 0.089
 ///   max_inclination_deg: 19.3
 ///   width_m: 0.497
+///   length_m: 0.508
 ///   weights: {roughness: 10, length: 1, inclination_x: 1, inclination_y: 1}
 ///   unknown: forbid              # forbid | penalise
 ///   unknown_penalty: 1.0
@@ -70,6 +74,17 @@ struct PlannerConfig {
 /// Missing fields keep their defaults. Throws std::runtime_error naming the source, field and
 /// value. A key given twice is the caller's to refuse (sensors::CheckUniqueYamlKeys, as the apps do).
 PlannerConfig ParsePlannerConfig(const std::string& yaml_text, const std::string& source_name);
+
+/// True when the grid's cells are larger than the robot's footprint (cell_m > max(width_m,
+/// length_m)): the robot stands within one cell, the ground between two cell centres is unseen,
+/// and BuildTraversability reads a rise between neighbouring cells as a slope (blocked, too steep,
+/// when steeper than max_inclination; a step only where it exceeds step_max and that slope too),
+/// not as a step (a 0.5 m rise between 3 m cells is a 9.5 deg slope). Finer grids keep the step
+/// rule: the robot spans several cells and meets a rise between two at once.
+bool CoarserThanRobot(const mapping::GridGeometry& geometry, const RobotLimits& robot);
+/// What a user should know about planning on `geometry` with `robot`: empty for a grid finer than
+/// the robot, else a warning that says what the planner does and what the map cannot show.
+std::string CoarseGridWarning(const mapping::GridGeometry& geometry, const RobotLimits& robot);
 
 /// Why a cell may not be entered.
 enum class Blocked : std::uint8_t {
@@ -80,7 +95,10 @@ enum class Blocked : std::uint8_t {
   kTooSteep,    ///< plane tilt above max_inclination_rad
   kNearHazard,  ///< within half the robot's width of a step, drop or steep cell or the grid's
                 ///< edge (footprint)
+  kOccupied,    ///< an obstacle in an occupancy grid (occupancy_grid.hpp)
 };
+/// A cell the robot's footprint must keep off (step, drop, too steep, occupied).
+bool IsFootprintHazard(Blocked b);
 const char* ToString(Blocked b);
 
 /// The 8 moves of a cell, in the order of TraversabilityGrid::moves: x and y steps [cell].
@@ -110,6 +128,8 @@ struct TraversabilityGrid {
   std::vector<float> enter_cost;   ///< W_T*T + W_phix*|phi_x| + W_phiy*|phi_y| (+ penalty) [1]
   std::vector<float> roughness_m;  ///< T [m] (0 when unknown)
   std::vector<float> phi_x_rad, phi_y_rad;  ///< [rad] (0 when unknown)
+  /// An occupancy grid's grey-level cost of entering each cell [1]; empty for elevation maps.
+  std::vector<float> occupancy_cost;
   std::vector<Blocked> blocked;
   /// Bit b set: the move to neighbour b is allowed (target free, no blocked corner cut); order
   /// +x, -x, +y, -y, (+x+y), (+x-y), (-x+y), (-x-y). Computed for every cell.

@@ -1,0 +1,14 @@
+#pragma once
+// The steps every traversability grid ends with, whatever map it came from (elevation layers or
+// an occupancy grid): the footprint's inflation, soft clearance, move masks and costs.
+
+#include "pitchlab/planning/traversability.hpp"
+
+namespace pitchlab::planning {
+
+/// Given `blocked`, `enter_cost` and `z_m` per cell: blocks the footprint's margin around every
+/// hazard and the grid's edge, adds the soft clearance, and fills moves, move_cost and the cost
+/// range the searches need.
+void FinishTraversability(TraversabilityGrid& grid);
+
+}  // namespace pitchlab::planning
