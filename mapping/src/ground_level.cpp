@@ -83,12 +83,10 @@ std::vector<Eigen::Vector3f> CellSamples(const std::vector<Eigen::Vector3f>& poi
     Eigen::Vector3f mean = Eigen::Vector3f::Zero();
     for (const Eigen::Vector3f& p : in_cell) mean += p;
     mean /= static_cast<float>(in_cell.size());
-    std::nth_element(in_cell.begin(), in_cell.begin() + in_cell.size() / 2, in_cell.end(),
-                     [](const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
-                       return a.z() < b.z();
-                     });
-    samples.emplace_back(key,
-                         Eigen::Vector3f(mean.x(), mean.y(), in_cell[in_cell.size() / 2].z()));
+    std::nth_element(
+        in_cell.begin(), in_cell.begin() + in_cell.size() / 2, in_cell.end(),
+        [](const Eigen::Vector3f& a, const Eigen::Vector3f& b) { return a.z() < b.z(); });
+    samples.emplace_back(key, Eigen::Vector3f(mean.x(), mean.y(), in_cell[in_cell.size() / 2].z()));
   }
   std::sort(samples.begin(), samples.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
@@ -185,26 +183,26 @@ Result<GroundLevel> FitGroundLevel(const std::vector<Eigen::Vector3f>& points_m,
   GroundLevel level;
   level.candidates = candidates.size();
   if (candidates.size() < config.min_points) {
-    return Fail(Error::Code::kFailed,
-                "ground levelling: " + std::to_string(candidates.size()) +
-                    " cells with points below the sensor within " + std::to_string(config.min_radius_m) +
-                    ".." + std::to_string(config.max_radius_m) +
-                    " m of it, too few to find the floor (need " +
-                    std::to_string(config.min_points) + ")");
+    return Fail(Error::Code::kFailed, "ground levelling: " + std::to_string(candidates.size()) +
+                                          " cells with points below the sensor within " +
+                                          std::to_string(config.min_radius_m) + ".." +
+                                          std::to_string(config.max_radius_m) +
+                                          " m of it, too few to find the floor (need " +
+                                          std::to_string(config.min_points) + ")");
   }
   std::mt19937 rng(config.seed);
   const Hypothesis best = BestHypothesis(candidates, sensor_m, config, rng);
   if (!std::isfinite(best.score_m)) {
-    return Fail(Error::Code::kFailed,
-                "ground levelling: no plane within " +
-                    std::to_string(config.max_tilt_rad * 180 / M_PI) +
-                    " deg of level lies below the sensor among " +
-                    std::to_string(candidates.size()) + " points");
+    return Fail(Error::Code::kFailed, "ground levelling: no plane within " +
+                                          std::to_string(config.max_tilt_rad * 180 / M_PI) +
+                                          " deg of level lies below the sensor among " +
+                                          std::to_string(candidates.size()) + " points");
   }
   const Refined fit = RefinePlane(candidates, best, config);
   if (fit.inliers.size() < config.min_points) {
-    return Fail(Error::Code::kFailed, "ground levelling: only " + std::to_string(fit.inliers.size()) +
-                                          " of " + std::to_string(candidates.size()) +
+    return Fail(Error::Code::kFailed, "ground levelling: only " +
+                                          std::to_string(fit.inliers.size()) + " of " +
+                                          std::to_string(candidates.size()) +
                                           " points near the sensor lie on one floor plane");
   }
   level.normal = fit.plane.n;
@@ -214,8 +212,8 @@ Result<GroundLevel> FitGroundLevel(const std::vector<Eigen::Vector3f>& points_m,
   level.threshold_m = fit.threshold_m;
   level.inliers = fit.inliers.size();
   level.sensor_height_m = fit.plane.Distance(sensor_m);
-  level.R_level = Eigen::Quaterniond::FromTwoVectors(fit.plane.n, Eigen::Vector3d::UnitZ())
-                      .toRotationMatrix();
+  level.R_level =
+      Eigen::Quaterniond::FromTwoVectors(fit.plane.n, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   return level;
 }
 

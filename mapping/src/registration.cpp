@@ -585,7 +585,9 @@ std::vector<Start> GuessGrid(const Start& guess, const RegistrationPrior& prior,
 // the truth through it, where the scans could not decide and odometry, within its bound, was
 // right; every later stop inherited the error). None without either.
 std::optional<Start> PriorGuess(const RegistrationPrior& prior, const RegistrationConfig& config) {
-  if (prior.odometry) return Start{*prior.odometry, RegistrationPath::kOdometry, "the odometry guess"};
+  if (prior.odometry) {
+    return Start{*prior.odometry, RegistrationPath::kOdometry, "the odometry guess"};
+  }
   if (prior.previous_motion && config.constant_velocity_fallback) {
     return Start{*prior.previous_motion, RegistrationPath::kFallback, "the fallback guess"};
   }
@@ -606,8 +608,8 @@ std::vector<Start> RunnersUp(const SacResult& sac) {
 // half capture range up to degeneracy_search_m either way; none when no translation is weak.
 std::vector<Start> StartsAlongWeakest(const IcpTarget& target, const PointCloud& source,
                                       const Verified& at, const RegistrationConfig& config) {
-  const Weakness weak = WeakDirections(target, source, at.icp.T_target_source, config,
-                                       config.degeneracy_ratio, 1);
+  const Weakness weak =
+      WeakDirections(target, source, at.icp.T_target_source, config, config.degeneracy_ratio, 1);
   std::vector<Start> along;
   if (weak.translations.empty()) return along;
   const double step = 0.5 * config.icp_max_distance_m;
@@ -713,8 +715,7 @@ Verified VerifyHypotheses(const PointCloud& source, const IcpTarget& target, con
   if (guess) starts.push_back(*guess);
   const std::vector<IcpResult> screened = verification.Verify(starts, 2);
   if (guess && config.guess_search_m > 0 && sac.inliers < 2 * config.sac_min_inliers &&
-      !SamePose(screened.back().T_target_source, verification.best().icp.T_target_source,
-                config)) {
+      !SamePose(screened.back().T_target_source, verification.best().icp.T_target_source, config)) {
     verification.Verify(GuessGrid(*guess, prior, config), 2);
   }
   if (verification.best().icp.degeneracy < config.degeneracy_ratio &&
@@ -900,9 +901,9 @@ Result<void> CheckPrior(const RegistrationPrior& prior) {
   for (const auto& [sensor, name] :
        {std::pair{&prior.source_sensor, "source"}, {&prior.target_sensor, "target"}}) {
     if (*sensor && !(*sensor)->allFinite()) {
-      return Fail(Error::Code::kInvalidArgument,
-                  std::string(name) + " sensor origin is not finite: " +
-                      Vector((*sensor)->cast<double>()));
+      return Fail(
+          Error::Code::kInvalidArgument,
+          std::string(name) + " sensor origin is not finite: " + Vector((*sensor)->cast<double>()));
     }
   }
   if (const auto& u = prior.odometry_uncertainty;
@@ -999,7 +1000,8 @@ struct IcpScene {
         fine(prep.target_icp, fine_cell),
         coarse(prep.target_icp, std::max<double>(fine_cell, config.icp_max_distance_m)),
         normals(EstimateNormals(prep.target_icp, fine,
-                                static_cast<float>(config.icp_normal_radius_m), prep.target_sensor)),
+                                static_cast<float>(config.icp_normal_radius_m),
+                                prep.target_sensor)),
         seen(prior.target_scan ? *prior.target_scan : target, prep.target_sensor, 1.0,
              FreeSpaceMargins(config)),
         target{prep.target_icp, normals, coarse, fine, fine_cell, &seen},
@@ -1217,11 +1219,10 @@ bool SearchAroundRejectedGuess(const Stages& s, const Start& guess, FromGuess& g
 
 // How ICP from the guess on `path` was accepted, for the reason.
 std::string AcceptedGuessNote(RegistrationPath path, const FromGuess& g, bool searched) {
-  const char* carried =
-      path == RegistrationPath::kFallback
-          ? " (degenerate: constant velocity assumed along the weak directions)"
-          : " (degenerate: the weak directions kept from the odometry guess, "
-            "whose error bound is within carry_max_m / carry_max_deg)";
+  const char* carried = path == RegistrationPath::kFallback
+                            ? " (degenerate: constant velocity assumed along the weak directions)"
+                            : " (degenerate: the weak directions kept from the odometry guess, "
+                              "whose error bound is within carry_max_m / carry_max_deg)";
   return std::string("took the ") + ToString(path) + " path" + (g.carried ? carried : "") +
          (searched ? " (ICP from the best of a grid of starts around the guess)" : "") +
          (g.held.any() ? HeldNote(g.tilt_off_deg) : "");
@@ -1253,8 +1254,7 @@ Verdict AlignFromGuess(const Stages& s, const Weakness& ambiguous, Progress& run
 // A success held within the prior's error bound that the scans contradict (ContradictedByTheScans)
 // is no success: whether it was one.
 bool ContradictedBound(const Stages& s, const FeatureMatches& matches, Progress& run) {
-  if (!run.out.success || !ConstraintLimits(s.prior, s.config).from_bound ||
-      s.prior.target_scan) {
+  if (!run.out.success || !ConstraintLimits(s.prior, s.config).from_bound || s.prior.target_scan) {
     return false;
   }
   std::string why =

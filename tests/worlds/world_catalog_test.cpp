@@ -234,8 +234,8 @@ TEST(Worlds, GullysDefaultGoalLiesDownhillFromItsStart) {
   ASSERT_TRUE(w.model);
   const WorldMetadata meta = ReadWorldMetadata(w.model.get());
   ASSERT_TRUE(meta.default_goal);
-  const double start_z = SurfaceHeight(w.model.get(), w.data.get(), meta.default_start.x_m,
-                                       meta.default_start.y_m);
+  const double start_z =
+      SurfaceHeight(w.model.get(), w.data.get(), meta.default_start.x_m, meta.default_start.y_m);
   const double goal_z =
       SurfaceHeight(w.model.get(), w.data.get(), meta.default_goal->x_m, meta.default_goal->y_m);
   // The DEM puts the goal 1.0 m below the start (GullyConfig::default_goal); half of that is far
