@@ -103,7 +103,7 @@ CliArgs BenchArgs() {
       "with --summarize DIR1 DIR2 ... . Exit 0 when every run of the shard is recorded\n"
       "(failed runs are results, see the summary); 2 on bad input.");
   args.Option("worlds", "W1,W2,...", "built-in worlds (" + BuiltinWorldNames() + ") or MJCF files",
-              "office,urban,terrain")
+              "office,urban,terrain,gully")
       .Option("seeds", "A..B|S1,S2,...", "seeds: ranges and lists, e.g. 1..20 or 1,5,9 or 1..3,7",
               "1..20")
       .Option("out", "DIR", "bench folder (created when missing; resumed when it exists)")

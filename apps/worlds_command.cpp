@@ -1,7 +1,9 @@
 // `pitchlab worlds`: what worlds there are, with what each says about itself.
 
+#include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <string>
 
 #include <mujoco/mujoco.h>
 #include <nlohmann/json.hpp>
@@ -16,7 +18,8 @@ namespace pitchlab::apps {
 
 int RunWorlds(int argc, char** argv) {
   CliArgs args("worlds",
-               "Lists the built-in worlds: description, placement bounds, default start and\n"
+               "Lists the built-in worlds: description, placement bounds, the default run's\n"
+               "start and goal (what `run` and `bench` use without --start / --goal) and\n"
                "geodetic origin. Any MJCF file is a world too (--world path/to/scene.xml).");
   args.Flag("json", "print the list as JSON on stdout");
   if (!args.Parse(argc, argv)) return 0;
@@ -38,6 +41,10 @@ int RunWorlds(int argc, char** argv) {
                         {"default_start", {{"x_m", meta.default_start.x_m},
                                            {"y_m", meta.default_start.y_m},
                                            {"yaw_deg", meta.default_start.yaw_rad * 180 / M_PI}}}};
+    // null when the world names none (then `run` needs --goal): every built-in world names one.
+    w["default_goal"] = meta.default_goal ? nlohmann::json{{"x_m", meta.default_goal->x_m},
+                                                           {"y_m", meta.default_goal->y_m}}
+                                          : nlohmann::json(nullptr);
     if (meta.geodetic_origin) {
       w["geodetic_origin"] = {{"latitude_deg", meta.geodetic_origin->latitude_deg},
                               {"longitude_deg", meta.geodetic_origin->longitude_deg},
@@ -49,11 +56,25 @@ int RunWorlds(int argc, char** argv) {
     std::cout << list.dump(2) << "\n";
     return 0;
   }
+  // Positions to the millimetre, without trailing zeros (-0.075, 45.825, 4).
+  const auto mm = [](const nlohmann::json& v) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.10g", std::round(v.get<double>() * 1000) / 1000);
+    return std::string(text);
+  };
+  std::printf("%-10s %-12s %-26s %-15s %s\n", "world", "size", "start x, y [m], yaw [deg]",
+              "goal x, y [m]", "description");
   for (const auto& w : list) {
     const auto& b = w["bounds_m"];
-    std::printf("%-10s %5.0f x %-5.0f m  %s\n", w["name"].get<std::string>().c_str(),
-                b[2].get<double>() - b[0].get<double>(), b[3].get<double>() - b[1].get<double>(),
-                w["description"].get<std::string>().c_str());
+    const auto& s = w["default_start"];
+    char size[32];
+    std::snprintf(size, sizeof(size), "%.0f x %.0f m", b[2].get<double>() - b[0].get<double>(),
+                  b[3].get<double>() - b[1].get<double>());
+    const std::string start = mm(s["x_m"]) + ", " + mm(s["y_m"]) + ", " + mm(s["yaw_deg"]);
+    const auto& g = w["default_goal"];
+    const std::string goal = g.is_null() ? "none" : mm(g["x_m"]) + ", " + mm(g["y_m"]);
+    std::printf("%-10s %-12s %-26s %-15s %s\n", w["name"].get<std::string>().c_str(), size,
+                start.c_str(), goal.c_str(), w["description"].get<std::string>().c_str());
   }
   std::printf("\nworld files in %s\n", WorldsDir().string().c_str());
   return 0;

@@ -433,6 +433,17 @@ Eigen::Vector3f LaserInBase() {
   return sensors::MountConfig{}.BaseToLaser(0.0).translation().cast<float>();
 }
 
+// A matrix's entries row by row: the pose and covariance in full, so two builds can be compared
+// bit for bit (a refactor of Register must not change them).
+template <typename Matrix>
+json RowMajor(const Matrix& m) {
+  json out = json::array();
+  for (int r = 0; r < m.rows(); ++r) {
+    for (int c = 0; c < m.cols(); ++c) out.push_back(m(r, c));
+  }
+  return out;
+}
+
 json RunPair(const Pair& p, mapping::RegistrationPrior prior,
              const mapping::RegistrationConfig& config) {
   prior.source_sensor = prior.target_sensor = LaserInBase();
@@ -465,6 +476,8 @@ json RunPair(const Pair& p, mapping::RegistrationPrior prior,
           {"degeneracy", r->degeneracy},
           {"iterations", r->iterations},
           {"sac_inliers", r->sac_inliers},
+          {"T_target_source", RowMajor(r->T_target_source.matrix())},
+          {"covariance", RowMajor(r->covariance)},
           {"timings_s",
            {{"voxel", t.voxel_s},
             {"normals", t.normals_s},

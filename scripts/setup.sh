@@ -11,6 +11,7 @@ packages=(
   libjs-three chromium  # the report's 3D view; its headless-browser test
   slurmctld slurmd slurm-client munge  # scripts/test-slurm.sh
   clang libclang-rt-dev valgrind  # the hw libFuzzer targets in CTest; scripts/sanitize.sh
+  python3  # scripts/check_function_size.py in CTest
 )
 
 missing=()

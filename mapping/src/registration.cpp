@@ -140,11 +140,9 @@ Weakness WithoutTilt(Weakness weak, const Eigen::Vector3d& up_target) {
   return weak;
 }
 
-// The clouds after the voxel grid, with what ICP needs of the target, and where each cloud's
-// sensor stood (normals face it).
+// The clouds after the voxel grid, and where each cloud's sensor stood (normals face it).
 struct Prepared {
   PointCloud target_icp, source_icp, target_features, source_features;
-  Normals target_normals;
   Eigen::Vector3f target_sensor = Eigen::Vector3f::Zero(), source_sensor = Eigen::Vector3f::Zero();
 };
 
@@ -582,6 +580,117 @@ std::vector<Start> GuessGrid(const Start& guess, const RegistrationPrior& prior,
   return out;
 }
 
+// The prior's guess: odometry, else the constant-velocity motion when the fallback is on (a motion
+// model never overrules odometry the robot has: a P3-DX in the corridor merged a stop 1.86 m off
+// the truth through it, where the scans could not decide and odometry, within its bound, was
+// right; every later stop inherited the error). None without either.
+std::optional<Start> PriorGuess(const RegistrationPrior& prior, const RegistrationConfig& config) {
+  if (prior.odometry) {
+    return Start{*prior.odometry, RegistrationPath::kOdometry, "the odometry guess"};
+  }
+  if (prior.previous_motion && config.constant_velocity_fallback) {
+    return Start{*prior.previous_motion, RegistrationPath::kFallback, "the fallback guess"};
+  }
+  return std::nullopt;
+}
+
+// The consensus' runners-up as starts, best first.
+std::vector<Start> RunnersUp(const SacResult& sac) {
+  std::vector<Start> starts;
+  for (std::size_t i = 0; i < sac.alternatives.size(); ++i) {
+    starts.push_back({sac.alternatives[i].T_target_source, RegistrationPath::kFeatures,
+                      "runner-up hypothesis " + std::to_string(i + 1) + " of the consensus"});
+  }
+  return starts;
+}
+
+// Starts along the direction `at` is most weakly constrained in (below degeneracy_ratio), every
+// half capture range up to degeneracy_search_m either way; none when no translation is weak.
+std::vector<Start> StartsAlongWeakest(const IcpTarget& target, const PointCloud& source,
+                                      const Verified& at, const RegistrationConfig& config) {
+  const Weakness weak =
+      WeakDirections(target, source, at.icp.T_target_source, config, config.degeneracy_ratio, 1);
+  std::vector<Start> along;
+  if (weak.translations.empty()) return along;
+  const double step = 0.5 * config.icp_max_distance_m;
+  const int steps = static_cast<int>(std::ceil(config.degeneracy_search_m / step));
+  for (int k = -steps; k <= steps; ++k) {
+    if (k == 0) continue;
+    along.push_back(
+        {Eigen::Translation3d(k * step * weak.translations.front()) * at.icp.T_target_source,
+         at.path, "starts along the weakly constrained direction"});
+  }
+  return along;
+}
+
+// The running winner of VerifyHypotheses, starting from ICP at the consensus' best pose, and the
+// ICP runs that compete with it.
+class Verification {
+ public:
+  Verification(const IcpTarget& target, const PointCloud& source, const SacResult& sac,
+               const RegistrationPrior& prior, const RegistrationConfig& config)
+      : target_(target), source_(source), prior_(prior), config_(config) {
+    best_.icp = PointToPlaneLm(target, source, sac.T_target_source, config, {});
+    best_.iterations = best_.icp.iterations;
+    accepted_ = Rejection(best_.icp, prior, config).empty();
+  }
+
+  // `icp`, run from `from`, wins when it ends in another pose than the winner's, passes the
+  // acceptance test and fits better (or the winner did not pass).
+  void Offer(const IcpResult& icp, const Start& from) {
+    if (SamePose(icp.T_target_source, best_.icp.T_target_source, config_)) return;
+    if (!Rejection(icp, prior_, config_).empty()) return;
+    if (accepted_ && icp.inlier_ratio <= best_.icp.inlier_ratio) return;
+    std::ostringstream os;
+    os.precision(3);
+    os << "ICP from " << from.name << " fits best (" << Percent(icp.inlier_ratio) << " inliers vs "
+       << Percent(best_.icp.inlier_ratio) << ")";
+    best_.note = os.str();
+    best_.icp = icp;
+    best_.path = from.path;
+    accepted_ = true;
+  }
+
+  // Screens `starts`, refines the `refine` best-screened that end away from the pose held (and
+  // from each other) and offers them; the screened results, in the order of `starts`.
+  std::vector<IcpResult> Verify(const std::vector<Start>& starts, std::size_t refine) {
+    std::vector<Eigen::Isometry3d> poses;
+    for (const Start& s : starts) poses.push_back(s.T);
+    const std::vector<IcpResult> screened =
+        Screen(target_, source_, poses, config_, {}, best_.iterations);
+    std::vector<std::size_t> order(starts.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return screened[a].inlier_ratio > screened[b].inlier_ratio;
+    });
+    std::vector<Eigen::Isometry3d> refined;
+    for (const std::size_t i : order) {
+      if (refined.size() == refine) break;
+      const Eigen::Isometry3d& end = screened[i].T_target_source;
+      if (SamePose(end, best_.icp.T_target_source, config_)) continue;
+      if (std::any_of(refined.begin(), refined.end(),
+                      [&](const auto& r) { return SamePose(end, r, config_); })) {
+        continue;
+      }
+      refined.push_back(end);
+      const IcpResult icp = PointToPlaneLm(target_, source_, end, config_, {});
+      best_.iterations += icp.iterations;
+      Offer(icp, starts[i]);
+    }
+    return screened;
+  }
+
+  const Verified& best() const { return best_; }
+
+ private:
+  const IcpTarget& target_;
+  const PointCloud& source_;
+  const RegistrationPrior& prior_;
+  const RegistrationConfig& config_;
+  Verified best_;
+  bool accepted_ = false;  // the winner passes the acceptance test
+};
+
 // ICP from each hypothesis of the consensus (best first, then the runners-up) and from the prior's
 // guess (odometry, else the constant-velocity motion): the best fit (inlier ratio) that passes the
 // acceptance test wins; a start that ends in the pose already held does not count. The consensus
@@ -600,84 +709,22 @@ std::vector<Start> GuessGrid(const Start& guess, const RegistrationPrior& prior,
 // (its rejection is then reported).
 Verified VerifyHypotheses(const PointCloud& source, const IcpTarget& target, const SacResult& sac,
                           const RegistrationPrior& prior, const RegistrationConfig& config) {
-  Verified best;
-  best.icp = PointToPlaneLm(target, source, sac.T_target_source, config, {});
-  best.iterations = best.icp.iterations;
-  bool accepted = Rejection(best.icp, prior, config).empty();
-  auto offer = [&](const IcpResult& icp, const Start& from) {
-    if (SamePose(icp.T_target_source, best.icp.T_target_source, config)) return;
-    if (!Rejection(icp, prior, config).empty()) return;
-    if (accepted && icp.inlier_ratio <= best.icp.inlier_ratio) return;
-    std::ostringstream os;
-    os.precision(3);
-    os << "ICP from " << from.name << " fits best (" << Percent(icp.inlier_ratio) << " inliers vs "
-       << Percent(best.icp.inlier_ratio) << ")";
-    best.note = os.str();
-    best.icp = icp;
-    best.path = from.path;
-    accepted = true;
-  };
-  // Screens `starts`, refines the `refine` best-screened that end away from the pose held.
-  auto verify = [&](const std::vector<Start>& starts, std::size_t refine) {
-    std::vector<Eigen::Isometry3d> poses;
-    for (const Start& s : starts) poses.push_back(s.T);
-    const std::vector<IcpResult> screened =
-        Screen(target, source, poses, config, {}, best.iterations);
-    std::vector<std::size_t> order(starts.size());
-    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      return screened[a].inlier_ratio > screened[b].inlier_ratio;
-    });
-    std::vector<Eigen::Isometry3d> refined;
-    for (const std::size_t i : order) {
-      if (refined.size() == refine) break;
-      const Eigen::Isometry3d& end = screened[i].T_target_source;
-      if (SamePose(end, best.icp.T_target_source, config)) continue;
-      if (std::any_of(refined.begin(), refined.end(),
-                      [&](const auto& r) { return SamePose(end, r, config); })) {
-        continue;
-      }
-      refined.push_back(end);
-      const IcpResult icp = PointToPlaneLm(target, source, end, config, {});
-      best.iterations += icp.iterations;
-      offer(icp, starts[i]);
-    }
-    return screened;
-  };
-  std::vector<Start> starts;
-  for (std::size_t i = 0; i < sac.alternatives.size(); ++i) {
-    starts.push_back({sac.alternatives[i].T_target_source, RegistrationPath::kFeatures,
-                      "runner-up hypothesis " + std::to_string(i + 1) + " of the consensus"});
-  }
-  std::optional<Start> guess;
-  if (prior.odometry) {
-    guess = Start{*prior.odometry, RegistrationPath::kOdometry, "the odometry guess"};
-  } else if (prior.previous_motion && config.constant_velocity_fallback) {
-    guess = Start{*prior.previous_motion, RegistrationPath::kFallback, "the fallback guess"};
-  }
+  Verification verification(target, source, sac, prior, config);
+  std::vector<Start> starts = RunnersUp(sac);
+  const std::optional<Start> guess = PriorGuess(prior, config);
   if (guess) starts.push_back(*guess);
-  const std::vector<IcpResult> screened = verify(starts, 2);
+  const std::vector<IcpResult> screened = verification.Verify(starts, 2);
   if (guess && config.guess_search_m > 0 && sac.inliers < 2 * config.sac_min_inliers &&
-      !SamePose(screened.back().T_target_source, best.icp.T_target_source, config)) {
-    verify(GuessGrid(*guess, prior, config), 2);
+      !SamePose(screened.back().T_target_source, verification.best().icp.T_target_source, config)) {
+    verification.Verify(GuessGrid(*guess, prior, config), 2);
   }
-  if (best.icp.degeneracy < config.degeneracy_ratio && config.degeneracy_search_m > 0) {
-    const Weakness weak = WeakDirections(target, source, best.icp.T_target_source, config,
-                                         config.degeneracy_ratio, 1);
-    if (!weak.translations.empty()) {
-      const double step = 0.5 * config.icp_max_distance_m;
-      const int steps = static_cast<int>(std::ceil(config.degeneracy_search_m / step));
-      std::vector<Start> along;
-      for (int k = -steps; k <= steps; ++k) {
-        if (k == 0) continue;
-        along.push_back(
-            {Eigen::Translation3d(k * step * weak.translations.front()) * best.icp.T_target_source,
-             best.path, "starts along the weakly constrained direction"});
-      }
-      verify(along, 2);
-    }
+  if (verification.best().icp.degeneracy < config.degeneracy_ratio &&
+      config.degeneracy_search_m > 0) {
+    const std::vector<Start> along =
+        StartsAlongWeakest(target, source, verification.best(), config);
+    if (!along.empty()) verification.Verify(along, 2);
   }
-  return best;
+  return verification.best();
 }
 
 // How many times the inliers of ICP from the guess a pose found around it must fit to replace it.
@@ -846,6 +893,392 @@ void Conclude(RegistrationResult& out, bool ambiguous, const Weakness& frozen,
   out.covariance = Covariance(out.information, frozen, prior, config);
 }
 
+// ---- Register's stages, in the order it runs them (Algorithm 1 and what the paper adds).
+
+// A sensor origin, an odometry error bound and a measured tilt must be finite (and the bound
+// >= 0, the tilt's up a unit vector and its tolerance > 0).
+Result<void> CheckPrior(const RegistrationPrior& prior) {
+  for (const auto& [sensor, name] :
+       {std::pair{&prior.source_sensor, "source"}, {&prior.target_sensor, "target"}}) {
+    if (*sensor && !(*sensor)->allFinite()) {
+      return Fail(
+          Error::Code::kInvalidArgument,
+          std::string(name) + " sensor origin is not finite: " + Vector((*sensor)->cast<double>()));
+    }
+  }
+  if (const auto& u = prior.odometry_uncertainty;
+      u && !(u->translation_m >= 0 && std::isfinite(u->translation_m) && u->rotation_deg >= 0 &&
+             std::isfinite(u->rotation_deg))) {
+    std::ostringstream os;
+    os << "the odometry prior's error bound (--prior-error) must be finite and >= 0, got "
+       << u->translation_m << " m / " << u->rotation_deg << " deg";
+    return Fail(Error::Code::kInvalidArgument, os.str());
+  }
+  if (const auto& t = prior.tilt; t && !(t->up_target.allFinite() && t->up_target.norm() > 0.5 &&
+                                         std::isfinite(t->tolerance_deg) && t->tolerance_deg > 0)) {
+    std::ostringstream os;
+    os << "tilt: up_target must be a finite unit vector and tolerance_deg finite and > 0, got up "
+       << Vector(t->up_target) << ", tolerance " << t->tolerance_deg << " deg";
+    return Fail(Error::Code::kInvalidArgument, os.str());
+  }
+  return {};
+}
+
+// Bad input, named: a config that does not validate, an empty or non-finite cloud, a bad prior.
+Result<void> CheckInput(const PointCloud& target, const PointCloud& source,
+                        const RegistrationPrior& prior, const RegistrationConfig& requested) {
+  try {
+    requested.Validate();
+  } catch (const std::invalid_argument& e) {
+    return Fail(Error::Code::kInvalidArgument, e.what());
+  }
+  if (Result<void> ok = CheckCloud(target, "target"); !ok) return ok;
+  if (Result<void> ok = CheckCloud(source, "source"); !ok) return ok;
+  return CheckPrior(prior);
+}
+
+// 0. What each cloud measures (range, spacing, noise: MeasureCloud) into `out`, and the settings
+// `requested`'s `auto` values resolve to (RegistrationConfig::Resolve).
+RegistrationConfig ResolveSettings(const PointCloud& target, const PointCloud& source,
+                                   const RegistrationPrior& prior,
+                                   const RegistrationConfig& requested, RegistrationResult& out) {
+  out.source_statistics =
+      MeasureCloud(source, prior.source_sensor.value_or(Eigen::Vector3f::Zero()));
+  out.target_statistics =
+      MeasureCloud(target, prior.target_sensor.value_or(Eigen::Vector3f::Zero()));
+  out.settings = requested.Resolve(out.source_statistics, out.target_statistics);
+  return out.settings;
+}
+
+// 1. Voxel grid: the ICP clouds at icp_voxel_m, the feature clouds at feature_voxel_m from those.
+Prepared VoxelGrid(const PointCloud& target, const PointCloud& source,
+                   const RegistrationPrior& prior, const RegistrationConfig& config) {
+  Prepared prep;
+  prep.source_sensor = prior.source_sensor.value_or(Eigen::Vector3f::Zero());
+  prep.target_sensor = prior.target_sensor.value_or(Eigen::Vector3f::Zero());
+  prep.target_icp = VoxelDownsample(target, config.icp_voxel_m);
+  prep.source_icp = VoxelDownsample(source, config.icp_voxel_m);
+  prep.target_features = VoxelDownsample(prep.target_icp, config.feature_voxel_m);
+  prep.source_features = VoxelDownsample(prep.source_icp, config.feature_voxel_m);
+  return prep;
+}
+
+// Fewer than kMinPoints points left by the voxel grid in either cloud is bad input.
+Result<void> CheckEnoughPoints(const Prepared& prep, const RegistrationConfig& config) {
+  for (const auto& [cloud, name] :
+       {std::pair{&prep.target_icp, "target"}, {&prep.source_icp, "source"}}) {
+    if (cloud->size() < kMinPoints) {
+      return Fail(Error::Code::kInvalidArgument,
+                  std::string(name) + " cloud has " + std::to_string(cloud->size()) +
+                      " points after the " + std::to_string(config.icp_voxel_m) +
+                      " m voxel grid; registration needs at least " + std::to_string(kMinPoints));
+    }
+  }
+  return {};
+}
+
+// The margins of the free-space evidence: its near range at the data's scale, and the pair's
+// free_space_margin_m.
+SeenMargins FreeSpaceMargins(const RegistrationConfig& config) {
+  SeenMargins margins;
+  margins.min_range_m *= static_cast<float>(config.length_scale);
+  margins.margin_m = static_cast<float>(config.free_space_margin_m);
+  return margins;
+}
+
+// 2. The target as ICP queries it: its normals (PCA in icp_normal_radius_m, facing its sensor; the
+// feature clouds' normals are part of stage 3), hashes for the widest gate and for the fine ones,
+// and the free space its scan saw through; and the source points ICP moves (at most
+// icp_max_points). The free-space evidence is the target's own scan unless it is a map
+// (prior.target_scan), in 1 deg bins: two or more of a seed-pattern scan's 0.5 deg beams and
+// ~0.5 deg lines per bin, so inside the view a bin is rarely empty.
+struct IcpScene {
+  IcpScene(const Prepared& prep, const PointCloud& target, const RegistrationPrior& prior,
+           const RegistrationConfig& config)
+      : fine_cell(static_cast<float>(std::max(
+            {config.icp_min_distance_m, config.inlier_distance_m, config.icp_normal_radius_m}))),
+        fine(prep.target_icp, fine_cell),
+        coarse(prep.target_icp, std::max<double>(fine_cell, config.icp_max_distance_m)),
+        normals(EstimateNormals(prep.target_icp, fine,
+                                static_cast<float>(config.icp_normal_radius_m),
+                                prep.target_sensor)),
+        seen(prior.target_scan ? *prior.target_scan : target, prep.target_sensor, 1.0,
+             FreeSpaceMargins(config)),
+        target{prep.target_icp, normals, coarse, fine, fine_cell, &seen},
+        source(EvenSubsample(prep.source_icp, config.icp_max_points)) {}
+
+  const float fine_cell;
+  const VoxelHashIndex fine, coarse;
+  const Normals normals;
+  const LazySeenSpace seen;
+  const IcpTarget target;
+  const PointCloud source;
+};
+
+// The voxels of the smaller ICP cloud when the pair is a confined scene (fewer than
+// confined_scene_voxels, backend fast), else none. The target's normals straddle a corner's edges
+// as much as the source's points do: either cloud confined makes the pair confined.
+std::optional<std::size_t> ConfinedVoxels(const Prepared& prep, const RegistrationConfig& config) {
+  const std::size_t fewest = std::min(prep.target_icp.size(), prep.source_icp.size());
+  if (config.backend != RegistrationBackend::kFast ||
+      fewest >= static_cast<std::size_t>(config.confined_scene_voxels)) {
+    return std::nullopt;
+  }
+  return fewest;
+}
+
+// What stages 3-6 work on: the input, the resolved settings and what stages 1-2 made of them.
+struct Stages {
+  const PointCloud& target;
+  const PointCloud& source;
+  const RegistrationPrior& prior;
+  const RegistrationConfig& config;  // resolved
+  const Prepared& prep;
+  const IcpScene& scene;
+  std::optional<std::size_t> confined_voxels;  // ConfinedVoxels
+};
+
+// The result as the stages fill it in, the notes its reason is joined from, and the clock that
+// charges each stage its time.
+struct Progress {
+  RegistrationResult out;
+  std::vector<std::string> notes;
+  Stopwatch lap;
+};
+
+// How the result is concluded (Conclude): whether the scans left it ambiguous, and the directions
+// kept at a guess.
+struct Verdict {
+  bool ambiguous = false;
+  Weakness frozen;
+};
+
+// The geometric constraint's region: around the odometry prior, else around the constant-velocity
+// motion (ConstraintLimits); none without either.
+std::optional<PriorRegion> ConstraintRegion(const RegistrationPrior& prior,
+                                            const RegistrationConfig& config) {
+  const auto& centre = prior.odometry ? prior.odometry : prior.previous_motion;
+  if (!centre) return std::nullopt;
+  const Limits limits = ConstraintLimits(prior, config);
+  return PriorRegion{*centre, limits.translation_m, limits.rotation_deg * kPi / 180.0};
+}
+
+// 3-4. Features and the sample-consensus initial alignment within `region`: backend pcl PCL's
+// FPFH and SAC-IA; fast NARF or our FPFH, and our RANSAC (whose matches are kept in `matches`).
+// Each stage's time is charged to `timings`.
+SacResult InitialAlignment(const Stages& s, const std::optional<PriorRegion>& region,
+                           StageTimings& timings, FeatureMatches& matches) {
+  if (s.config.backend == RegistrationBackend::kPcl) {
+    const PclAlignment pcl = PclInitialAlignment(s.prep.target_features, s.prep.source_features,
+                                                 s.target, s.source, s.config);
+    timings.normals_s += pcl.normals_s;
+    timings.features_s = pcl.features_s;
+    timings.initial_alignment_s = pcl.sac_s;
+    SacResult sac;  // PCL's SAC-IA gives one pose, no runners-up
+    sac.found = pcl.found && (!region || region->Contains(pcl.T_target_source));
+    sac.T_target_source = pcl.T_target_source;
+    sac.inliers = pcl.correspondences;
+    return sac;
+  }
+  if (s.config.features == FeatureKind::kNarf) {
+    return FastNarfAlignment(s.target, s.source, s.config, region, timings);
+  }
+  return FastFeatureAlignment(s.prep, s.config, region, timings, matches);
+}
+
+// The initial alignment refined by ICP: PCL's ICP-NL from it (backend pcl), or the verification
+// of the consensus' hypotheses and the prior's guess (fast, VerifyHypotheses), whose ICP runs are
+// counted in `out` but for the winner's own (Fill adds those).
+Verified RefineInitialAlignment(const Stages& s, const SacResult& sac, RegistrationResult& out) {
+  if (s.config.backend == RegistrationBackend::kPcl) {
+    Verified v;
+    v.icp = RunPclIcp(s.scene.target, s.scene.source, s.prep, sac.T_target_source, s.config);
+    return v;
+  }
+  const Verified v = VerifyHypotheses(s.scene.source, s.scene.target, sac, s.prior, s.config);
+  out.iterations += v.iterations - v.icp.iterations;
+  return v;
+}
+
+// Why the feature alignment was not taken: ambiguous, or rejected by the acceptance test.
+std::string FeatureAlignmentNote(const Weakness& ambiguous, const std::string& rejection,
+                                 const RegistrationConfig& config) {
+  std::ostringstream os;
+  os.precision(3);
+  if (ambiguous.any()) {
+    os << "feature alignment ambiguous: degenerate geometry (ICP restarted "
+       << config.degeneracy_probe_m << " m / " << config.degeneracy_probe_deg
+       << " deg along the weakest direction does not come back, and nothing rules out where "
+          "it ends: a fit about as good, or no free-space violation)";
+  } else {
+    os << "feature alignment rejected: " << rejection;
+  }
+  return os.str();
+}
+
+// A feature alignment that passed is the result, unless it lies within the prior's error bound
+// and the scans contradict the bound (ContradictedByTheScans): then it is ambiguous.
+Verdict AcceptFeatureAlignment(const Stages& s, const Verified& v, const FeatureMatches& matches,
+                               Progress& run) {
+  if (ConstraintLimits(s.prior, s.config).from_bound && !s.prior.target_scan) {
+    const std::string contradiction =
+        ContradictedByTheScans(s.scene.target, s.scene.source, matches, run.out, s.config);
+    if (!contradiction.empty()) {
+      run.out.reason = "feature alignment within the prior's region: " + contradiction;
+      run.out.timings.icp_s += run.lap.Lap();
+      return {true, {}};
+    }
+  }
+  run.out.success = true;
+  run.out.reason = v.note.empty() ? std::string(ToString(v.path)) : v.note;
+  return {};
+}
+
+// What stages 3-4 leave: whether they decided the result (its verdict), else what stage 5 needs:
+// the directions the feature alignment left undetermined, and its matches (to ask the consensus
+// again without the prior's region).
+struct FeatureStage {
+  bool decided = false;
+  Verdict verdict;
+  Weakness ambiguous;
+  FeatureMatches matches;
+};
+
+// 3-4. Features, sample-consensus initial alignment, ICP from it and the acceptance test; a fit
+// that passes is probed for degeneracy (AmbiguousDirections): only such a fit says anything about
+// the scene's.
+FeatureStage AlignByFeatures(const Stages& s, Progress& run) {
+  FeatureStage stage;
+  if (s.config.features == FeatureKind::kNone) return stage;
+  const std::optional<PriorRegion> region = ConstraintRegion(s.prior, s.config);
+  const SacResult sac = InitialAlignment(s, region, run.out.timings, stage.matches);
+  run.lap.Lap();  // charged stage by stage above
+  run.out.sac_inliers = sac.inliers;
+  if (!sac.found) {
+    run.notes.push_back("initial alignment failed: " + std::to_string(sac.inliers) +
+                        " agreeing feature correspondences (min " +
+                        std::to_string(s.config.sac_min_inliers) + ")" +
+                        (region ? " inside the prior's region" : ""));
+    return stage;
+  }
+  const Verified v = RefineInitialAlignment(s, sac, run.out);
+  const std::string rejection = Rejection(v.icp, s.prior, s.config);
+  if (s.config.backend == RegistrationBackend::kFast && rejection.empty()) {
+    stage.ambiguous = AmbiguousDirections(s.scene.target, s.scene.source, v.icp, s.config);
+  }
+  run.out.timings.icp_s += run.lap.Lap();
+  Fill(run.out, v.icp, v.path);
+  if (stage.ambiguous.any() || !rejection.empty()) {
+    run.notes.push_back(FeatureAlignmentNote(stage.ambiguous, rejection, s.config));
+    return stage;
+  }
+  stage.decided = true;
+  stage.verdict = AcceptFeatureAlignment(s, v, stage.matches, run);
+  return stage;
+}
+
+// ICP from the guess was rejected for its fit (not undetermined; backend fast; guess_search_m on):
+// the best accepted pose of a grid of starts around the guess (SearchAroundGuess) replaces it when
+// it fits clearly better, or is the same pose (which failed for its residual or tilt rather than
+// its fit), and the scene pins it down; else the rejection says why not. Whether it replaced it.
+bool SearchAroundRejectedGuess(const Stages& s, const Start& guess, FromGuess& g, Progress& run) {
+  if (g.rejection.empty() || g.undetermined || s.config.backend != RegistrationBackend::kFast ||
+      !(s.config.guess_search_m > 0)) {
+    return false;
+  }
+  int iterations = 0;
+  const std::optional<IcpResult> found =
+      SearchAroundGuess(s.scene.target, s.scene.source, {guess.T, guess.path, ToString(guess.path)},
+                        s.prior, s.config, g.held, iterations);
+  run.out.iterations += iterations;
+  if (!found) return false;
+  // Where the scan overlaps the map little, the best of the grid fits about as well somewhere else
+  // by chance (office mission: 16.5 % of the scan 1.2 m off, where ICP from a guess 3 cm off
+  // fitted 13.4 %; registration_eval's search winners fit 1.55-20x the guess's own ICP).
+  if (!SamePose(found->T_target_source, g.icp.T_target_source, s.config) &&
+      found->inlier_ratio < kSearchMargin * g.icp.inlier_ratio) {
+    g.rejection += " (a grid of starts around the guess fits " + Percent(found->inlier_ratio) +
+                   " elsewhere: not clearly better than the guess's " +
+                   Percent(g.icp.inlier_ratio) + ")";
+    return false;
+  }
+  // In a corridor a grid start fits anywhere along the axis, and nothing says where.
+  if (GuessDegenerateDirections(s.scene.target, s.scene.source, *found, s.config).any()) {
+    g.rejection +=
+        " (a grid of starts around the guess fits, but degenerate geometry leaves the "
+        "pose undetermined there)";
+    return false;
+  }
+  run.notes.push_back(std::string("ICP from the ") + ToString(guess.path) +
+                      " guess: " + g.rejection);
+  g.icp = *found, g.rejection.clear(), g.carried = false;
+  g.frozen = g.held;                       // the search kept only the tilt
+  run.out.iterations -= g.icp.iterations;  // Fill adds the winner's own
+  return true;
+}
+
+// How ICP from the guess on `path` was accepted, for the reason.
+std::string AcceptedGuessNote(RegistrationPath path, const FromGuess& g, bool searched) {
+  const char* carried = path == RegistrationPath::kFallback
+                            ? " (degenerate: constant velocity assumed along the weak directions)"
+                            : " (degenerate: the weak directions kept from the odometry guess, "
+                              "whose error bound is within carry_max_m / carry_max_deg)";
+  return std::string("took the ") + ToString(path) + " path" + (g.carried ? carried : "") +
+         (searched ? " (ICP from the best of a grid of starts around the guess)" : "") +
+         (g.held.any() ? HeldNote(g.tilt_off_deg) : "");
+}
+
+// 5. Non-linear ICP from the prior's guess (PriorGuess: odometry, else the constant-velocity
+// motion, the paper's guess for a robot without odometry), searched around when it was rejected.
+// The directions the feature alignment left `ambiguous` stay so (IcpFromGuess).
+Verdict AlignFromGuess(const Stages& s, const Weakness& ambiguous, Progress& run) {
+  const std::optional<Start> guess = PriorGuess(s.prior, s.config);
+  if (!guess) {
+    run.notes.push_back("no odometry prior or previous motion to fall back on");
+    return {};
+  }
+  FromGuess g = IcpFromGuess(s.scene.target, s.scene.source, s.prep, guess->T, guess->path,
+                             ambiguous, s.prior, s.config);
+  const bool searched = SearchAroundRejectedGuess(s, *guess, g, run);
+  run.out.timings.icp_s += run.lap.Lap();
+  Fill(run.out, g.icp, guess->path);
+  if (!g.rejection.empty()) {
+    run.notes.push_back(std::string(ToString(guess->path)) + " path rejected: " + g.rejection);
+    return {g.undetermined, {}};
+  }
+  run.out.success = true;
+  run.notes.push_back(AcceptedGuessNote(guess->path, g, searched));
+  return {g.undetermined, g.frozen};
+}
+
+// A success held within the prior's error bound that the scans contradict (ContradictedByTheScans)
+// is no success: whether it was one.
+bool ContradictedBound(const Stages& s, const FeatureMatches& matches, Progress& run) {
+  if (!run.out.success || !ConstraintLimits(s.prior, s.config).from_bound || s.prior.target_scan) {
+    return false;
+  }
+  std::string why =
+      ContradictedByTheScans(s.scene.target, s.scene.source, matches, run.out, s.config);
+  const bool contradicted = !why.empty();
+  if (contradicted) {
+    run.out.success = false;
+    run.notes.push_back(std::move(why));
+  }
+  run.out.timings.icp_s += run.lap.Lap();
+  return contradicted;
+}
+
+// 6. A success in a confined scene refined and judged again at half the scale (RefineConfined);
+// the outcome and the covariance of the pose (Conclude).
+void Finish(const Stages& s, const Verdict& verdict, Progress& run) {
+  if (run.out.success && s.confined_voxels) {
+    RefineConfined(s.target, s.source, s.prep.target_sensor, *s.confined_voxels, verdict.frozen,
+                   s.prior, s.config, run.out);
+    run.out.timings.icp_s += run.lap.Lap();
+  }
+  Conclude(run.out, verdict.ambiguous, verdict.frozen, s.prior, s.config);
+}
+
 }  // namespace
 
 const char* ToString(RegistrationOutcome outcome) {
@@ -896,265 +1329,44 @@ Eigen::Isometry3d PoseFromXyzRpyDeg(double x, double y, double z, double roll_de
   return T;
 }
 
+// Algorithm 1, stage by stage: 0-2 prepare both clouds, 3-4 align their features and verify the
+// alignment by ICP, 5 else ICP from the prior's guess, 6 conclude. Stages 3-5 decide the pose.
 Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& source,
                                     const RegistrationPrior& prior,
                                     const RegistrationConfig& requested) {
-  try {
-    requested.Validate();
-  } catch (const std::invalid_argument& e) {
-    return Fail(Error::Code::kInvalidArgument, e.what());
+  if (Result<void> ok = CheckInput(target, source, prior, requested); !ok) {
+    return tl::make_unexpected(ok.error());
   }
-  if (auto ok = CheckCloud(target, "target"); !ok) return tl::make_unexpected(ok.error());
-  if (auto ok = CheckCloud(source, "source"); !ok) return tl::make_unexpected(ok.error());
-  for (const auto& [sensor, name] :
-       {std::pair{&prior.source_sensor, "source"}, {&prior.target_sensor, "target"}}) {
-    if (*sensor && !(*sensor)->allFinite()) {
-      return Fail(Error::Code::kInvalidArgument,
-                  std::string(name) + " sensor origin is not finite: " +
-                      Vector((*sensor)->cast<double>()));
-    }
-  }
-  if (const auto& u = prior.odometry_uncertainty;
-      u && !(u->translation_m >= 0 && std::isfinite(u->translation_m) && u->rotation_deg >= 0 &&
-             std::isfinite(u->rotation_deg))) {
-    std::ostringstream os;
-    os << "the odometry prior's error bound (--prior-error) must be finite and >= 0, got " << u->translation_m << " m / "
-       << u->rotation_deg << " deg";
-    return Fail(Error::Code::kInvalidArgument, os.str());
-  }
-
-  if (const auto& t = prior.tilt; t && !(t->up_target.allFinite() && t->up_target.norm() > 0.5 &&
-                                         std::isfinite(t->tolerance_deg) && t->tolerance_deg > 0)) {
-    std::ostringstream os;
-    os << "tilt: up_target must be a finite unit vector and tolerance_deg finite and > 0, got up "
-       << Vector(t->up_target) << ", tolerance " << t->tolerance_deg << " deg";
-    return Fail(Error::Code::kInvalidArgument, os.str());
-  }
-
-  RegistrationResult out;
-  Stopwatch total, lap;
+  Stopwatch total;
+  Progress run;
   // 0. What the clouds measure, and the settings that follow from it.
-  Prepared prep;
-  prep.source_sensor = prior.source_sensor.value_or(Eigen::Vector3f::Zero());
-  prep.target_sensor = prior.target_sensor.value_or(Eigen::Vector3f::Zero());
-  out.source_statistics = MeasureCloud(source, prep.source_sensor);
-  out.target_statistics = MeasureCloud(target, prep.target_sensor);
-  const RegistrationConfig config =
-      requested.Resolve(out.source_statistics, out.target_statistics);
-  out.settings = config;
+  const RegistrationConfig config = ResolveSettings(target, source, prior, requested, run.out);
   // 1. Voxel grid.
-  prep.target_icp = VoxelDownsample(target, config.icp_voxel_m);
-  prep.source_icp = VoxelDownsample(source, config.icp_voxel_m);
-  prep.target_features = VoxelDownsample(prep.target_icp, config.feature_voxel_m);
-  prep.source_features = VoxelDownsample(prep.source_icp, config.feature_voxel_m);
-  out.timings.voxel_s = lap.Lap();
-  for (const auto& [cloud, name] :
-       {std::pair{&prep.target_icp, "target"}, {&prep.source_icp, "source"}}) {
-    if (cloud->size() < kMinPoints) {
-      return Fail(Error::Code::kInvalidArgument,
-                  std::string(name) + " cloud has " + std::to_string(cloud->size()) +
-                      " points after the " + std::to_string(config.icp_voxel_m) +
-                      " m voxel grid; registration needs at least " + std::to_string(kMinPoints));
-    }
+  const Prepared prep = VoxelGrid(target, source, prior, config);
+  run.out.timings.voxel_s = run.lap.Lap();
+  if (Result<void> ok = CheckEnoughPoints(prep, config); !ok) {
+    return tl::make_unexpected(ok.error());
   }
-  // 2. Normals of the ICP target (the feature clouds' normals are part of the feature stage).
-  const float fine_cell = static_cast<float>(
-      std::max({config.icp_min_distance_m, config.inlier_distance_m, config.icp_normal_radius_m}));
-  const VoxelHashIndex fine(prep.target_icp, fine_cell);
-  const VoxelHashIndex coarse(prep.target_icp,
-                              std::max<double>(fine_cell, config.icp_max_distance_m));
-  prep.target_normals = EstimateNormals(
-      prep.target_icp, fine, static_cast<float>(config.icp_normal_radius_m), prep.target_sensor);
-  out.timings.normals_s = lap.Lap();
-  // Free-space evidence: the target's own scan unless it is a map. Two or more of a seed-pattern
-  // scan's 0.5 deg beams and ~0.5 deg lines per 1 deg bin: inside the view a bin is rarely empty.
-  SeenMargins margins;
-  margins.min_range_m *= static_cast<float>(config.length_scale);
-  margins.margin_m = static_cast<float>(config.free_space_margin_m);
-  const LazySeenSpace seen(prior.target_scan ? *prior.target_scan : target, prep.target_sensor,
-                           1.0, margins);
-  const IcpTarget icp_target{prep.target_icp, prep.target_normals, coarse, fine, fine_cell, &seen};
-  const PointCloud icp_source = EvenSubsample(prep.source_icp, config.icp_max_points);
-  // The target's normals straddle a corner's edges as much as the source's points do: either
-  // cloud confined makes the pair confined.
-  const std::size_t fewest_voxels = std::min(prep.target_icp.size(), prep.source_icp.size());
-  const bool confined = config.backend == RegistrationBackend::kFast &&
-                        fewest_voxels < static_cast<std::size_t>(config.confined_scene_voxels);
-
-  // Geometric constraint: around the odometry prior, else around the constant-velocity motion.
-  std::optional<PriorRegion> region;
-  if (const auto& centre = prior.odometry ? prior.odometry : prior.previous_motion; centre) {
-    const Limits limits = ConstraintLimits(prior, config);
-    region = PriorRegion{*centre, limits.translation_m, limits.rotation_deg * kPi / 180.0};
+  // 2. Normals of the ICP target, its search structures and the free space its scan saw.
+  const IcpScene scene(prep, target, prior, config);
+  run.out.timings.normals_s = run.lap.Lap();
+  const Stages s{target, source, prior, config, prep, scene, ConfinedVoxels(prep, config)};
+  // 3-4. Features, sample-consensus initial alignment, ICP from it (Levenberg-Marquardt).
+  const FeatureStage features = AlignByFeatures(s, run);
+  Verdict verdict = features.verdict;
+  if (!features.decided) {
+    // 5. ICP from the odometry prior, else from the constant-velocity motion.
+    verdict = AlignFromGuess(s, features.ambiguous, run);
+    const bool contradicted = ContradictedBound(s, features.matches, run);
+    verdict.ambiguous = features.ambiguous.any() || verdict.ambiguous || contradicted;
   }
-  std::vector<std::string> notes;
-  Weakness ambiguous;  // directions the feature alignment left undetermined
-  FeatureMatches matches;  // of the fast FPFH consensus, when it ran
-  // 3-4. Features and sample-consensus initial alignment.
-  if (config.features != FeatureKind::kNone) {
-    SacResult sac;
-    if (config.backend == RegistrationBackend::kPcl) {
-      const PclAlignment pcl =
-          PclInitialAlignment(prep.target_features, prep.source_features, target, source, config);
-      out.timings.normals_s += pcl.normals_s;
-      out.timings.features_s = pcl.features_s;
-      out.timings.initial_alignment_s = pcl.sac_s;
-      sac = SacResult{};  // PCL's SAC-IA gives one pose, no runners-up
-      sac.found = pcl.found && (!region || region->Contains(pcl.T_target_source));
-      sac.T_target_source = pcl.T_target_source;
-      sac.inliers = pcl.correspondences;
-      lap.Lap();
-    } else if (config.features == FeatureKind::kNarf) {
-      sac = FastNarfAlignment(target, source, config, region, out.timings);
-      lap.Lap();
-    } else {
-      sac = FastFeatureAlignment(prep, config, region, out.timings, matches);
-      lap.Lap();
-    }
-    out.sac_inliers = sac.inliers;
-    if (sac.found) {
-      IcpResult icp;
-      RegistrationPath path = RegistrationPath::kFeatures;
-      std::string note;
-      if (config.backend == RegistrationBackend::kPcl) {
-        icp = RunPclIcp(icp_target, icp_source, prep, sac.T_target_source, config);
-      } else {
-        const Verified v = VerifyHypotheses(icp_source, icp_target, sac, prior, config);
-        icp = v.icp, path = v.path, note = v.note;
-        out.iterations += v.iterations - icp.iterations;  // Fill adds the winner's own
-      }
-      const std::string rejection = Rejection(icp, prior, config);
-      // Only a fit that passes the acceptance test says anything about the scene's degeneracy.
-      if (config.backend == RegistrationBackend::kFast && rejection.empty()) {
-        ambiguous = AmbiguousDirections(icp_target, icp_source, icp, config);
-      }
-      out.timings.icp_s += lap.Lap();
-      Fill(out, icp, path);
-      std::string contradiction;
-      if (!ambiguous.any() && rejection.empty() && ConstraintLimits(prior, config).from_bound &&
-          !prior.target_scan) {
-        contradiction = ContradictedByTheScans(icp_target, icp_source, matches, out, config);
-      }
-      if (!contradiction.empty()) {
-        out.reason = "feature alignment within the prior's region: " + contradiction;
-        out.timings.icp_s += lap.Lap();
-        Conclude(out, true, {}, prior, config);
-        out.timings.total_s = total.Lap();
-        return out;
-      }
-      if (!ambiguous.any() && rejection.empty()) {
-        out.success = true;
-        out.reason = note.empty() ? std::string(ToString(path)) : note;
-        if (confined) {
-          RefineConfined(target, source, prep.target_sensor, fewest_voxels, {}, prior, config, out);
-          out.timings.icp_s += lap.Lap();
-        }
-        Conclude(out, false, {}, prior, config);
-        out.timings.total_s = total.Lap();
-        return out;
-      }
-      std::ostringstream os;
-      os.precision(3);
-      if (ambiguous.any()) {
-        os << "feature alignment ambiguous: degenerate geometry (ICP restarted "
-           << config.degeneracy_probe_m << " m / " << config.degeneracy_probe_deg
-           << " deg along the weakest direction does not come back, and nothing rules out where "
-              "it ends: a fit about as good, or no free-space violation)";
-      } else {
-        os << "feature alignment rejected: " << rejection;
-      }
-      notes.push_back(os.str());
-    } else {
-      notes.push_back("initial alignment failed: " + std::to_string(sac.inliers) +
-                      " agreeing feature correspondences (min " +
-                      std::to_string(config.sac_min_inliers) + ")" +
-                      (region ? " inside the prior's region" : ""));
-    }
+  for (std::size_t i = 0; i < run.notes.size(); ++i) {
+    run.out.reason += (i ? "; " : "") + run.notes[i];
   }
-  // 5. Non-linear ICP from the odometry prior, else from the constant-velocity motion: the paper's
-  // guess for a robot without odometry. A motion model never overrules odometry the robot has (a
-  // P3-DX in the corridor merged a stop 1.86 m off the truth through it, where the scans could not
-  // decide and odometry, within its bound, was right; every later stop inherited the error).
-  std::vector<std::pair<RegistrationPath, Eigen::Isometry3d>> guesses;
-  if (prior.odometry) {
-    guesses.emplace_back(RegistrationPath::kOdometry, *prior.odometry);
-  } else if (prior.previous_motion && config.constant_velocity_fallback) {
-    guesses.emplace_back(RegistrationPath::kFallback, *prior.previous_motion);
-  }
-  Weakness frozen;         // what the accepted ICP from a guess kept at the guess
-  bool undetermined = false;  // a guess's ICP fitted, but along directions nothing decides
-  for (const auto& [path, guess] : guesses) {
-    FromGuess g = IcpFromGuess(icp_target, icp_source, prep, guess, path, ambiguous, prior, config);
-    bool searched = false;
-    if (!g.rejection.empty() && !g.undetermined && config.backend == RegistrationBackend::kFast &&
-        config.guess_search_m > 0) {
-      int iterations = 0;
-      const std::optional<IcpResult> found = SearchAroundGuess(
-          icp_target, icp_source, {guess, path, ToString(path)}, prior, config, g.held, iterations);
-      out.iterations += iterations;
-      // Only a pose that fits clearly better than ICP from the guess itself may replace it (unless
-      // it is the same pose, which failed for its residual or tilt rather than its fit): where
-      // the scan overlaps the map little, the best of the grid fits about as well somewhere else
-      // by chance (office mission: 16.5 % of the scan 1.2 m off, where ICP from a guess 3 cm off
-      // fitted 13.4 %; registration_eval's search winners fit 1.55-20x the guess's own ICP).
-      // And only a pose the scene pins down: in a corridor a grid start fits anywhere along the
-      // axis, and nothing says where.
-      if (found && !SamePose(found->T_target_source, g.icp.T_target_source, config) &&
-          found->inlier_ratio < kSearchMargin * g.icp.inlier_ratio) {
-        g.rejection += " (a grid of starts around the guess fits " + Percent(found->inlier_ratio) +
-                       " elsewhere: not clearly better than the guess's " +
-                       Percent(g.icp.inlier_ratio) + ")";
-      } else if (found &&
-                 !GuessDegenerateDirections(icp_target, icp_source, *found, config).any()) {
-        notes.push_back(std::string("ICP from the ") + ToString(path) + " guess: " + g.rejection);
-        g.icp = *found, g.rejection.clear(), searched = true, g.carried = false;
-        g.frozen = g.held;                   // the search kept only the tilt
-        out.iterations -= g.icp.iterations;  // Fill adds the winner's own
-      } else if (found) {
-        g.rejection +=
-            " (a grid of starts around the guess fits, but degenerate geometry leaves the "
-            "pose undetermined there)";
-      }
-    }
-    out.timings.icp_s += lap.Lap();
-    Fill(out, g.icp, path);
-    undetermined = undetermined || g.undetermined;
-    if (g.rejection.empty()) {
-      out.success = true;
-      frozen = g.frozen;
-      const char* carried =
-          path == RegistrationPath::kFallback
-              ? " (degenerate: constant velocity assumed along the weak directions)"
-              : " (degenerate: the weak directions kept from the odometry guess, "
-                "whose error bound is within carry_max_m / carry_max_deg)";
-      notes.push_back(
-          std::string("took the ") + ToString(path) + " path" + (g.carried ? carried : "") +
-          (searched ? " (ICP from the best of a grid of starts around the guess)" : "") +
-          (g.held.any() ? HeldNote(g.tilt_off_deg) : ""));
-      break;
-    }
-    notes.push_back(std::string(ToString(path)) + " path rejected: " + g.rejection);
-  }
-  if (!out.success && guesses.empty()) {
-    notes.push_back("no odometry prior or previous motion to fall back on");
-  }
-  bool contradicted = false;
-  if (out.success && ConstraintLimits(prior, config).from_bound && !prior.target_scan) {
-    if (std::string why = ContradictedByTheScans(icp_target, icp_source, matches, out, config);
-        !why.empty()) {
-      out.success = false, contradicted = true;
-      notes.push_back(std::move(why));
-    }
-    out.timings.icp_s += lap.Lap();
-  }
-  for (std::size_t i = 0; i < notes.size(); ++i) out.reason += (i ? "; " : "") + notes[i];
-  if (out.success && confined) {
-    RefineConfined(target, source, prep.target_sensor, fewest_voxels, frozen, prior, config, out);
-    out.timings.icp_s += lap.Lap();
-  }
-  Conclude(out, ambiguous.any() || undetermined || contradicted, frozen, prior, config);
-  out.timings.total_s = total.Lap();
-  return out;
+  // 6. A confined scene refined at half scale; the outcome and the pose's covariance.
+  Finish(s, verdict, run);
+  run.out.timings.total_s = total.Lap();
+  return std::move(run.out);
 }
 
 }  // namespace pitchlab::mapping

@@ -3,6 +3,8 @@
 #include <GeographicLib/UTMUPS.hpp>
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 #include <tuple>
 
 #include "pitchlab/worlds/dem_world.hpp"
@@ -172,6 +174,25 @@ TEST(Heightfield, GeneratedWorldsAreTheSameBytesFromTheSameSeed) {
   }
   EXPECT_NE(test::ReadBytes(a.path() / "terrain_hfield.bin"),
             test::ReadBytes(c.path() / "terrain_hfield.bin"));
+}
+
+TEST(Heightfield, ADefaultGoalOffTheWorldIsRefusedNamingItAndNothingIsWritten) {
+  TempDir dir("gully_goal");
+  GullyConfig gully;
+  gully.dem_path = std::filesystem::path(PITCHLAB_WORLDS_SOURCE_DIR) / "data/west_bijou_gully.asc";
+  gully.cell_m = 0.5;                // coarse: the check does not depend on the resolution
+  gully.default_goal = {0.0, 70.0};  // the world spans y -66.4 .. 66.4 m
+  try {
+    GenerateGullyWorld(gully, dir.path());
+    FAIL() << "a goal off the world was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("default goal (0.000, 70.000) lies outside the world's "
+                                         "bounds"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "gully.xml"));
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "gully_hfield.bin"));
 }
 
 TEST(Heightfield, BuiltWorldsEqualAFreshRunOfTheDefaultGenerators) {

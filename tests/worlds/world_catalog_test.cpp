@@ -56,6 +56,21 @@ TEST_P(BuiltinWorld, LoadsWithDescriptionBoundsAndAFlatFreeStart) {
   }
 }
 
+// Every built-in world is a mission: `run` and `bench` drive from its default start to this goal.
+TEST_P(BuiltinWorld, NamesADefaultGoalOnItsGroundAwayFromTheStart) {
+  const WorldMetadata meta = ReadWorldMetadata(model_.get());
+  ASSERT_TRUE(meta.default_goal) << GetParam().name;
+  const GoalPoint& g = *meta.default_goal;
+  const Bounds2d& b = meta.bounds;
+  EXPECT_TRUE(g.x_m > b.x_min_m && g.x_m < b.x_max_m && g.y_m > b.y_min_m && g.y_m < b.y_max_m);
+  EXPECT_FALSE(std::isnan(SurfaceHeight(model_.get(), data_.get(), g.x_m, g.y_m)));
+  // Farther than the run's goal tolerance (0.5 m) plus one stop's drive (4 m): at least one
+  // scan-plan-drive cycle before the goal.
+  constexpr double kMinMission_m = 4.5;
+  EXPECT_GT(std::hypot(g.x_m - meta.default_start.x_m, g.y_m - meta.default_start.y_m),
+            kMinMission_m);
+}
+
 TEST_P(BuiltinWorld, GroundCoversItsBoundsWithFiniteVisibleGeoms) {
   const WorldMetadata meta = ReadWorldMetadata(model_.get());
   const Bounds2d& b = meta.bounds;
@@ -212,6 +227,20 @@ TEST(Worlds, OfficeDoorsAreAtLeastNinetyCentimetresWide) {
     }
     EXPECT_GE(doors, 2) << "wall at y " << wall_y;
   }
+}
+
+TEST(Worlds, GullysDefaultGoalLiesDownhillFromItsStart) {
+  Loaded w = LoadWorld("gully");
+  ASSERT_TRUE(w.model);
+  const WorldMetadata meta = ReadWorldMetadata(w.model.get());
+  ASSERT_TRUE(meta.default_goal);
+  const double start_z =
+      SurfaceHeight(w.model.get(), w.data.get(), meta.default_start.x_m, meta.default_start.y_m);
+  const double goal_z =
+      SurfaceHeight(w.model.get(), w.data.get(), meta.default_goal->x_m, meta.default_goal->y_m);
+  // The DEM puts the goal 1.0 m below the start (GullyConfig::default_goal); half of that is far
+  // above the relief's rocks and cracks and still says the mission descends into the gully.
+  EXPECT_LT(goal_z, start_z - 0.5);
 }
 
 TEST(Worlds, GullyIsPlacedAtItsTrueGeodeticOrigin) {

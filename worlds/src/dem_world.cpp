@@ -72,6 +72,18 @@ DemWorld BuildDemWorld(const DemWorldConfig& config) {
   const double margin_m = std::min(1.0, 0.1 * (grid.XMax_m() - grid.x0_m));
   metadata.bounds = Bounds2d{grid.x0_m + margin_m, grid.y0_m + margin_m, grid.XMax_m() - margin_m,
                              grid.YMax_m() - margin_m};
+  if (const std::optional<GoalPoint>& goal = config.default_goal; goal) {
+    const Bounds2d& b = metadata.bounds;
+    if (!(goal->x_m >= b.x_min_m && goal->x_m <= b.x_max_m && goal->y_m >= b.y_min_m &&
+          goal->y_m <= b.y_max_m)) {
+      throw std::invalid_argument(
+          config.dem_path.string() + ": default goal (" + FormatFixed(goal->x_m, 3) + ", " +
+          FormatFixed(goal->y_m, 3) + ") lies outside the world's bounds x " +
+          FormatFixed(b.x_min_m, 3) + " .. " + FormatFixed(b.x_max_m, 3) + ", y " +
+          FormatFixed(b.y_min_m, 3) + " .. " + FormatFixed(b.y_max_m, 3) + " m");
+    }
+    metadata.default_goal = goal;
+  }
   world.comment = "dem: " + file + ", " + Describe(placement) + ", cell " +
                   FormatFixed(config.cell_m, 3) + " m, origin height " +
                   FormatFixed(projected.origin_height_m, 3) + " m";
@@ -94,6 +106,7 @@ DemWorldConfig GullyDemConfig(const GullyConfig& config) {
   dem.relief_seed = config.relief_seed;
   dem.description = "West Bijou Creek gully, CO: 3 m DEM (UTM 13N) upsampled to " +
                     FormatFixed(config.cell_m, 2) + " m with seeded rocks and cracks";
+  dem.default_goal = config.default_goal;
   return dem;
 }
 

@@ -16,6 +16,9 @@ struct DemWorldConfig {
   double cell_m = 0.2;                       ///< output vertex spacing [m]
   std::optional<std::uint64_t> relief_seed;  ///< add seeded rocks and cracks when given
   std::string description;                   ///< empty: derived from the file name
+  /// The default run's goal in the world frame [m]; must lie within the world's bounds. Absent:
+  /// the world names none (`pitchlab run` then needs --goal).
+  std::optional<GoalPoint> default_goal;
 };
 
 /// A DEM world before it is written: the surface, its metadata and how the DEM was placed.
@@ -39,6 +42,13 @@ struct GullyConfig {
   std::filesystem::path dem_path;    ///< west_bijou_gully.asc
   double cell_m = 0.15;              ///< [m]
   std::uint64_t relief_seed = 3980;  ///< the default world's seed
+  /// The default run's goal [m]: 10.8 m downhill from the start (-0.075, 45.825), 1.0 m lower,
+  /// at the head of the gully. The floor beyond it is out of a P3-AT's reach: on the true map
+  /// (0.1 m cells, the run's 19.3 deg slip limit and 8.9 cm step) nothing south of y = 34 m
+  /// connects to the start but a strip against the east bound, since the head scarp between
+  /// y = 28 and 36 m slopes 16-23 deg; this spot lies 1 m inside the connected ground on every
+  /// side. Valid for the default cell_m and relief_seed only.
+  GoalPoint default_goal{3.0, 35.5};
 };
 
 /// The DemWorldConfig of the gully world (UTM 13N, relief on).
