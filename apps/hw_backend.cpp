@@ -16,14 +16,14 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "app_config.hpp"
+#include "pitchlab/mission/app_config.hpp"
 #include "cli_args.hpp"
 #include "pitchlab/hw/stop_request.hpp"
 #include "pitchlab/worlds/world_catalog.hpp"
 #include "pitchlab/worlds/world_metadata.hpp"
-#include "run_config.hpp"
-#include "run_folder.hpp"
-#include "run_outputs.hpp"
+#include "pitchlab/mission/run_config.hpp"
+#include "pitchlab/mission/run_folder.hpp"
+#include "pitchlab/mission/run_outputs.hpp"
 #include "world_paths.hpp"
 
 namespace pitchlab::apps {
@@ -225,7 +225,7 @@ Backend SelectedBackend(int argc, char** argv) {
   if (!config) return Backend::kSim;
   std::string text;
   try {
-    text = ReadBinaryFile(*config);
+    text = mission::ReadBinaryFile(*config);
   } catch (const std::exception&) {
     return Backend::kSim;  // the run reports the unreadable file as for any config
   }
@@ -336,8 +336,8 @@ int RunHwMission(int argc, char** argv) {
   if (!args.Parse(argc, argv)) return 0;
   const bool quiet = args.Flagged("quiet");
 
-  AppConfig config =
-      LoadAppConfig(args.Has("config") ? std::optional(args.Get("config")) : std::nullopt);
+  mission::AppConfig config =
+      mission::LoadAppConfig(args.Has("config") ? std::optional(args.Get("config")) : std::nullopt);
   if (args.Has("seed")) {
     const std::vector<double> seed = args.GetNumbers("seed", 1);
     if (seed[0] < 0 || seed[0] != std::floor(seed[0]))
@@ -346,19 +346,19 @@ int RunHwMission(int argc, char** argv) {
   }
   if (args.Has("robot")) config.rig.robot.model = ParseRobotModel(args.Get("robot"));
   const std::string config_text =
-      args.Has("config") ? ReadBinaryFile(args.Get("config")) : std::string();
-  RunSettings settings = ParseRunSettings(config_text, config.source, config.rig.robot.model);
+      args.Has("config") ? mission::ReadBinaryFile(args.Get("config")) : std::string();
+  mission::RunSettings settings = mission::ParseRunSettings(config_text, config.source, config.rig.robot.model);
   const hw::HwRigConfig hw_config = ParseHwRigConfig(config_text, config.source, config.sensors);
 
   const std::vector<double> s = args.GetNumbers("start", 3);
   const Eigen::Vector3d start(s[0], s[1], s[2] * kDegToRad);
   const Frame frame = MissionFrame(args, start, settings.cell_m, settings.map_size_m);
-  MissionConfig& mission = settings.mission;
+  mission::MissionConfig& mission = settings.mission;
   mission.goal_m = frame.goal;
   mission.mount = config.rig.robot.mount;
   mission.map_area = frame.map_area;
 
-  RunFolder folder(args.Has("out") ? args.Get("out") : DefaultOut(config.seed));
+  mission::RunFolder folder(args.Has("out") ? args.Get("out") : DefaultOut(config.seed));
   // Ctrl-C / SIGTERM from here on: the drivers see the flag within one read timeout, the mission
   // ends, the drivers' destructors stop the base (zero speed, motors off) and the LMS200 output,
   // and the staging folder is removed uncommitted: no half-written run folder.
@@ -385,9 +385,9 @@ int RunHwMission(int argc, char** argv) {
   T_world_start.translation() << start.x(), start.y(), 0.0;
   T_world_start.rotate(Eigen::AngleAxisd(start.z(), Eigen::Vector3d::UnitZ()));
 
-  MissionObserver observer;
-  observer.on_stop = [&](const StopRecord& stop, const MissionResult& so_far) {
-    WriteStopOutputs(folder, stop, so_far, frame.origin,
+  mission::MissionObserver observer;
+  observer.on_stop = [&](const mission::StopRecord& stop, const mission::MissionResult& so_far) {
+    mission::WriteStopOutputs(folder, stop, so_far, frame.origin,
                      frame.world_file.empty()
                          ? std::string()
                          : std::filesystem::path(frame.world_file).stem().string());
@@ -398,14 +398,14 @@ int RunHwMission(int argc, char** argv) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     std::fprintf(stderr, "run: %s | wall %.1f s\n", text.c_str(), wall);
   };
-  const MissionResult result = RunMission(*backend.rig, *backend.rig->base(), T_world_start,
+  const mission::MissionResult result = mission::RunMission(*backend.rig, *backend.rig->base(), T_world_start,
                                           mission, backend.probes, observer);
   if (hw::StopRequested()) {
     backend.rig.reset();  // the destructors put the devices in a safe state now
     return interrupted("after " + std::to_string(result.stops.size()) + " stops");
   }
 
-  RunContext context;
+  mission::RunContext context;
   context.world = frame.world;
   context.world_file = frame.world_file;
   context.robot = config.rig.robot.model == sim::P3Model::kP3AT ? "p3at" : "p3dx";
@@ -414,17 +414,17 @@ int RunHwMission(int argc, char** argv) {
   context.goal = frame.goal;
   context.geodetic_origin = frame.origin;
   context.config_yaml =
-      AppConfigToYaml(config) + RunSettingsToYaml(settings) + HwRigConfigToYaml(hw_config);
-  context.planner = MissionPlanner(mission);
+      mission::AppConfigToYaml(config) + mission::RunSettingsToYaml(settings) + HwRigConfigToYaml(hw_config);
+  context.planner = mission::MissionPlanner(mission);
   context.layers = mission.layers;
   context.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  WriteFinalOutputs(folder, context, result, std::nullopt, nullptr, std::nullopt);
+  mission::WriteFinalOutputs(folder, context, result, std::nullopt, nullptr, std::nullopt);
   backend.rig.reset();
   if (hw::StopRequested()) return interrupted("while writing the run folder");
   folder.Commit();
 
-  const nlohmann::json metrics = RunMetrics(context, result, std::nullopt);
+  const nlohmann::json metrics = mission::RunMetrics(context, result, std::nullopt);
   if (args.Flagged("json")) std::cout << metrics.dump(2) << "\n";
   std::fprintf(stderr, "run (hw): %s: %s after %zu stops, %.1f s; run folder: %s\n",
                result.success ? "success" : "FAILED", result.reason.c_str(), result.stops.size(),

@@ -17,7 +17,7 @@
 #include <optional>
 #include <string>
 
-#include "mission.hpp"
+#include "pitchlab/mission/mission.hpp"
 #include "pitchlab/hw/hw_rig.hpp"
 #include "pitchlab/sensors/sensor_config.hpp"
 
@@ -45,7 +45,7 @@ std::string HwRigConfigToYaml(const hw::HwRigConfig& config);
 /// The devices of a hardware run and what the mission reads besides them.
 struct HwBackend {
   std::unique_ptr<hw::HwRig> rig;  ///< scan source; rig->base() the MobileBase
-  MissionProbes probes;            ///< steady clock only: no truth, no attitude sensor
+  mission::MissionProbes probes;            ///< steady clock only: no truth, no attitude sensor
 };
 
 /// Opens and initialises every device (the steady clock stamps lines, odometry and the mission).

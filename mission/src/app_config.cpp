@@ -1,4 +1,4 @@
-#include "app_config.hpp"
+#include "pitchlab/mission/app_config.hpp"
 
 #include <fstream>
 #include <set>
@@ -7,7 +7,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 // Top-level sections any pitchlab module reads; anything else is a typo worth an error.
@@ -161,4 +161,4 @@ std::string AppConfigToYaml(const AppConfig& config) {
   return os.str();
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 double NiceStep(double span, int count) {
   const double raw = std::max(span, 1e-9) / std::max(count, 1);
@@ -31,4 +31,4 @@ std::string TickLabel(double v, double step) {
   return s;
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

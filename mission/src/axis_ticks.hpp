@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 /// A round step for about `count` ticks over `span`: 1, 2 or 5 times a power of ten.
 double NiceStep(double span, int count);
@@ -13,4 +13,4 @@ std::vector<double> Ticks(double lo, double hi, double step);
 /// `v` with no more decimals than `step` needs and no "-0".
 std::string TickLabel(double v, double step);
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

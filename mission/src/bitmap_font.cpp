@@ -3,7 +3,7 @@
 #include <array>
 #include <stdexcept>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 struct Glyph {
@@ -73,4 +73,4 @@ void DrawText(mapping::RgbImage& image, int x, int y, const std::string& text, i
   }
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

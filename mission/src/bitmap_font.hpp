@@ -7,7 +7,7 @@
 
 #include "pitchlab/mapping/elevation_io.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 /// Width of `text` drawn at `scale` [px]: 6 px a character (5 + 1 space) times the scale.
 int TextWidth(const std::string& text, int scale);
@@ -20,4 +20,4 @@ bool FontHas(const std::string& text);
 void DrawText(mapping::RgbImage& image, int x, int y, const std::string& text, int scale,
               std::uint8_t r, std::uint8_t g, std::uint8_t b);
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -1,10 +1,10 @@
-#include "height_fit.hpp"
+#include "pitchlab/mission/height_fit.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <utility>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 constexpr int kMinPointsPerCell = 3;
@@ -58,4 +58,4 @@ std::optional<HeightOffset> FitHeightOffset(const mapping::ElevationMap& map,
   return out;
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

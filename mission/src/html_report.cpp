@@ -8,7 +8,7 @@
 
 #include "axis_ticks.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 // Layout for a screen from 1366 px wide up: nothing wider than the page, the first screen holds
@@ -311,4 +311,4 @@ std::string HtmlReport::Render() const {
          "</script>\n</body></html>\n";
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

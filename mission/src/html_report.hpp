@@ -10,7 +10,7 @@
 
 #include <Eigen/Core>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 /// One polyline of a trajectory plot, in metres, with its CSS colour and legend label.
 struct PlotSeries {
@@ -76,4 +76,4 @@ std::string Base64(const std::string& bytes);
 /// Text with &, <, >, " escaped for HTML.
 std::string HtmlEscape(const std::string& text);
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -9,7 +9,7 @@
 #include "axis_ticks.hpp"
 #include "bitmap_font.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 // 15 x 21 px characters: still ~9 x 12 px where the report shows a 1000 px figure 600 px wide.
@@ -236,4 +236,4 @@ mapping::RgbImage ComposeMapFigure(const mapping::RgbImage& map, const mapping::
   return out;
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

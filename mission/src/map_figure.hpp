@@ -11,7 +11,7 @@
 
 #include "pitchlab/mapping/elevation_io.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 /// The part of the map a figure shows, in the map frame [m].
 struct MapWindow {
@@ -47,4 +47,4 @@ struct FigureMarks {
 mapping::RgbImage ComposeMapFigure(const mapping::RgbImage& map, const mapping::GridGeometry& grid,
                                    const MapWindow& window, const FigureMarks& marks);
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -1,4 +1,4 @@
-#include "mission.hpp"
+#include "pitchlab/mission/mission.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,9 +9,9 @@
 
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/point_cloud.hpp"
-#include "slope_guard.hpp"
+#include "pitchlab/mission/slope_guard.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -760,4 +760,4 @@ MissionResult RunMission(sensors::ScanSource& source, sensors::MobileBase& base,
   return mission.Run(T_world_start);
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -1,4 +1,4 @@
-#include "path_follower.hpp"
+#include "pitchlab/mission/path_follower.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 void PurePursuitConfig::Validate() const {
   auto positive = [](const char* name, double v) {
@@ -98,4 +98,4 @@ DriveCommand PurePursuit::Command(double x_m, double y_m, double yaw_rad) {
   return cmd;
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "html_report.hpp"
-#include "traversability_image.hpp"
+#include "pitchlab/mission/traversability_image.hpp"
 
 // JSON format (all lengths in metres, world frame, z up):
 //   cloud:   {origin: [x, y, z], scale, xyz: base64 int16 little-endian triplets}
@@ -15,7 +15,7 @@
 //   surface: {x0, y0, cell, nx, ny, z0, scale, z: base64 int16 (-32768 unknown), rgb: base64 u8}
 //            height = z0 + (q + 32767) * scale
 //   true, estimated, stops: [[x, y, z], ...]; start, goal: [x, y, z]
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 constexpr int kUnknown = -32768;
@@ -148,4 +148,4 @@ std::string SceneJson(const Scene3D& s) {
       .dump();
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

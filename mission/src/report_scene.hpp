@@ -15,7 +15,7 @@
 #include "pitchlab/mapping/point_cloud.hpp"
 #include "pitchlab/planning/traversability.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 /// At most this many cloud points go into a page: 100k points are 0.8 MB of base64, and a
 /// software-rendered WebGL canvas still orbits them smoothly.
@@ -52,4 +52,4 @@ SceneSurface BuildSurface(const mapping::ElevationLayers& layers,
 /// The scene as the JSON object the viewer's script reads (format in report_scene.cpp).
 std::string SceneJson(const Scene3D& scene);
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

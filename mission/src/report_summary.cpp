@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 // The report prints distances to 0.1 m, the elevation map's usual cell: closer than half of
@@ -119,4 +119,4 @@ std::vector<MetricRow> KeyMetrics(const nlohmann::json& m) {
   return rows;
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 /// The verdict of a run, read from metrics.json.
 struct Outcome {
@@ -39,4 +39,4 @@ std::vector<MetricRow> KeyMetrics(const nlohmann::json& metrics);
 /// "-" for NaN or infinity.
 std::string Significant(double v, int digits = 3);
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -9,7 +9,7 @@
 #define PITCHLAB_THREE_JS_DIR ""
 #endif
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 Result<std::string> Slurp(const std::filesystem::path& file) {
@@ -232,4 +232,4 @@ std::string ViewerUnavailableHtml(const std::string& why) {
          HtmlEscape(why) + "</p></div>\n";
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -7,7 +7,7 @@
 
 #include "pitchlab/sensors/result.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 /// three.js and its OrbitControls, the browser (UMD) builds.
 struct ThreeJs {
@@ -29,4 +29,4 @@ std::string ViewerHtml(const std::string& scene_json, const ThreeJs& three);
 /// What the page shows in the view's place when three.js is missing: the reason and the fix.
 std::string ViewerUnavailableHtml(const std::string& why);
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

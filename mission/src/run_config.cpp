@@ -1,4 +1,4 @@
-#include "run_config.hpp"
+#include "pitchlab/mission/run_config.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
@@ -258,4 +258,4 @@ std::string RunSettingsToYaml(const RunSettings& s) {
   return os.str();
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -1,4 +1,4 @@
-#include "run_folder.hpp"
+#include "pitchlab/mission/run_folder.hpp"
 
 #include <unistd.h>
 
@@ -8,9 +8,9 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "interrupt.hpp"
+#include "pitchlab/mission/cleanup_registry.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 namespace fs = std::filesystem;
 
@@ -95,4 +95,4 @@ std::string ReadBinaryFile(const fs::path& path) {
   return os.str();
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

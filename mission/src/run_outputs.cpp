@@ -1,5 +1,5 @@
-#include "run_outputs.hpp"
-#include "registration_json.hpp"
+#include "pitchlab/mission/run_outputs.hpp"
+#include "pitchlab/mission/registration_json.hpp"
 #include "run_pictures.hpp"
 #include "run_report.hpp"
 
@@ -15,7 +15,7 @@
 #include "pitchlab/planning/path_io.hpp"
 #include "pitchlab/sensors/scan_pcd.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
@@ -238,4 +238,4 @@ void WriteFinalOutputs(RunFolder& folder, const RunContext& c, const MissionResu
   WriteRunReport(folder, c, r, metrics, layers);
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

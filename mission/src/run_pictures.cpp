@@ -4,9 +4,9 @@
 
 #include "map_figure.hpp"
 #include "pitchlab/planning/path_io.hpp"
-#include "traversability_image.hpp"
+#include "pitchlab/mission/traversability_image.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 void Write(const mapping::RgbImage& image, const std::filesystem::path& file) {
@@ -147,4 +147,4 @@ mapping::RgbImage StopPicture(const MissionResult& so_far,
   return ComposeMapFigure(image, g, window, marks);
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -8,13 +8,13 @@
 
 #include <Eigen/Core>
 
-#include "mission.hpp"
+#include "pitchlab/mission/mission.hpp"
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
-#include "run_folder.hpp"
-#include "run_outputs.hpp"
+#include "pitchlab/mission/run_folder.hpp"
+#include "pitchlab/mission/run_outputs.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 /// The estimated (or, with `truth`, the true) x, y of every trajectory sample [m].
 std::vector<Eigen::Vector2d> TrajectoryXy(const MissionResult& result, bool truth);
@@ -46,4 +46,4 @@ mapping::RgbImage Downscale(const mapping::RgbImage& image, int max_width_px);
 void WriteStopPictures(RunFolder& folder, const std::string& dir, const MissionResult& so_far,
                        const std::optional<planning::Path>& plan);
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

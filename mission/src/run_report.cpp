@@ -4,7 +4,7 @@
 
 #include "report_summary.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 // Display width of a map figure: two side by side on a 1366 px screen (the page is 1240 px).
@@ -145,4 +145,4 @@ std::string RenderRunReport(const RunReportInput& in, const Result<ThreeJs>& thr
   return page.Render();
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

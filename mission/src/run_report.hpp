@@ -10,13 +10,13 @@
 #include <nlohmann/json.hpp>
 
 #include "html_report.hpp"
-#include "mission.hpp"
+#include "pitchlab/mission/mission.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "report_viewer.hpp"
-#include "run_folder.hpp"
-#include "run_outputs.hpp"
+#include "pitchlab/mission/run_folder.hpp"
+#include "pitchlab/mission/run_outputs.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 /// A picture of the run folder shown in the report.
 struct ReportPicture {
@@ -55,4 +55,4 @@ RunReportInput GatherRunReport(const RunFolder& folder, const RunContext& contex
 void WriteRunReport(RunFolder& folder, const RunContext& context, const MissionResult& result,
                     const nlohmann::json& metrics, const mapping::ElevationLayers& layers);
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -8,9 +8,9 @@
 #include "report_scene.hpp"
 #include "run_pictures.hpp"
 #include "run_report.hpp"
-#include "traversability_image.hpp"
+#include "pitchlab/mission/traversability_image.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 std::string Fixed(double v, int digits) {
@@ -144,4 +144,4 @@ void WriteRunReport(RunFolder& folder, const RunContext& c, const MissionResult&
                 RenderRunReport(GatherRunReport(folder, c, r, metrics, layers), three));
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -1,4 +1,4 @@
-#include "run_scoring.hpp"
+#include "pitchlab/mission/run_scoring.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <tuple>
 #include <utility>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
@@ -170,4 +170,4 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
   return s;
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

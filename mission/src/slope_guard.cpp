@@ -1,9 +1,9 @@
-#include "slope_guard.hpp"
+#include "pitchlab/mission/slope_guard.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 constexpr float kObstacleHeight_m = 0.5f;  // what a felt obstacle stands above its cells
@@ -63,4 +63,4 @@ void MarkFelt(mapping::ElevationLayers& L, const FeltHazard& f) {
   }
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -1,12 +1,12 @@
-#include "traversability_image.hpp"
+#include "pitchlab/mission/traversability_image.hpp"
 
-#include "run_scoring.hpp"
+#include "pitchlab/mission/run_scoring.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 namespace {
 
@@ -134,4 +134,4 @@ std::string TraversabilityLegend() {
          "the safety margin.";
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

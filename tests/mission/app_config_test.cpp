@@ -1,4 +1,4 @@
-#include "app_config.hpp"
+#include "pitchlab/mission/app_config.hpp"
 
 #include <cstdio>
 #include <fstream>
@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 // LoadAppConfig reads files: one in the test's temporary folder, removed after.
@@ -66,4 +66,4 @@ TEST(AppConfig, ABadImuSettingNamesTheFieldAndValue) {
 }
 
 }  // namespace
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -1,14 +1,14 @@
 // FitHeightOffset against known offsets: a map of rough ground, the same ground seen again shifted
 // up, plus clutter the map never saw.
 
-#include "height_fit.hpp"
+#include "pitchlab/mission/height_fit.hpp"
 
 #include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 double Ground(double x, double y) { return 0.3 * std::sin(0.7 * x) + 0.2 * std::cos(0.5 * y); }
@@ -53,4 +53,4 @@ TEST(HeightFit, TooLittleOverlapFitsNothing) {
 }
 
 }  // namespace
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 TEST(Base64, MatchesRfc4648TestVectors) {
@@ -90,4 +90,4 @@ TEST(HtmlReport, RejectsARaggedTable) {
 }
 
 }  // namespace
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

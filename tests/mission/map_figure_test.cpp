@@ -9,7 +9,7 @@
 #include "axis_ticks.hpp"
 #include "bitmap_font.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 using Rgb = std::array<int, 3>;
@@ -195,4 +195,4 @@ TEST(BitmapFont, DrawsTheGlyphsPixelForPixel) {
 }
 
 }  // namespace
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -1,10 +1,10 @@
-#include "path_follower.hpp"
+#include "pitchlab/mission/path_follower.hpp"
 
 #include <cmath>
 
 #include <gtest/gtest.h>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -91,4 +91,4 @@ TEST(PurePursuit, RejectsAnEmptyPathAndBadConfig) {
 }
 
 }  // namespace
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

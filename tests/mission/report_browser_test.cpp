@@ -20,7 +20,7 @@
 #define PITCHLAB_CHROMIUM ""
 #endif
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 namespace fs = std::filesystem;
@@ -245,4 +245,4 @@ TEST_F(ReportInBrowser, TheScreenshotAt1366ShowsTheFailedOutcome) {
 }
 
 }  // namespace
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 std::string FromBase64(const std::string& text) {
@@ -92,4 +92,4 @@ TEST(BuildSurface, KeepsHeightsUnknownCellsAndTraversabilityColours) {
 }
 
 }  // namespace
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 TEST(Significant, KeepsThreeDigitsWithoutExponents) {
@@ -103,4 +103,4 @@ TEST(KeyMetrics, ShowsUnitsAndLeavesOutWhatIsUnknown) {
 }
 
 }  // namespace
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -1,10 +1,10 @@
-#include "run_config.hpp"
+#include "pitchlab/mission/run_config.hpp"
 
 #include <cmath>
 
 #include <gtest/gtest.h>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
@@ -157,4 +157,4 @@ TEST(RunSettings, WrittenYamlReadsBackTheSame) {
 }
 
 }  // namespace
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

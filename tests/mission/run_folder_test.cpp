@@ -1,4 +1,4 @@
-#include "run_folder.hpp"
+#include "pitchlab/mission/run_folder.hpp"
 
 #include <unistd.h>
 
@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 namespace fs = std::filesystem;
@@ -51,4 +51,4 @@ TEST(RunFolder, RefusesToOverwriteAnExistingRun) {
 }
 
 }  // namespace
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

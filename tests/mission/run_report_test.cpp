@@ -5,7 +5,7 @@
 #include "report_scene.hpp"
 #include "synthetic_report.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 namespace fs = std::filesystem;
@@ -89,4 +89,4 @@ TEST_F(RunReport, TheLargestPageStaysUnderTenMegabytes) {
 }
 
 }  // namespace
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -1,4 +1,4 @@
-#include "slope_guard.hpp"
+#include "pitchlab/mission/slope_guard.hpp"
 
 #include <cmath>
 
@@ -6,7 +6,7 @@
 
 #include "pitchlab/planning/traversability.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -125,4 +125,4 @@ TEST(MarkFelt, DropCellsStayDrops) {
 }
 
 }  // namespace
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -9,7 +9,7 @@
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "report_scene.hpp"
 
-namespace pitchlab::apps::testing {
+namespace pitchlab::mission::testing {
 namespace {
 
 constexpr double kCell_m = 0.1;
@@ -123,4 +123,4 @@ RunReportInput SyntheticReport(const std::filesystem::path& folder, std::size_t 
   return in;
 }
 
-}  // namespace pitchlab::apps::testing
+}  // namespace pitchlab::mission::testing

@@ -6,7 +6,7 @@
 
 #include "run_report.hpp"
 
-namespace pitchlab::apps::testing {
+namespace pitchlab::mission::testing {
 
 /// A report input for a failed run (reason: kSyntheticReason) whose pictures are written into
 /// `folder` (created). `cloud_points` and `surface_side_cells` size the 3D scene.
@@ -17,4 +17,4 @@ RunReportInput SyntheticReport(const std::filesystem::path& folder,
 inline constexpr const char* kSyntheticReason =
     "no path: the goal at (6.0, 4.0) m is walled in by steps";
 
-}  // namespace pitchlab::apps::testing
+}  // namespace pitchlab::mission::testing

@@ -1,11 +1,11 @@
-#include "traversability_image.hpp"
+#include "pitchlab/mission/traversability_image.hpp"
 
 #include <array>
 #include <cmath>
 
 #include <gtest/gtest.h>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
 using planning::Blocked;
@@ -48,4 +48,4 @@ TEST(RenderTraversability, EachKindOfCellHasItsColourNorthUp) {
 }
 
 }  // namespace
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -10,7 +10,7 @@
 #include "pitchlab/sensors/sensor_config.hpp"
 #include "pitchlab/sim/sim_rig.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 struct AppConfig {
   std::uint64_t seed = 1;  ///< one seed for every random source of a run
@@ -26,4 +26,4 @@ AppConfig LoadAppConfig(const std::optional<std::string>& path);
 /// The configuration actually used, as YAML that LoadAppConfig reads back.
 std::string AppConfigToYaml(const AppConfig& config);
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

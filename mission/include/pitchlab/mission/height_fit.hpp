@@ -14,7 +14,7 @@
 
 #include "pitchlab/mapping/elevation_map.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 /// How far a scan's ground lies above the map's.
 struct HeightOffset {
@@ -30,4 +30,4 @@ std::optional<HeightOffset> FitHeightOffset(const mapping::ElevationMap& map,
                                             const std::vector<Eigen::Vector3f>& points,
                                             int min_cells = 50);
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -10,8 +10,8 @@
 
 #include <Eigen/Geometry>
 
-#include "height_fit.hpp"
-#include "path_follower.hpp"
+#include "pitchlab/mission/height_fit.hpp"
+#include "pitchlab/mission/path_follower.hpp"
 #include "pitchlab/mapping/elevation_map.hpp"
 #include "pitchlab/mapping/map_builder.hpp"
 #include "pitchlab/planning/planner.hpp"
@@ -19,7 +19,7 @@
 #include "pitchlab/sensors/mobile_base.hpp"
 #include "pitchlab/sensors/pitching_scanner.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 struct MissionConfig {
   Eigen::Vector2d goal_m = Eigen::Vector2d::Zero();  ///< goal in the world frame [m]
@@ -157,4 +157,4 @@ MissionResult RunMission(sensors::ScanSource& source, sensors::MobileBase& base,
                          const Eigen::Isometry3d& T_world_start, const MissionConfig& config,
                          const MissionProbes& probes, const MissionObserver& observer = {});
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

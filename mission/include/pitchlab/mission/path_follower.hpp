@@ -6,7 +6,7 @@
 
 #include <Eigen/Core>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 struct PurePursuitConfig {
   double lookahead_m = 0.45;       ///< distance along the path to the point steered at [m]
@@ -50,4 +50,4 @@ class PurePursuit {
   double ClosestArc(const Eigen::Vector2d& p, double from_arc_m, double window_m) const;
 };
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -6,7 +6,7 @@
 
 #include "pitchlab/mapping/registration.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 /// Rows of a 6x6 matrix (information, covariance: roll pitch yaw [rad], x y z [m]).
 inline nlohmann::json Matrix6Json(const mapping::Matrix6d& m) {
@@ -37,4 +37,4 @@ inline nlohmann::json StageTimingsJson(const mapping::StageTimings& t) {
           {"icp", t.icp_s},           {"total", t.total_s}};
 }
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -5,10 +5,10 @@
 #include <optional>
 #include <string>
 
-#include "mission.hpp"
+#include "pitchlab/mission/mission.hpp"
 #include "pitchlab/sim/robot_model.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 struct RunSettings {
   MissionConfig mission;  ///< goal, map_area and mount are filled in by the caller
@@ -31,4 +31,4 @@ RunSettings ParseRunSettings(const std::string& yaml_text, const std::string& so
 /// The three sections as YAML, readable back by ParseRunSettings.
 std::string RunSettingsToYaml(const RunSettings& settings);
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <string>
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 class RunFolder {
  public:
@@ -40,4 +40,4 @@ void WriteTextFile(const std::filesystem::path& path, const std::string& text);
 /// Reads a whole file; throws std::runtime_error naming the path.
 std::string ReadBinaryFile(const std::filesystem::path& path);
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

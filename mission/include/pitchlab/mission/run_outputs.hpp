@@ -9,12 +9,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "mission.hpp"
+#include "pitchlab/mission/mission.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
-#include "run_folder.hpp"
-#include "run_scoring.hpp"
+#include "pitchlab/mission/run_folder.hpp"
+#include "pitchlab/mission/run_scoring.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 /// Facts about the run that the mission itself does not hold.
 struct RunContext {
@@ -49,4 +49,4 @@ void WriteFinalOutputs(RunFolder& folder, const RunContext& context, const Missi
                        const std::optional<RunScore>& score, const mapping::ElevationLayers* truth,
                        const std::optional<planning::Path>& truth_optimum);
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

@@ -5,11 +5,11 @@
 #include <optional>
 #include <string>
 
-#include "mission.hpp"
+#include "pitchlab/mission/mission.hpp"
 #include "pitchlab/planning/planner.hpp"
 #include "pitchlab/planning/traversability.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 struct RunScore {
   double final_translation_error_m = 0;             ///< last estimate vs truth [m]
@@ -62,4 +62,4 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
                   const Eigen::Vector2d& start_m, const Eigen::Vector2d& goal_m,
                   planning::Algorithm algorithm);
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

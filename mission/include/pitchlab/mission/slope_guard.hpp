@@ -11,7 +11,7 @@
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/planning/planner.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 /// The grades of a path: its arc lengths computed once, so a controller can ask every step.
 class PathGrade {
@@ -49,4 +49,4 @@ struct FeltHazard {
 /// An obstacle makes them a step (a point 0.5 m above the cell's mean). Drop cells stay drops.
 void MarkFelt(mapping::ElevationLayers& layers, const FeltHazard& f);
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission

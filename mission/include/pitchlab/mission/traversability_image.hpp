@@ -7,7 +7,7 @@
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/planning/traversability.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 
 /// Free cells in shades of green (darker costs more to enter), unknown cells as the elevation
 /// picture's checkerboard, steps red, too steep orange, drops magenta, cells within the robot's
@@ -29,4 +29,4 @@ mapping::RgbImage RenderHazardErrors(const planning::TraversabilityGrid& estimat
 /// The legend of RenderHazardErrors' colours, one sentence.
 std::string HazardErrorsLegend();
 
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission
