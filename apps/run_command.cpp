@@ -8,7 +8,7 @@
 
 #include "cli_args.hpp"
 #include "commands.hpp"
-#include "hw_backend.hpp"
+#include "hw_run.hpp"
 #include "interrupt.hpp"
 #include "output_paths.hpp"
 #include "pitchlab/mission/sim_mission.hpp"
@@ -72,7 +72,7 @@ mission::SimMissionObserver ProgressLines(std::chrono::steady_clock::time_point 
 
 int RunRun(int argc, char** argv) {
   // backend: hw (config or --backend): the same mission over the hardware drivers.
-  if (SelectedBackend(argc, argv) == Backend::kHw) return RunHwMission(argc, argv);
+  if (SelectedBackend(argc, argv) == mission::Backend::kHw) return RunHwRun(argc, argv);
   InstallInterruptCleanup("pitchlab run");  // first: before any thread starts
   const auto wall_start = std::chrono::steady_clock::now();
   CliArgs args = RunArgs();

@@ -1,13 +1,7 @@
-#include "hw_backend.hpp"
-
-#include <mujoco/mujoco.h>
+#include "pitchlab/mission/hw_mission.hpp"
 
 #include <chrono>
-#include <cmath>
-#include <cstdio>
-#include <ctime>
 #include <filesystem>
-#include <iostream>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -16,20 +10,15 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "pitchlab/mission/app_config.hpp"
-#include "cli_args.hpp"
 #include "pitchlab/hw/stop_request.hpp"
-#include "pitchlab/worlds/world_catalog.hpp"
-#include "pitchlab/worlds/world_metadata.hpp"
-#include "pitchlab/mission/run_config.hpp"
 #include "pitchlab/mission/run_folder.hpp"
-#include "pitchlab/mission/run_outputs.hpp"
-#include "world_paths.hpp"
+#include "pitchlab/mission/sim_mission.hpp"
+#include "pitchlab/worlds/world_metadata.hpp"
 
-namespace pitchlab::apps {
+namespace pitchlab::mission {
 namespace {
 
-constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+// The map without a world: a square this wide around the start, unless run.map_size_m says [m].
 constexpr double kDefaultMapSize_m = 60.0;
 constexpr double kMapMargin_m = 1.0;  // around a world's bounds, as in the simulated run
 
@@ -105,96 +94,6 @@ void RequireDevice(const std::string& device, const std::string& source, const s
   }
 }
 
-std::string DefaultOut(std::uint64_t seed) {
-  const std::time_t now = std::time(nullptr);
-  char stamp[32];
-  std::strftime(stamp, sizeof(stamp), "%Y%m%d-%H%M%S", std::localtime(&now));
-  return "runs/hw-s" + std::to_string(seed) + "-" + stamp;
-}
-
-worlds::WorldMetadata LoadMetadata(const std::filesystem::path& world) {
-  char error[1000] = "";
-  mjModel* model = mj_loadXML(world.string().c_str(), nullptr, error, sizeof(error));
-  if (model == nullptr)
-    throw std::runtime_error("cannot load world '" + world.string() + "': " + error);
-  const worlds::WorldMetadata meta = worlds::ReadWorldMetadata(model);
-  mj_deleteModel(model);
-  return meta;
-}
-
-CliArgs HwRunArgs() {
-  CliArgs args("run --backend hw",
-               "The closed-loop stop-scan-go mission on the real robot (or its emulators): the\n"
-               "same loop as in simulation over the LMS200, pitch-unit and P2OS drivers named in\n"
-               "the config's `hw` section. No ground truth: no scoring. Writes the run folder.");
-  args.Option("backend", "sim|hw", "hw here (overrides the config's backend)")
-      .Option("config", "FILE.yaml", "configuration with the `hw` section (see hw/README.md)")
-      .Option("world", "NAME|FILE.xml",
-              "a world whose bounds (and default goal, geodetic origin) frame the map")
-      .Option("start", "x,y,yaw", "the robot's pose in the map frame: m, m, deg", "0,0,0")
-      .Option("goal", "x,y", "goal in metres (default: the --world's default goal)")
-      .Option("robot", "p3at|p3dx", "robot model (planner limits), overrides robot.model")
-      .Option("seed", "N", "seed of every random source, overrides the config's seed")
-      .Option("out", "DIR", "run folder to create (default: runs/hw-s<seed>-<time>)")
-      .Flag("json", "print metrics.json on stdout at the end")
-      .Flag("quiet", "no progress on stderr");
-  return args;
-}
-
-// The mission's goal, map area and geodetic origin from --world / --goal / run.map_size_m.
-struct Frame {
-  std::string world = "hardware", world_file;
-  Eigen::Vector2d goal{0, 0};
-  mapping::GridGeometry map_area;
-  std::optional<mapping::GeodeticOrigin> origin;
-};
-
-Frame MissionFrame(const CliArgs& args, const Eigen::Vector3d& start, double cell_m,
-                   std::optional<double> map_size_m) {
-  Frame f;
-  std::optional<Eigen::Vector2d> default_goal;
-  if (args.Has("world")) {
-    f.world = args.Get("world");
-    f.world_file = worlds::ResolveWorld(f.world, WorldsDir()).string();
-    const worlds::WorldMetadata meta = LoadMetadata(f.world_file);
-    const worlds::Bounds2d& b = meta.bounds;
-    f.map_area = mapping::GridGeometry::Covering(Eigen::Vector2d(b.x_min_m, b.y_min_m),
-                                                 Eigen::Vector2d(b.x_max_m, b.y_max_m), cell_m,
-                                                 kMapMargin_m);
-    if (meta.default_goal)
-      default_goal = Eigen::Vector2d(meta.default_goal->x_m, meta.default_goal->y_m);
-    if (meta.geodetic_origin) {
-      f.origin = mapping::GeodeticOrigin{meta.geodetic_origin->latitude_deg,
-                                         meta.geodetic_origin->longitude_deg,
-                                         meta.geodetic_origin->height_m};
-    }
-  } else {
-    const double half = 0.5 * map_size_m.value_or(kDefaultMapSize_m);
-    f.map_area = mapping::GridGeometry::Covering(start.head<2>().array() - half,
-                                                 start.head<2>().array() + half, cell_m);
-  }
-  if (args.Has("goal")) {
-    const std::vector<double> g = args.GetNumbers("goal", 2);
-    f.goal = Eigen::Vector2d(g[0], g[1]);
-  } else if (default_goal) {
-    f.goal = *default_goal;
-  } else {
-    throw CliError("a hardware run needs --goal x,y (or a --world with a default goal)");
-  }
-  const mapping::GridGeometry& a = f.map_area;
-  for (const auto& [name, p] :
-       {std::pair{"start", Eigen::Vector2d(start.head<2>())}, std::pair{"goal", f.goal}}) {
-    if (p.x() < a.x_min_m || p.x() > a.x_max_m() || p.y() < a.y_min_m || p.y() > a.y_max_m()) {
-      throw std::runtime_error(std::string(name) + " (" + std::to_string(p.x()) + ", " +
-                               std::to_string(p.y()) + ") is off the map: it spans x " +
-                               std::to_string(a.x_min_m) + " .. " + std::to_string(a.x_max_m()) +
-                               ", y " + std::to_string(a.y_min_m) + " .. " +
-                               std::to_string(a.y_max_m()));
-    }
-  }
-  return f;
-}
-
 }  // namespace
 
 Backend ParseBackend(const std::string& yaml_text, const std::string& source) {
@@ -205,31 +104,6 @@ Backend ParseBackend(const std::string& yaml_text, const std::string& source) {
   if (value == "sim") return Backend::kSim;
   if (value == "hw") return Backend::kHw;
   throw std::invalid_argument(source + ": backend = '" + value + "' is not a backend (sim, hw)");
-}
-
-Backend SelectedBackend(int argc, char** argv) {
-  std::optional<std::string> backend, config;
-  for (int i = 0; i < argc; ++i) {
-    const std::string arg = argv[i];
-    for (auto [name, value] : {std::pair{"--backend", &backend}, std::pair{"--config", &config}}) {
-      const std::string prefix = std::string(name) + "=";
-      if (arg == name && i + 1 < argc) *value = argv[i + 1];
-      if (arg.rfind(prefix, 0) == 0) *value = arg.substr(prefix.size());
-    }
-  }
-  if (backend) {
-    if (*backend == "sim") return Backend::kSim;
-    if (*backend == "hw") return Backend::kHw;
-    throw CliError("--backend '" + *backend + "' is not a backend (sim, hw)");
-  }
-  if (!config) return Backend::kSim;
-  std::string text;
-  try {
-    text = mission::ReadBinaryFile(*config);
-  } catch (const std::exception&) {
-    return Backend::kSim;  // the run reports the unreadable file as for any config
-  }
-  return ParseBackend(text, *config);
 }
 
 hw::HwRigConfig ParseHwRigConfig(const std::string& yaml_text, const std::string& source,
@@ -330,106 +204,125 @@ HwBackend StartHwBackend(const hw::HwRigConfig& config) {
   return backend;
 }
 
-int RunHwMission(int argc, char** argv) {
-  const auto wall_start = std::chrono::steady_clock::now();
-  CliArgs args = HwRunArgs();
-  if (!args.Parse(argc, argv)) return 0;
-  const bool quiet = args.Flagged("quiet");
-
-  mission::AppConfig config =
-      mission::LoadAppConfig(args.Has("config") ? std::optional(args.Get("config")) : std::nullopt);
-  if (args.Has("seed")) {
-    const std::vector<double> seed = args.GetNumbers("seed", 1);
-    if (seed[0] < 0 || seed[0] != std::floor(seed[0]))
-      throw CliError("--seed must be an integer >= 0");
-    config.seed = static_cast<std::uint64_t>(seed[0]);
+HwMissionFrame FrameHwMission(const HwMissionSpec& spec) {
+  HwMissionFrame f;
+  const double cell_m = spec.settings.cell_m;
+  std::optional<Eigen::Vector2d> default_goal;
+  if (!spec.world_file.empty()) {
+    f.world = spec.world_name.empty() ? spec.world_file.stem().string() : spec.world_name;
+    f.world_file = spec.world_file.string();
+    const worlds::WorldMetadata meta = LoadWorldMetadata(spec.world_file);
+    const worlds::Bounds2d& b = meta.bounds;
+    f.map_area = mapping::GridGeometry::Covering(Eigen::Vector2d(b.x_min_m, b.y_min_m),
+                                                 Eigen::Vector2d(b.x_max_m, b.y_max_m), cell_m,
+                                                 kMapMargin_m);
+    if (meta.default_goal)
+      default_goal = Eigen::Vector2d(meta.default_goal->x_m, meta.default_goal->y_m);
+    if (meta.geodetic_origin) {
+      f.origin = mapping::GeodeticOrigin{meta.geodetic_origin->latitude_deg,
+                                         meta.geodetic_origin->longitude_deg,
+                                         meta.geodetic_origin->height_m};
+    }
+  } else {
+    f.world = spec.world_name.empty() ? "hardware" : spec.world_name;
+    const double half = 0.5 * spec.settings.map_size_m.value_or(kDefaultMapSize_m);
+    f.map_area = mapping::GridGeometry::Covering(spec.start.head<2>().array() - half,
+                                                 spec.start.head<2>().array() + half, cell_m);
   }
-  if (args.Has("robot")) config.rig.robot.model = ParseRobotModel(args.Get("robot"));
-  const std::string config_text =
-      args.Has("config") ? mission::ReadBinaryFile(args.Get("config")) : std::string();
-  mission::RunSettings settings = mission::ParseRunSettings(config_text, config.source, config.rig.robot.model);
-  const hw::HwRigConfig hw_config = ParseHwRigConfig(config_text, config.source, config.sensors);
+  if (spec.goal_m) {
+    f.goal = *spec.goal_m;
+  } else if (default_goal) {
+    f.goal = *default_goal;
+  } else {
+    throw std::invalid_argument("a hardware run needs a goal (or a world with a default goal)");
+  }
+  const mapping::GridGeometry& a = f.map_area;
+  for (const auto& [name, p] :
+       {std::pair{"start", Eigen::Vector2d(spec.start.head<2>())}, std::pair{"goal", f.goal}}) {
+    if (p.x() < a.x_min_m || p.x() > a.x_max_m() || p.y() < a.y_min_m || p.y() > a.y_max_m()) {
+      throw std::runtime_error(std::string(name) + " (" + std::to_string(p.x()) + ", " +
+                               std::to_string(p.y()) + ") is off the map: it spans x " +
+                               std::to_string(a.x_min_m) + " .. " + std::to_string(a.x_max_m()) +
+                               ", y " + std::to_string(a.y_min_m) + " .. " +
+                               std::to_string(a.y_max_m()));
+    }
+  }
+  return f;
+}
 
-  const std::vector<double> s = args.GetNumbers("start", 3);
-  const Eigen::Vector3d start(s[0], s[1], s[2] * kDegToRad);
-  const Frame frame = MissionFrame(args, start, settings.cell_m, settings.map_size_m);
-  mission::MissionConfig& mission = settings.mission;
+HwMissionOutcome RunHwMission(const HwMissionSpec& spec, const std::filesystem::path& out,
+                              const HwMissionObserver& observer) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  if (!spec.devices.base) {
+    throw std::invalid_argument("backend hw: a mission needs a base (hw.base.device)");
+  }
+  const HwMissionFrame frame = FrameHwMission(spec);
+  RunSettings settings = spec.settings;
+  MissionConfig& mission = settings.mission;
   mission.goal_m = frame.goal;
-  mission.mount = config.rig.robot.mount;
+  mission.mount = spec.config.rig.robot.mount;
   mission.map_area = frame.map_area;
 
-  mission::RunFolder folder(args.Has("out") ? args.Get("out") : DefaultOut(config.seed));
-  // Ctrl-C / SIGTERM from here on: the drivers see the flag within one read timeout, the mission
-  // ends, the drivers' destructors stop the base (zero speed, motors off) and the LMS200 output,
-  // and the staging folder is removed uncommitted: no half-written run folder.
-  hw::InstallStopSignalHandlers();
-  const auto interrupted = [&](const std::string& during) {
-    std::fprintf(stderr,
-                 "run (hw): %s %s: base stopped and motors disabled, LMS200 output stopped; "
-                 "no run folder written (%s)\n",
-                 hw::StopReason().c_str(), during.c_str(), folder.final_path().string().c_str());
-    return hw::StopExitCode();
-  };
-  if (!quiet)
-    std::fprintf(stderr, "run: opening %s, %s, %s\n", hw_config.lms200.device.c_str(),
-                 hw_config.pitch_unit.device.c_str(), hw_config.base->device.c_str());
+  HwMissionOutcome run;
+  // A stop request from here on: the drivers see it within one read timeout, the mission ends,
+  // the drivers' destructors stop the base (zero speed, motors off) and the LMS200 output, and
+  // the staging folder is removed uncommitted: no half-written run folder.
+  RunFolder folder(out);
+  run.folder = folder.final_path();
+  if (observer.on_setup) {
+    observer.on_setup("opening " + spec.devices.lms200.device + ", " +
+                      spec.devices.pitch_unit.device + ", " + spec.devices.base->device);
+  }
   HwBackend backend;
   try {
-    backend = StartHwBackend(hw_config);
+    backend = StartHwBackend(spec.devices);
   } catch (const std::runtime_error&) {
-    if (hw::StopRequested()) return interrupted("while opening the devices");
-    throw;
+    if (!hw::StopRequested()) throw;
+    run.interrupted = "while opening the devices";
+    return run;
   }
   backend.probes.interrupted = hw::StopRequested;
   Eigen::Isometry3d T_world_start = Eigen::Isometry3d::Identity();  // base_link on the ground
-  T_world_start.translation() << start.x(), start.y(), 0.0;
-  T_world_start.rotate(Eigen::AngleAxisd(start.z(), Eigen::Vector3d::UnitZ()));
+  T_world_start.translation() << spec.start.x(), spec.start.y(), 0.0;
+  T_world_start.rotate(Eigen::AngleAxisd(spec.start.z(), Eigen::Vector3d::UnitZ()));
 
-  mission::MissionObserver observer;
-  observer.on_stop = [&](const mission::StopRecord& stop, const mission::MissionResult& so_far) {
-    mission::WriteStopOutputs(folder, stop, so_far, frame.origin,
-                     frame.world_file.empty()
-                         ? std::string()
-                         : std::filesystem::path(frame.world_file).stem().string());
+  MissionObserver mission_observer;
+  const std::string world_stem =
+      frame.world_file.empty() ? std::string() : spec.world_file.stem().string();
+  mission_observer.on_stop = [&](const StopRecord& stop, const MissionResult& so_far) {
+    WriteStopOutputs(folder, stop, so_far, frame.origin, world_stem);
   };
-  observer.on_progress = [&](const std::string& text) {
-    if (quiet) return;
-    const double wall =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-    std::fprintf(stderr, "run: %s | wall %.1f s\n", text.c_str(), wall);
-  };
-  const mission::MissionResult result = mission::RunMission(*backend.rig, *backend.rig->base(), T_world_start,
-                                          mission, backend.probes, observer);
+  mission_observer.on_progress = observer.on_progress;
+  run.result = RunMission(*backend.rig, *backend.rig->base(), T_world_start, mission,
+                          backend.probes, mission_observer);
   if (hw::StopRequested()) {
     backend.rig.reset();  // the destructors put the devices in a safe state now
-    return interrupted("after " + std::to_string(result.stops.size()) + " stops");
+    run.interrupted = "after " + std::to_string(run.result.stops.size()) + " stops";
+    return run;
   }
 
-  mission::RunContext context;
+  RunContext& context = run.context;
   context.world = frame.world;
   context.world_file = frame.world_file;
-  context.robot = config.rig.robot.model == sim::P3Model::kP3AT ? "p3at" : "p3dx";
-  context.seed = config.seed;
-  context.start = start;
+  context.robot = spec.config.rig.robot.model == sim::P3Model::kP3AT ? "p3at" : "p3dx";
+  context.seed = spec.config.seed;
+  context.start = spec.start;
   context.goal = frame.goal;
   context.geodetic_origin = frame.origin;
-  context.config_yaml =
-      mission::AppConfigToYaml(config) + mission::RunSettingsToYaml(settings) + HwRigConfigToYaml(hw_config);
-  context.planner = mission::MissionPlanner(mission);
+  context.config_yaml = AppConfigToYaml(spec.config) + RunSettingsToYaml(settings) +
+                        HwRigConfigToYaml(spec.devices);
+  context.planner = MissionPlanner(mission);
   context.layers = mission.layers;
   context.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  mission::WriteFinalOutputs(folder, context, result, std::nullopt, nullptr, std::nullopt);
+  WriteFinalOutputs(folder, context, run.result, std::nullopt, nullptr, std::nullopt);
   backend.rig.reset();
-  if (hw::StopRequested()) return interrupted("while writing the run folder");
+  if (hw::StopRequested()) {
+    run.interrupted = "while writing the run folder";
+    return run;
+  }
   folder.Commit();
-
-  const nlohmann::json metrics = mission::RunMetrics(context, result, std::nullopt);
-  if (args.Flagged("json")) std::cout << metrics.dump(2) << "\n";
-  std::fprintf(stderr, "run (hw): %s: %s after %zu stops, %.1f s; run folder: %s\n",
-               result.success ? "success" : "FAILED", result.reason.c_str(), result.stops.size(),
-               context.wall_time_s, folder.final_path().string().c_str());
-  return result.success ? 0 : 1;
+  run.metrics = RunMetrics(context, run.result, std::nullopt);
+  return run;
 }
-
-}  // namespace pitchlab::apps
+}  // namespace pitchlab::mission
