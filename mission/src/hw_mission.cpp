@@ -94,6 +94,24 @@ void RequireDevice(const std::string& device, const std::string& source, const s
   }
 }
 
+// What the run folder says about a hardware run besides the mission's result.
+RunContext HwContext(const HwMissionSpec& spec, const HwMissionFrame& frame,
+                     const RunSettings& settings) {
+  RunContext context;
+  context.world = frame.world;
+  context.world_file = frame.world_file;
+  context.robot = spec.config.rig.robot.model == sim::P3Model::kP3AT ? "p3at" : "p3dx";
+  context.seed = spec.config.seed;
+  context.start = spec.start;
+  context.goal = frame.goal;
+  context.geodetic_origin = frame.origin;
+  context.config_yaml = AppConfigToYaml(spec.config) + RunSettingsToYaml(settings) +
+                        HwRigConfigToYaml(spec.devices);
+  context.planner = MissionPlanner(settings.mission);
+  context.layers = settings.mission.layers;
+  return context;
+}
+
 }  // namespace
 
 Backend ParseBackend(const std::string& yaml_text, const std::string& source) {
@@ -301,28 +319,17 @@ HwMissionOutcome RunHwMission(const HwMissionSpec& spec, const std::filesystem::
     return run;
   }
 
-  RunContext& context = run.context;
-  context.world = frame.world;
-  context.world_file = frame.world_file;
-  context.robot = spec.config.rig.robot.model == sim::P3Model::kP3AT ? "p3at" : "p3dx";
-  context.seed = spec.config.seed;
-  context.start = spec.start;
-  context.goal = frame.goal;
-  context.geodetic_origin = frame.origin;
-  context.config_yaml = AppConfigToYaml(spec.config) + RunSettingsToYaml(settings) +
-                        HwRigConfigToYaml(spec.devices);
-  context.planner = MissionPlanner(mission);
-  context.layers = mission.layers;
-  context.wall_time_s =
+  run.context = HwContext(spec, frame, settings);
+  run.context.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  WriteFinalOutputs(folder, context, run.result, std::nullopt, nullptr, std::nullopt);
+  WriteFinalOutputs(folder, run.context, run.result, std::nullopt, nullptr, std::nullopt);
   backend.rig.reset();
   if (hw::StopRequested()) {
     run.interrupted = "while writing the run folder";
     return run;
   }
   folder.Commit();
-  run.metrics = RunMetrics(context, run.result, std::nullopt);
+  run.metrics = RunMetrics(run.context, run.result, std::nullopt);
   return run;
 }
 }  // namespace pitchlab::mission

@@ -20,8 +20,8 @@
 namespace pitchlab::mission {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
-constexpr double kDegToRad = 1.0 / kRadToDeg;
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegToRad = kPi / 180.0;
 // The map covers the world's bounds and this much around them: a robot at the edge of the bounds
 // still has its own footprint and the ground beside it on the map [m].
 constexpr double kMapMargin_m = 1.0;
@@ -108,17 +108,30 @@ MissionProbes SimProbes(sim::Simulation& sim, std::uint64_t seed) {
   return probes;
 }
 
-// The configuration as used, plus the mount error the simulator drew from the seed
+// What the run folder says about a simulated run besides the mission's result; its config.yaml
+// is the configuration as used plus the mount error the simulator drew from the seed
 // (lms200.mount_error_sigma_deg): truth the pipeline never saw, so a comment, not a setting.
-std::string ConfigYaml(const SimMissionSpec& spec, const RunSettings& settings,
-                       const sim::SimRig& rig) {
-  const Eigen::Vector3d mount_error_deg = rig.mount_error_rpy_rad() * kRadToDeg;
+RunContext SimContext(const SimMissionSpec& spec, const RunSettings& settings,
+                      const Eigen::Vector3d& start,
+                      const std::optional<mapping::GeodeticOrigin>& origin, const sim::SimRig& rig) {
+  RunContext context;
+  context.world = spec.world_name.empty() ? spec.world_file.stem().string() : spec.world_name;
+  context.world_file = spec.world_file.string();
+  context.robot = spec.config.rig.robot.model == sim::P3Model::kP3AT ? "p3at" : "p3dx";
+  context.seed = spec.config.seed;
+  context.start = start;
+  context.goal = settings.mission.goal_m;
+  context.geodetic_origin = origin;
+  const Eigen::Vector3d mount_error_deg = rig.mount_error_rpy_rad() * 180.0 / kPi;
   std::ostringstream truth;
   truth.precision(6);
   truth << "# sim truth: scanner mount error drawn for this run, roll/pitch/yaw [deg]: ["
         << mount_error_deg.x() << ", " << mount_error_deg.y() << ", " << mount_error_deg.z()
         << "]\n";
-  return AppConfigToYaml(spec.config) + RunSettingsToYaml(settings) + truth.str();
+  context.config_yaml = AppConfigToYaml(spec.config) + RunSettingsToYaml(settings) + truth.str();
+  context.planner = MissionPlanner(settings.mission);
+  context.layers = settings.mission.layers;
+  return context;
 }
 
 }  // namespace
@@ -208,22 +221,12 @@ SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesyste
   run.score =
       ScoreRun(run.result, truth.grid, final_grid, start.head<2>(), goal, mission.algorithm);
 
-  RunContext& context = run.context;
-  context.world = spec.world_name.empty() ? world_stem : spec.world_name;
-  context.world_file = spec.world_file.string();
-  context.robot = spec.config.rig.robot.model == sim::P3Model::kP3AT ? "p3at" : "p3dx";
-  context.seed = spec.config.seed;
-  context.start = start;
-  context.goal = goal;
-  context.geodetic_origin = origin;
-  context.config_yaml = ConfigYaml(spec, settings, rig);
-  context.planner = MissionPlanner(mission);
-  context.layers = mission.layers;
-  context.wall_time_s =
+  run.context = SimContext(spec, settings, start, origin, rig);
+  run.context.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  WriteFinalOutputs(folder, context, run.result, run.score, &truth.layers, truth.optimum);
+  WriteFinalOutputs(folder, run.context, run.result, run.score, &truth.layers, truth.optimum);
   folder.Commit();
-  run.metrics = RunMetrics(context, run.result, run.score);
+  run.metrics = RunMetrics(run.context, run.result, run.score);
   run.folder = folder.final_path();
   return run;
 }

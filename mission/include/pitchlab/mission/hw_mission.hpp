@@ -32,6 +32,7 @@
 
 namespace pitchlab::mission {
 
+/// Where a run's scans and motion come from: the simulator or the real devices.
 enum class Backend { kSim, kHw };
 
 /// The config's `backend` ("sim" or "hw"; absent: sim). Throws std::invalid_argument naming
