@@ -51,8 +51,8 @@ CliArgs HwRunArgs() {
 // The run's spec from the arguments and the config file: sensor sections, run settings, devices.
 mission::HwMissionSpec HwSpec(const CliArgs& args) {
   mission::HwMissionSpec spec;
-  spec.config = mission::LoadAppConfig(args.Has("config") ? std::optional(args.Get("config"))
-                                                          : std::nullopt);
+  spec.config =
+      mission::LoadAppConfig(args.Has("config") ? std::optional(args.Get("config")) : std::nullopt);
   if (args.Has("seed")) {
     const std::vector<double> seed = args.GetNumbers("seed", 1);
     if (seed[0] < 0 || seed[0] != std::floor(seed[0]))

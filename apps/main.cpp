@@ -78,8 +78,8 @@ int main(int argc, char** argv) {
       return 1;
     } catch (const std::exception& e) {
       pitchlab::mission::WaitIfInterrupted();
-      std::cerr << "pitchlab " << c.name << ": error: " << pitchlab::mission::WithFinalPaths(e.what())
-                << "\n";
+      std::cerr << "pitchlab " << c.name
+                << ": error: " << pitchlab::mission::WithFinalPaths(e.what()) << "\n";
       return 1;
     }
   }

@@ -108,7 +108,8 @@ nlohmann::json ResultJson(const mapping::RegistrationResult& r) {
                           {"icp_min_distance_m", c.icp_min_distance_m},
                           {"constraint_translation_m", c.constraint_translation_m}}},
                         {"timings_s", mission::StageTimingsJson(r.timings)}};
-  out.update(mission::ObservabilityJson(r));  // outcome, covariance, noise, length scale: as run stops say
+  // Outcome, covariance, noise, length scale: as run stops say.
+  out.update(mission::ObservabilityJson(r));
   return out;
 }
 

@@ -39,7 +39,8 @@ std::vector<std::string> RunCleanups(int signal) {
   std::vector<Cleanup> cleanups;
   {
     std::lock_guard<std::mutex> lock(g_mutex);
-    for (auto it = g_cleanups.rbegin(); it != g_cleanups.rend(); ++it) cleanups.push_back(it->second);
+    for (auto it = g_cleanups.rbegin(); it != g_cleanups.rend(); ++it)
+      cleanups.push_back(it->second);
   }
   std::vector<std::string> removed;
   for (const Cleanup& c : cleanups) {

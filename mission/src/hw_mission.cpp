@@ -105,8 +105,8 @@ RunContext HwContext(const HwMissionSpec& spec, const HwMissionFrame& frame,
   context.start = spec.start;
   context.goal = frame.goal;
   context.geodetic_origin = frame.origin;
-  context.config_yaml = AppConfigToYaml(spec.config) + RunSettingsToYaml(settings) +
-                        HwRigConfigToYaml(spec.devices);
+  context.config_yaml =
+      AppConfigToYaml(spec.config) + RunSettingsToYaml(settings) + HwRigConfigToYaml(spec.devices);
   context.planner = MissionPlanner(settings.mission);
   context.layers = settings.mission.layers;
   return context;

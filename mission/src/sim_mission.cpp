@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <memory>
 #include <cmath>
+#include <memory>
 #include <random>
 #include <sstream>
 #include <stdexcept>
@@ -34,8 +34,8 @@ constexpr std::uint64_t kAttitudeSeedSalt = 0x6174746974756465;  // "attitude": 
 // The run's start (given or the world's) and goal (given or the world's), checked on its map.
 void ResolveEnds(const SimMissionSpec& spec, const worlds::WorldMetadata& meta,
                  Eigen::Vector3d& start, Eigen::Vector2d& goal) {
-  start = spec.start.value_or(Eigen::Vector3d(meta.default_start.x_m, meta.default_start.y_m,
-                                              meta.default_start.yaw_rad));
+  start = spec.start.value_or(
+      Eigen::Vector3d(meta.default_start.x_m, meta.default_start.y_m, meta.default_start.yaw_rad));
   if (spec.goal_m) {
     goal = *spec.goal_m;
   } else if (meta.default_goal) {
@@ -113,7 +113,8 @@ MissionProbes SimProbes(sim::Simulation& sim, std::uint64_t seed) {
 // (lms200.mount_error_sigma_deg): truth the pipeline never saw, so a comment, not a setting.
 RunContext SimContext(const SimMissionSpec& spec, const RunSettings& settings,
                       const Eigen::Vector3d& start,
-                      const std::optional<mapping::GeodeticOrigin>& origin, const sim::SimRig& rig) {
+                      const std::optional<mapping::GeodeticOrigin>& origin,
+                      const sim::SimRig& rig) {
   RunContext context;
   context.world = spec.world_name.empty() ? spec.world_file.stem().string() : spec.world_name;
   context.world_file = spec.world_file.string();
@@ -143,8 +144,8 @@ SimMissionSpec LoadSimMissionSpec(const std::optional<std::string>& config_path,
   spec.config = LoadAppConfig(config_path);
   if (seed) {
     spec.config.seed = *seed;
-    spec.config.sensors.lms200.seed = spec.config.rig.lms200.seed =
-        spec.config.rig.odometry.seed = spec.config.rig.imu.seed = *seed;
+    spec.config.sensors.lms200.seed = spec.config.rig.lms200.seed = spec.config.rig.odometry.seed =
+        spec.config.rig.imu.seed = *seed;
   }
   if (robot) spec.config.rig.robot.model = *robot;
   const std::string text = config_path ? ReadBinaryFile(*config_path) : std::string();
@@ -197,7 +198,8 @@ SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesyste
                                      meta.geodetic_origin->height_m};
   }
   if (observer.on_setup) {
-    observer.on_setup("ground truth of " + (spec.world_name.empty() ? world_stem : spec.world_name) +
+    observer.on_setup("ground truth of " +
+                      (spec.world_name.empty() ? world_stem : spec.world_name) +
                       ": true surface on " + std::to_string(mission.map_area.size_x) + " x " +
                       std::to_string(mission.map_area.size_y) + " cells");
   }

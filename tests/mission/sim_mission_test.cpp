@@ -23,9 +23,9 @@ constexpr const char* kFloorWorld = R"(<mujoco model="floor">
 </mujoco>)";
 
 fs::path Scratch() {
-  const fs::path dir = fs::temp_directory_path() /
-                       ("pitchlab_simmission_" + std::to_string(::getpid()) + "_" +
-                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  const fs::path dir =
+      fs::temp_directory_path() / ("pitchlab_simmission_" + std::to_string(::getpid()) + "_" +
+                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -96,8 +96,7 @@ TEST(RunSimMission, NoGoalGivenAndNoneInTheWorldIsABadSpec) {
 
 TEST(RunSimMission, NoWorldFileIsABadSpec) {
   const fs::path dir = Scratch();
-  EXPECT_THROW(RunSimMission(LoadSimMissionSpec(std::nullopt), dir / "run"),
-               std::invalid_argument);
+  EXPECT_THROW(RunSimMission(LoadSimMissionSpec(std::nullopt), dir / "run"), std::invalid_argument);
 }
 
 }  // namespace

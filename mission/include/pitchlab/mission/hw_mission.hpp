@@ -64,7 +64,7 @@ struct HwMissionSpec {
   /// a square of settings.map_size_m (60 m) around the start.
   std::filesystem::path world_file;
   std::string world_name;  ///< how the outputs name the world; empty: the file's stem, "hardware"
-  Eigen::Vector3d start{0, 0, 0};        ///< the robot in the map frame: x [m], y [m], yaw [rad]
+  Eigen::Vector3d start{0, 0, 0};         ///< the robot in the map frame: x [m], y [m], yaw [rad]
   std::optional<Eigen::Vector2d> goal_m;  ///< [m]; empty: the world's default goal
   AppConfig config;                       ///< sensor sections (shape the scan), robot model, seed
   RunSettings settings;                   ///< mission, planner, registration

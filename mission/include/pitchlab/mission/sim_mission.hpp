@@ -31,10 +31,11 @@ namespace pitchlab::mission {
 struct SimMissionSpec {
   std::filesystem::path world_file;  ///< any MJCF world (worlds::ResolveWorld for built-in names)
   std::string world_name;            ///< how the outputs name the world; empty: the file's stem
-  std::optional<Eigen::Vector3d> start;  ///< x [m], y [m], yaw [rad]; empty: the world's default
+  std::optional<Eigen::Vector3d> start;   ///< x [m], y [m], yaw [rad]; empty: the world's default
   std::optional<Eigen::Vector2d> goal_m;  ///< [m]; empty: the world's default goal
   AppConfig config;                       ///< sensors, simulated rig, seed
-  RunSettings settings;  ///< mission, planner, registration; goal, map area, mount are set by the run
+  /// Mission, planner, registration; the run sets the goal, map area and mount.
+  RunSettings settings;
 };
 
 /// The spec `pitchlab run --config` builds, world_file still to set: `config_path`'s sections
@@ -50,7 +51,7 @@ worlds::WorldMetadata LoadWorldMetadata(const std::filesystem::path& world_file)
 
 /// Progress of a simulated run, for a person watching; every callback may be empty.
 struct SimMissionObserver {
-  std::function<void(const std::string& text)> on_setup;  ///< set-up steps (the ground truth)
+  std::function<void(const std::string& text)> on_setup;   ///< set-up steps (the ground truth)
   std::function<void(int done, int total)> on_truth_rows;  ///< rows of the true map computed
   /// The mission's progress (mission.hpp) with the simulated clock then [s].
   std::function<void(const std::string& text, double sim_time_s)> on_progress;
