@@ -1,11 +1,10 @@
 # `cmake --install build --prefix P`: the libraries and their headers (pitchlab_add_library), the
-# pitchlab program (apps/), the built-in worlds and this CMake package, so that a user's project
+# pitchlab program (apps/), the built-in worlds (worlds/) and this CMake package, so that a user's project
 # does find_package(pitchlab) and links pitchlab::mission (examples/).
 include(CMakePackageConfigHelpers)
 
 set(PITCHLAB_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/pitchlab")
 
-install(DIRECTORY "${PITCHLAB_WORLDS_BUILD_DIR}/" DESTINATION "${PITCHLAB_INSTALL_WORLDSDIR}")
 install(EXPORT pitchlabTargets NAMESPACE pitchlab:: DESTINATION "${PITCHLAB_INSTALL_CMAKEDIR}")
 configure_package_config_file(cmake/pitchlabConfig.cmake.in
   "${CMAKE_CURRENT_BINARY_DIR}/pitchlabConfig.cmake"

@@ -25,6 +25,13 @@ foreach(file bin/pitchlab include/pitchlab/mission/sim_mission.hpp
         share/pitchlab/worlds/terrain_hfield.bin lib/cmake/pitchlab/pitchlabConfig.cmake)
   expect("EXISTS;${prefix}/${file}" "the install has no ${file}")
 endforeach()
+# The worlds folder holds worlds and their height fields, nothing of the build.
+file(GLOB installed_worlds RELATIVE "${prefix}/share/pitchlab/worlds"
+     "${prefix}/share/pitchlab/worlds/*")
+foreach(name ${installed_worlds})
+  expect("name;MATCHES;^[a-z0-9_]+(\\.xml|_hfield\\.bin)$"
+         "share/pitchlab/worlds holds ${name}, which is no world file")
+endforeach()
 file(GLOB package_files "${prefix}/lib/cmake/pitchlab/*.cmake")
 foreach(f ${package_files})
   file(READ "${f}" text)
