@@ -51,6 +51,12 @@ run("configure examples/" ${CMAKE_COMMAND} -S "${EXAMPLE_DIR}" -B "${WORK_DIR}/e
     -DCMAKE_BUILD_TYPE=Release "-DCMAKE_PREFIX_PATH=${prefix}")
 run("build examples/" ${CMAKE_COMMAND} --build "${WORK_DIR}/example")
 
+# A goal that is no number is the user's mistake: exit 2 with the usage, before any work.
+execute_process(COMMAND "${WORK_DIR}/example/run_mission" office east 0 "${WORK_DIR}/bad"
+                RESULT_VARIABLE code ERROR_VARIABLE err)
+expect("code;EQUAL;2;AND;err;MATCHES;usage" "a goal of 'east' gave ${code}: ${err}")
+expect("NOT;EXISTS;${WORK_DIR}/bad" "a refused run left ${WORK_DIR}/bad")
+
 # A short office mission: from the default start (-8, 0) 3 m along the open floor to (-5, 0)
 # (4 stops, ~80 s simulated, ~5 s of wall time).
 set(run_dir "${WORK_DIR}/run")
