@@ -30,13 +30,14 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app_config.hpp"
+#include "pitchlab/mission/app_config.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "interrupt.hpp"
+#include "pitchlab/mission/cleanup_registry.hpp"
 #include "pitchlab/worlds/world_catalog.hpp"
-#include "run_config.hpp"
-#include "run_folder.hpp"
+#include "pitchlab/mission/run_config.hpp"
+#include "pitchlab/mission/run_folder.hpp"
 #include "world_paths.hpp"
 
 namespace pitchlab::apps {
@@ -212,8 +213,8 @@ std::string ConfigHash(const std::string& bytes) {
 /// Loads the config the way `pitchlab run` will, so a bad file fails before any run.
 fs::path CheckConfig(const std::string& path) {
   try {
-    const AppConfig config = LoadAppConfig(path);
-    ParseRunSettings(ReadBinaryFile(path), config.source, config.rig.robot.model);
+    const mission::AppConfig config = mission::LoadAppConfig(path);
+    mission::ParseRunSettings(mission::ReadBinaryFile(path), config.source, config.rig.robot.model);
   } catch (const std::exception& e) {
     throw CliError(std::string("--config: ") + e.what());
   }
@@ -230,7 +231,7 @@ SweepSettings ParseSweepSettings(const CliArgs& args) {
   s.timeout_s = args.GetNumbers("timeout-s", 1)[0];
   if (!(s.timeout_s > 0)) throw CliError("--timeout-s must be positive");
   if (args.Has("config")) s.config = CheckConfig(args.Get("config"));
-  s.config_hash = ConfigHash(s.config ? ReadBinaryFile(*s.config) : std::string());
+  s.config_hash = ConfigHash(s.config ? mission::ReadBinaryFile(*s.config) : std::string());
   return s;
 }
 
@@ -519,7 +520,7 @@ void RunSweep(const SweepSettings& s, const std::vector<BenchRun>& pending, Reco
               bool quiet) {
   std::vector<Running> running;
   std::mutex running_mutex;  // the interruption's watcher thread reads `running`
-  const int cleanup = RegisterCleanup(
+  const int cleanup = mission::RegisterCleanup(
       [&](int signal) {
         std::lock_guard<std::mutex> lock(running_mutex);
         return StopRuns(s, running, signal);
@@ -527,7 +528,7 @@ void RunSweep(const SweepSettings& s, const std::vector<BenchRun>& pending, Reco
       "the unfinished runs' folders (their logs stay in " + (s.out / "logs").string() + ")");
   struct Unregister {
     int id;
-    ~Unregister() { UnregisterCleanup(id); }
+    ~Unregister() { mission::UnregisterCleanup(id); }
   } unregister{cleanup};
   std::size_t next = 0, done = 0;
   const auto finish = [&](const json& record) {
@@ -691,7 +692,7 @@ void PrintTable(const json& summary, std::FILE* out) {
 /// Writes `text` to `path` through a temporary sibling and a rename (readers never see half).
 void WriteAtomically(const fs::path& path, const std::string& text) {
   const fs::path tmp = path.string() + ".tmp-" + std::to_string(::getpid());
-  WriteTextFile(tmp, text);
+  mission::WriteTextFile(tmp, text);
   fs::rename(tmp, path);
 }
 

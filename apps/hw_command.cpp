@@ -13,7 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app_config.hpp"
+#include "pitchlab/mission/app_config.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "pitchlab/hw/lms200_driver.hpp"
@@ -63,7 +63,7 @@ const char* StatusName(sensors::ReadingStatus s) {
 // The simulator behind the three emulators. One mutex: physics is stepped by one caller at a time.
 class SimulatedDevices {
  public:
-  SimulatedDevices(const std::string& world_path, const AppConfig& config, int pitch_baud,
+  SimulatedDevices(const std::string& world_path, const mission::AppConfig& config, int pitch_baud,
                    int base_baud)
       : rig_(world_path, config.rig) {
     if (Result<Eigen::Isometry3d> placed = rig_.PlaceAtDefaultStart(); !placed) {
@@ -98,7 +98,7 @@ class SimulatedDevices {
 
  private:
   // The simulated base as the P3's microcontroller sees it.
-  hw::BasePhysics BaseOf(const AppConfig& config) {
+  hw::BasePhysics BaseOf(const mission::AppConfig& config) {
     hw::BasePhysics base;
     base.command = [this](double v, double w) {
       v_mps_ = v;
@@ -184,8 +184,8 @@ int RunEmulate(int argc, char** argv) {
   const bool baud_given = args.Has("baud");
   const int pitch_baud = baud_given ? ParseBaud(args.Get("baud")) : kPitchUnitPowerOnBaud;
   const int base_baud = baud_given ? ParseBaud(args.Get("baud")) : kBasePowerOnBaud;
-  AppConfig config =
-      LoadAppConfig(args.Has("config") ? std::optional(args.Get("config")) : std::nullopt);
+  mission::AppConfig config =
+      mission::LoadAppConfig(args.Has("config") ? std::optional(args.Get("config")) : std::nullopt);
   const auto world_path = worlds::ResolveWorld(args.Get("world"), WorldsDir());
   SimulatedDevices devices(world_path.string(), config, pitch_baud, base_baud);
   const nlohmann::json paths = devices.Paths();

@@ -10,8 +10,8 @@
 
 #include "cli_args.hpp"
 #include "commands.hpp"
-#include "interrupt.hpp"
-#include "run_folder.hpp"
+#include "pitchlab/mission/cleanup_registry.hpp"
+#include "pitchlab/mission/run_folder.hpp"
 
 namespace {
 
@@ -61,10 +61,10 @@ int main(int argc, char** argv) {
     // watcher's exit status (130, 143) is the one that counts, so wait for it.
     try {
       const int code = c.run(argc - 2, argv + 2);
-      pitchlab::apps::WaitIfInterrupted();
+      pitchlab::mission::WaitIfInterrupted();
       return code;
     } catch (const pitchlab::apps::CliError& e) {
-      pitchlab::apps::WaitIfInterrupted();
+      pitchlab::mission::WaitIfInterrupted();
       std::cerr << "pitchlab " << c.name << ": " << e.what() << "\n";
       return 2;
     } catch (const std::bad_alloc&) {
@@ -77,9 +77,9 @@ int main(int argc, char** argv) {
                 << "container can hold (a count in a file header, a cell too small for the area)\n";
       return 1;
     } catch (const std::exception& e) {
-      pitchlab::apps::WaitIfInterrupted();
-      std::cerr << "pitchlab " << c.name << ": error: " << pitchlab::apps::WithFinalPaths(e.what())
-                << "\n";
+      pitchlab::mission::WaitIfInterrupted();
+      std::cerr << "pitchlab " << c.name
+                << ": error: " << pitchlab::mission::WithFinalPaths(e.what()) << "\n";
       return 1;
     }
   }

@@ -11,7 +11,7 @@
 #include "commands.hpp"
 #include "pitchlab/mapping/registration.hpp"
 #include "pitchlab/sensors/cloud_file.hpp"
-#include "registration_json.hpp"
+#include "pitchlab/mission/registration_json.hpp"
 
 namespace pitchlab::apps {
 namespace {
@@ -92,7 +92,7 @@ nlohmann::json ResultJson(const mapping::RegistrationResult& r) {
                         {"degeneracy", r.degeneracy},
                         {"sac_inliers", r.sac_inliers},
                         {"iterations", r.iterations},
-                        {"information", Matrix6Json(r.information)},
+                        {"information", mission::Matrix6Json(r.information)},
                         {"sigma", SigmasJson(r.covariance)},
                         {"statistics",
                          {{"source", StatisticsJson(r.source_statistics)},
@@ -107,8 +107,9 @@ nlohmann::json ResultJson(const mapping::RegistrationResult& r) {
                           {"icp_max_distance_m", c.icp_max_distance_m},
                           {"icp_min_distance_m", c.icp_min_distance_m},
                           {"constraint_translation_m", c.constraint_translation_m}}},
-                        {"timings_s", StageTimingsJson(r.timings)}};
-  out.update(ObservabilityJson(r));  // outcome, covariance, noise, length scale: as run stops say
+                        {"timings_s", mission::StageTimingsJson(r.timings)}};
+  // Outcome, covariance, noise, length scale: as run stops say.
+  out.update(mission::ObservabilityJson(r));
   return out;
 }
 

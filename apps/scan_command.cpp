@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app_config.hpp"
+#include "pitchlab/mission/app_config.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "output_paths.hpp"
@@ -71,8 +71,8 @@ int RunScan(int argc, char** argv) {
   const bool json = args.Flagged("json");
   const bool quiet = args.Flagged("quiet");
 
-  AppConfig config = LoadAppConfig(args.Has("config") ? std::optional(args.Get("config"))
-                                                      : std::nullopt);
+  mission::AppConfig config =
+      mission::LoadAppConfig(args.Has("config") ? std::optional(args.Get("config")) : std::nullopt);
   if (args.Has("robot")) config.rig.robot.model = ParseRobotModel(args.Get("robot"));
   const std::string caster = args.Get("caster");
   if (caster != "embree" && caster != "mujoco") {

@@ -1,6 +1,7 @@
 #include "world_paths.hpp"
 
 #include <cstdlib>
+#include <system_error>
 
 #include "cli_args.hpp"
 #include "pitchlab/worlds/world_catalog.hpp"
@@ -9,6 +10,14 @@ namespace pitchlab::apps {
 
 std::filesystem::path WorldsDir() {
   if (const char* env = std::getenv("PITCHLAB_WORLDS_DIR"); env && *env) return env;
+  // An installed pitchlab: <prefix>/bin/pitchlab finds <prefix>/share/pitchlab/worlds. The build
+  // tree's program has no such folder beside it and uses the build's worlds.
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const std::filesystem::path installed = exe.parent_path() / PITCHLAB_WORLDS_FROM_BIN;
+    if (std::filesystem::is_directory(installed, ec)) return installed.lexically_normal();
+  }
   return PITCHLAB_WORLDS_DIR;
 }
 

@@ -8,7 +8,8 @@
 
 namespace pitchlab::apps {
 
-/// The worlds folder: $PITCHLAB_WORLDS_DIR if set, else the build's generated worlds.
+/// The worlds folder: $PITCHLAB_WORLDS_DIR if set, else the installed worlds beside the program
+/// (<prefix>/share/pitchlab/worlds), else the build's generated worlds.
 std::filesystem::path WorldsDir();
 /// "office, cluttered, ..." for help texts and errors.
 std::string BuiltinWorldNames();

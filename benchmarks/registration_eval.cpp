@@ -59,7 +59,7 @@ constexpr double kMaxTruthDrift_m = 0.005;
 // above every curb, step and slope the P3 drives in the sampled regions, below any roof.
 constexpr double kMaxClimb_m = 2.0;
 // The planner keeps half the robot's width plus this clearance free of obstacles
-// (MissionConfig::safety_margin_m, apps/mission.hpp) [m].
+// (MissionConfig::safety_margin_m, pitchlab/mission/mission.hpp) [m].
 constexpr double kPlannerSafetyMargin_m = 0.08;
 // A point this far above base_link's ground plane is an obstacle: above the range noise of the
 // floor and the support step the placement accepts under the footprint

@@ -1,3 +1,5 @@
+include(GNUInstallDirs)
+
 # pitchlab_add_library(<module> [PUBLIC_DEPS ...] [PRIVATE_DEPS ...])
 # One static library per top-level module: sources are <module>/src/*.cpp, public headers
 # <module>/include/pitchlab/<module>/*.hpp; the target is pitchlab_<module>, alias pitchlab::<module>.
@@ -7,11 +9,17 @@ function(pitchlab_add_library module)
   add_library(pitchlab_${module} STATIC ${sources})
   add_library(pitchlab::${module} ALIAS pitchlab_${module})
   target_include_directories(pitchlab_${module}
-    PUBLIC "${CMAKE_CURRENT_SOURCE_DIR}/include"
+    PUBLIC "$<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>"
+           "$<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>"
     PRIVATE "${CMAKE_CURRENT_SOURCE_DIR}/src")
   target_link_libraries(pitchlab_${module} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
   target_compile_options(pitchlab_${module} PRIVATE -Wall -Wextra -Wpedantic)
-  set_target_properties(pitchlab_${module} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  set_target_properties(pitchlab_${module} PROPERTIES POSITION_INDEPENDENT_CODE ON
+                        EXPORT_NAME ${module})
+  # Installed with its public headers into the package pitchlab::<module> (cmake/Install.cmake).
+  install(TARGETS pitchlab_${module} EXPORT pitchlabTargets
+          ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}")
+  install(DIRECTORY "${CMAKE_CURRENT_SOURCE_DIR}/include/" DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}")
 endfunction()
 
 # pitchlab_add_test(<name> SOURCES ... DEPS ...): one GoogleTest binary, its cases registered in CTest.

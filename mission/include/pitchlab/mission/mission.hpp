@@ -1,0 +1,160 @@
+#pragma once
+// The closed-loop stop-scan-go mission (DESIGN.md pipeline step 6): stop, scan, register against
+// the map (odometry as prior), update the elevation map, plan to the goal, drive a prefix of the
+// path, repeat. Written against the seam interfaces only, so simulation and hardware share it.
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "pitchlab/mission/height_fit.hpp"
+#include "pitchlab/mission/path_follower.hpp"
+#include "pitchlab/mapping/elevation_map.hpp"
+#include "pitchlab/mapping/map_builder.hpp"
+#include "pitchlab/planning/planner.hpp"
+#include "pitchlab/planning/traversability.hpp"
+#include "pitchlab/sensors/mobile_base.hpp"
+#include "pitchlab/sensors/pitching_scanner.hpp"
+
+namespace pitchlab::mission {
+
+struct MissionConfig {
+  Eigen::Vector2d goal_m = Eigen::Vector2d::Zero();  ///< goal in the world frame [m]
+  double goal_tolerance_m = 0.5;                     ///< success within this of the goal [m]
+  double drive_per_stop_m = 4.0;                     ///< path length driven between two scans [m]
+  int max_stops = 40;                                ///< scans at most [1]
+  double time_budget_s = 1800.0;  ///< mission time at most (simulated or real) [s]
+  double max_tilt_deg = 30.0;     ///< beyond this the robot is tipping over [deg]
+  /// Beyond this tilt the robot backs off and marks the ground ahead as too steep, then plans
+  /// again: the loaded P3-AT (laser 0.45 m up, batteries low) pitches over forward at 31 deg
+  /// standing, less while braking downhill [deg].
+  double caution_tilt_deg = 24.0;
+  /// A drive that ends tilted more than this backs off before the robot stops to scan: sweeping
+  /// the laser down shifts its weight forward, and the wheel hold creeps on steep ground [deg].
+  double scan_tilt_deg = 17.0;
+  /// Beyond this tilt the follower slows to slope_speed_mps (same curvature) [deg].
+  double slope_tilt_deg = 10.0;
+  double slope_speed_mps = 0.2;   ///< cruise speed on slopes [m/s]
+  double stuck_timeout_s = 8.0;   ///< no progress while commanded for this long: stuck [s]
+  double control_period_s = 0.1;  ///< path follower rate [s]
+  /// Returns farther than this from the laser stay out of the elevation map the robot plans on
+  /// (the merged cloud and registration keep them). Far ground is seen at a grazing angle on
+  /// sparse lines, and a scan's attitude or registration error of 0.2-0.3 deg shifts it by
+  /// centimetres a cell: overlapping far views of two scans read as steps and slopes that cut
+  /// every way (terrain). The robot rescans every drive_per_stop_m, well inside this [m].
+  double map_range_m = 10.0;
+  /// How far odometry may be off the motion since the last merged scan (plus that scan's own
+  /// registration error), the registration prior's error bound (mapping::GuessUncertainty): it
+  /// narrows the geometric constraint and the search around the guess to itself, and lets
+  /// odometry supply what the scene leaves free. odometry_error_m + odometry_error_per_m x the
+  /// distance driven [m] ... (terrain runs, the worst ground: 0.16 m median, 0.56 m p95 over ~3 m;
+  /// office: 0.12 m at most)
+  double odometry_error_m = 0.3;
+  double odometry_error_per_m = 0.3;  ///< ... [m/m]
+  /// ... and odometry_error_deg + odometry_error_dps x the time elapsed [deg]: the gyro's drift
+  /// (0.017 deg/s p95) and the roll/pitch errors of the attitude sensor and the last registration
+  /// (terrain: 0.6 deg median, 4.5 deg p99 between stops).
+  double odometry_error_deg = 5.0;
+  double odometry_error_dps = 0.03;  ///< ... [deg/s]
+  /// How far a registration may tilt a scan from the attitude sensor's roll and pitch, averaged
+  /// at standstill (mapping::MeasuredTilt); beyond, ICP holds them. Two stops' averages of the
+  /// simulated inclinometer differ by 0.06 deg (1 sigma) and share its bias; free ICP tilted
+  /// office scans 0.5-2.6 deg where it fitted too little of the map. Unused without an attitude
+  /// sensor [deg].
+  double tilt_tolerance_deg = 0.5;
+  /// Clearance kept beyond the robot's half width when planning, for tracking error [m].
+  double safety_margin_m = 0.08;
+  /// The robot stops this far before the first unobserved cell of its plan, turns to face it and
+  /// scans: it never drives blind into ground its laser has not seen [m].
+  double unknown_margin_m = 0.5;
+  PurePursuitConfig follower;
+  planning::PlannerConfig planner;
+  mapping::LayerConfig layers;  ///< how the elevation map's layers are derived for planning
+  planning::Algorithm algorithm = planning::Algorithm::kAStar;
+  mapping::MapConfig registration;  ///< scan-to-map merging
+  mapping::GridGeometry map_area;   ///< the elevation map's grid, world frame
+  sensors::MountConfig mount;       ///< for the laser origin of clearance rays
+};
+
+/// What the loop reads besides the seam interfaces. `now_s` is required; the others may be empty.
+struct MissionProbes {
+  std::function<double()> now_s;  ///< the run's clock (simulated or steady) [s]
+  /// Attitude sensor (an inclinometer, or an IMU's gravity vector): roll and pitch of base_link
+  /// (x, y of the ZYX Euler angles) [rad]. It sets the attitude of the odometry pose, which is the
+  /// registration prior and the pose a scan goes in at when registration fails; the robot slows on
+  /// slopes, backs off from a tilt and knows it is tipping over by it. May be empty.
+  std::function<Eigen::Vector2d()> roll_pitch_rad;
+  /// Ground truth (simulation only): scoring, never steering.
+  std::function<Eigen::Isometry3d()> true_pose;
+  /// True once the run should stop now (Ctrl-C on hardware); polled wherever the budget is.
+  std::function<bool()> interrupted;
+};
+
+/// The planner as the mission runs it: the robot's width grown by the safety margin each side.
+planning::PlannerConfig MissionPlanner(const MissionConfig& config);
+
+/// One stop of the mission, as it happened.
+struct StopRecord {
+  int index = 0;
+  double stamp_s = 0;        ///< when the scan started [s]
+  sensors::Scan3D scan;      ///< points in base_link
+  mapping::MergeStep merge;  ///< registration against the map
+  Eigen::Isometry3d T_world_base_odom = Eigen::Isometry3d::Identity();  ///< odometry's pose
+  Eigen::Isometry3d T_world_base = Eigen::Isometry3d::Identity();       ///< the estimate used
+  std::optional<Eigen::Isometry3d> T_world_base_true;                   ///< simulation only
+  std::optional<planning::Path> plan;  ///< to the goal, world frame
+  std::string plan_error;              ///< why there was no plan
+  std::string plan_note;               ///< how the plan was found, when not the plain way
+  /// Recovery: planned through cells taken for hazards (inferred drops, hazards around a goal
+  /// seen from afar) as unknown, to look from closer (plan_note says which).
+  bool look_closer = false;
+  double plan_to_doubt_m = 0;  ///< with look_closer: plan length before the first such cell [m]
+  double plan_known_m = 0;     ///< length of the plan over observed cells [m]
+  int felt_hazards = 0;        ///< places marked too steep by the tilt so far
+  bool elevation_from_odometry = false;  ///< registration failed: the scan entered the elevation
+                                         ///< map at the odometry pose
+  /// With elevation_from_odometry: the height that pose took from the map's ground
+  /// (FitHeightOffset), when the scan overlapped enough of it.
+  std::optional<HeightOffset> height_fit;
+  /// With elevation_from_odometry: the map's unknown cells the scan filled; it leaves the cells
+  /// the map has already seen as they are [1].
+  std::size_t elevation_cells_filled = 0;
+  double distance_to_goal_m = 0;  ///< from the estimate [m]
+};
+
+/// A pose of the robot while driving (sampled every control period).
+struct TrajectorySample {
+  double stamp_s = 0;
+  Eigen::Isometry3d T_world_base_est = Eigen::Isometry3d::Identity();
+  std::optional<Eigen::Isometry3d> T_world_base_true;
+};
+
+struct MissionResult {
+  bool success = false;
+  std::string reason;  ///< "goal reached" or why it stopped
+  std::vector<StopRecord> stops;
+  std::vector<TrajectorySample> trajectory;
+  mapping::ElevationMap elevation;      ///< estimated, world frame
+  mapping::PointCloud map_cloud_world;  ///< merged scans, world frame
+  double start_s = 0, end_s = 0;        ///< clock at start and end [s]
+  double odometry_distance_m = 0;       ///< driven, by odometry [m]
+  double max_tilt_rad = 0;              ///< largest tilt seen by the attitude probe [rad]
+};
+
+/// Called after each stop is planned (for output as it happens) and with progress text.
+struct MissionObserver {
+  std::function<void(const StopRecord&, const MissionResult&)> on_stop;
+  std::function<void(const std::string&)> on_progress;
+};
+
+/// Runs the mission from the robot's current pose `T_world_start` (known at start: the map frame
+/// is the first scan's base_link placed there). Device errors end the mission with a reason; bad
+/// configuration throws std::invalid_argument.
+MissionResult RunMission(sensors::ScanSource& source, sensors::MobileBase& base,
+                         const Eigen::Isometry3d& T_world_start, const MissionConfig& config,
+                         const MissionProbes& probes, const MissionObserver& observer = {});
+
+}  // namespace pitchlab::mission

@@ -1,0 +1,40 @@
+#pragma once
+// How a registration's stage timings appear in the JSON the apps write (register --json, each
+// run stop's registration.json), in one place so the two read alike.
+
+#include <nlohmann/json.hpp>
+
+#include "pitchlab/mapping/registration.hpp"
+
+namespace pitchlab::mission {
+
+/// Rows of a 6x6 matrix (information, covariance: roll pitch yaw [rad], x y z [m]).
+inline nlohmann::json Matrix6Json(const mapping::Matrix6d& m) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int r = 0; r < 6; ++r) {
+    nlohmann::json row = nlohmann::json::array();
+    for (int c = 0; c < 6; ++c) row.push_back(m(r, c));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+/// What a registration concluded and how sure it is: outcome, covariance, the clouds' noise and
+/// the length scale they resolved to.
+inline nlohmann::json ObservabilityJson(const mapping::RegistrationResult& r) {
+  return {{"outcome", mapping::ToString(r.outcome)},
+          {"covariance", Matrix6Json(r.covariance)},
+          {"covariance_order", "roll pitch yaw [rad] x y z [m], perturbation in the target frame"},
+          {"noise_m", {{"source", r.source_statistics.noise_m},
+                       {"target", r.target_statistics.noise_m}}},
+          {"length_scale", r.settings.length_scale}};
+}
+
+/// {"voxel", "normals", "features", "initial_alignment", "icp", "total"} in seconds.
+inline nlohmann::json StageTimingsJson(const mapping::StageTimings& t) {
+  return {{"voxel", t.voxel_s},       {"normals", t.normals_s},
+          {"features", t.features_s}, {"initial_alignment", t.initial_alignment_s},
+          {"icp", t.icp_s},           {"total", t.total_s}};
+}
+
+}  // namespace pitchlab::mission

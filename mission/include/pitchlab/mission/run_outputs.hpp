@@ -1,0 +1,52 @@
+#pragma once
+// What a closed-loop run leaves in its folder: per stop the scan, registration and plan; at the
+// end the merged cloud, the elevation map (lossless, ESRI grid, PNG), both trajectories (CSV,
+// GeoJSON), metrics.json and a self-contained report.html.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "pitchlab/mission/mission.hpp"
+#include "pitchlab/mapping/elevation_layers.hpp"
+#include "pitchlab/mission/run_folder.hpp"
+#include "pitchlab/mission/run_scoring.hpp"
+
+namespace pitchlab::mission {
+
+/// Facts about the run that the mission itself does not hold.
+struct RunContext {
+  std::string world, world_file, robot;
+  std::uint64_t seed = 0;
+  Eigen::Vector3d start{0, 0, 0};  ///< x [m], y [m], yaw [rad]
+  Eigen::Vector2d goal{0, 0};      ///< [m]
+  std::optional<mapping::GeodeticOrigin> geodetic_origin;
+  std::string config_yaml;  ///< the configuration as used
+  /// The planner as the mission used it (robot width including the safety margin).
+  planning::PlannerConfig planner;
+  mapping::LayerConfig layers;  ///< how the mission derived the map's layers
+  double wall_time_s = 0;       ///< whole run including set-up [s]
+};
+
+/// Writes stops/NN/{scan.pcd, registration.json, path.csv, path.geojson, map.png, map_small.png}.
+/// `world`: the world's name (its file's stem; empty when unknown), written into scan.pcd so that
+/// `map --world` can tell a scan of another world. Throws std::runtime_error naming the file on a
+/// write failure.
+void WriteStopOutputs(RunFolder& folder, const StopRecord& stop, const MissionResult& so_far,
+                      const std::optional<mapping::GeodeticOrigin>& origin,
+                      const std::string& world);
+
+/// metrics.json's content.
+nlohmann::json RunMetrics(const RunContext& context, const MissionResult& result,
+                          const std::optional<RunScore>& score);
+
+/// Everything written at the end (see the file comment), report.html last. `truth` may be null
+/// (hardware runs), `truth_optimum` is the true optimal path when known; with `truth` also
+/// hazard_errors.png (run_pictures.hpp).
+void WriteFinalOutputs(RunFolder& folder, const RunContext& context, const MissionResult& result,
+                       const std::optional<RunScore>& score, const mapping::ElevationLayers* truth,
+                       const std::optional<planning::Path>& truth_optimum);
+
+}  // namespace pitchlab::mission

@@ -1,0 +1,65 @@
+#pragma once
+// Scores a simulated mission against ground truth: pose errors, the driven path costed on the
+// true map against the true optimum, closest approach to a truly forbidden cell, tilt.
+
+#include <optional>
+#include <string>
+
+#include "pitchlab/mission/mission.hpp"
+#include "pitchlab/planning/planner.hpp"
+#include "pitchlab/planning/traversability.hpp"
+
+namespace pitchlab::mission {
+
+struct RunScore {
+  double final_translation_error_m = 0;             ///< last estimate vs truth [m]
+  double final_rotation_error_deg = 0;              ///< [deg]
+  double max_registration_translation_error_m = 0;  ///< over stops merged by registration [m]
+  double max_registration_rotation_error_deg = 0;   ///< [deg]
+  /// Registration's own error, without the drift it inherits: each merged stop's motion since the
+  /// previous merged stop, estimated vs true. Largest and 95th percentile over the run's steps
+  /// (0 when fewer than one step) [m] / [deg].
+  int registration_steps = 0;
+  double registration_step_max_m = 0, registration_step_p95_m = 0;
+  double registration_step_max_deg = 0, registration_step_p95_deg = 0;
+  double true_distance_m = 0;               ///< driven, by ground truth [m]
+  double final_distance_to_goal_m = 0;      ///< true position to goal [m]
+  double max_true_tilt_deg = 0;             ///< [deg]
+  std::optional<double> true_optimal_cost;  ///< start to goal on the true map (none: no path)
+  std::string true_optimum_note;            ///< why there is none
+  double driven_cost_on_true_map = 0;       ///< the true trajectory's cells, costed by Eq. 5
+  std::optional<double> cost_ratio;         ///< driven / optimal (>= 1 up to discretisation)
+  std::size_t forbidden_cells_crossed = 0;  ///< truly forbidden cells under the true trajectory
+  /// Of those, cells that are a true step, drop or too steep themselves (the rest are within half
+  /// the robot's width of one, or unknown in the truth) [1].
+  std::size_t hazard_cells_crossed = 0;
+  /// Smallest distance from the robot's centre to a truly hazardous cell (step, steep, drop) [m];
+  /// infinity when none is within 5 m of the trajectory.
+  double closest_hazard_m = 0;
+  Eigen::Vector2d closest_hazard_at{0, 0};  ///< where the robot was then [m]
+  /// The final map's hazards (step, drop, too steep) against the true ones, cell by cell over the
+  /// cells both know: a run that ends with no path was most often walled in by false hazards, and
+  /// unlike success these counts change smoothly with the map's quality [1].
+  std::size_t map_cells_compared = 0;
+  std::size_t false_hazard_cells = 0;   ///< hazard in the map, truly free (not even near one)
+  /// Of those, what the map took them for: a step, a drop, too steep [1].
+  std::size_t false_steps = 0, false_drops = 0, false_too_steep = 0;
+  std::size_t missed_hazard_cells = 0;  ///< free in the map, truly a hazard
+};
+
+/// How a map's cell compares with the truth's (both on one grid): kNotCompared where either does
+/// not know the cell (no height and no hazard inferred: a drop may have no points, only rays).
+enum class HazardVerdict { kNotCompared, kAgree, kFalseHazard, kMissedHazard };
+/// kFalseHazard: a step, drop or too steep cell of `estimated` that `truth` calls free (not even
+/// near a hazard); kMissedHazard: a true hazard `estimated` calls free.
+HazardVerdict CompareHazard(const planning::TraversabilityGrid& estimated,
+                            const planning::TraversabilityGrid& truth, std::size_t k);
+
+/// `truth` is the true traversability over the mission's map area, `estimated` the final map's on
+/// the same grid; `start_m`/`goal_m` world [m].
+RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGrid& truth,
+                  const planning::TraversabilityGrid& estimated,
+                  const Eigen::Vector2d& start_m, const Eigen::Vector2d& goal_m,
+                  planning::Algorithm algorithm);
+
+}  // namespace pitchlab::mission

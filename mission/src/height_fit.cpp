@@ -1,0 +1,61 @@
+#include "pitchlab/mission/height_fit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace pitchlab::mission {
+namespace {
+
+constexpr int kMinPointsPerCell = 3;
+constexpr double kMinInlierBand_m = 0.05;
+
+double Median(std::vector<double> v) {
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+}  // namespace
+
+std::optional<HeightOffset> FitHeightOffset(const mapping::ElevationMap& map,
+                                            const std::vector<Eigen::Vector3f>& points,
+                                            int min_cells) {
+  const mapping::GridGeometry& g = map.geometry();
+  std::vector<std::pair<std::size_t, float>> keyed;  // (cell, z), sorted: deterministic sums
+  keyed.reserve(points.size());
+  for (const Eigen::Vector3f& p : points) {
+    if (!p.allFinite()) continue;
+    const mapping::CellIndex c = g.IndexOf(p.x(), p.y());
+    if (g.Contains(c)) keyed.emplace_back(g.Linear(c), p.z());
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<double> diff;  // scan's cell mean minus the map's
+  for (std::size_t b = 0; b < keyed.size();) {
+    std::size_t e = b;
+    double sum = 0;
+    for (; e < keyed.size() && keyed[e].first == keyed[b].first; ++e) sum += keyed[e].second;
+    const mapping::CellStats& m = map.at(keyed[b].first);
+    if (static_cast<int>(e - b) >= kMinPointsPerCell && m.count >= kMinPointsPerCell) {
+      diff.push_back(sum / static_cast<double>(e - b) - m.mean_z);
+    }
+    b = e;
+  }
+  if (static_cast<int>(diff.size()) < min_cells) return std::nullopt;
+  const double median = Median(diff);
+  std::vector<double> spread;
+  for (const double d : diff) spread.push_back(std::abs(d - median));
+  const double band = std::max(3.0 * 1.4826 * Median(spread), kMinInlierBand_m);
+  HeightOffset out;
+  double sum = 0;
+  for (const double d : diff) {
+    if (std::abs(d - median) > band) continue;
+    sum += d;
+    ++out.cells;
+  }
+  if (out.cells < min_cells) return std::nullopt;
+  out.dz_m = sum / out.cells;
+  return out;
+}
+
+}  // namespace pitchlab::mission

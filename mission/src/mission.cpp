@@ -1,0 +1,763 @@
+#include "pitchlab/mission/mission.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <limits>
+#include <stdexcept>
+
+#include "pitchlab/mapping/elevation_layers.hpp"
+#include "pitchlab/mapping/point_cloud.hpp"
+#include "pitchlab/mission/slope_guard.hpp"
+
+namespace pitchlab::mission {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kMinProgress_m = 0.05;   // less than this over stuck_timeout_s is no progress
+constexpr double kFootprintHalf_m = 0.2;  // ground known under the robot: it stands on it
+constexpr double kStopTime_s = 0.5;       // braking before a scan
+constexpr double kEscapeRadius_m = 1.0;   // how far a start inside a hazard margin looks out
+constexpr double kGoalApproach_m = 2.0;   // a blocked goal farther than this: approach it
+constexpr double kFarDoubt_m = 6.0;       // beyond this a hazard may be a sparse view (recovery)
+constexpr double kHeadingTolerance_rad = 3.0 * kPi / 180;  // turning in place ends within this
+constexpr double kTurnGain_per_s = 2.0;                    // yaw rate per radian of heading error
+constexpr double kMinDrive_m = 0.1;  // a drive shorter than this is no progress
+constexpr double kBackOff_m = 0.6;   // reverse this far from a tilt beyond caution
+constexpr double kBackOffSpeed_mps = 0.2;
+constexpr double kBackOffTiltRise_rad = 4.0 * kPi / 180;  // reversing tilts it this much more: stop
+constexpr double kFeltAhead_m = 0.2;           // the tilting ground: under the front axle and on
+constexpr double kMaxCentripetal_mps2 = 0.15;  // v * omega while following a path
+// Beyond the path's own grade, a tilt is something the robot ran onto (a crack's edge, a rock).
+// Rugged ground rocks the loaded P3-AT 12-16 deg over paths graded near 5 deg; at 8 deg those
+// rocks became 1.4 m obstacle discs that sealed the rugged band before the terrain goal (terrain
+// seeds 1..40: 32/40 runs at 8 deg, 36/40 at 12 deg, highest tilt 29.8 vs 27.3 deg).
+constexpr double kUnexpectedTilt_rad = 12.0 * kPi / 180;
+constexpr double kSlopeYawRate_rps = 0.3;  // skid-steer turns on a slope at most this fast
+constexpr double kSlopeLookahead_m = 1.0;  // slow down this far before a slope (braking distance)
+
+double Yaw(const Eigen::Isometry3d& T) { return std::atan2(T.linear()(1, 0), T.linear()(0, 0)); }
+
+// Odometry increment since `ref` applied to the pose estimated at `ref`, in the horizontal plane:
+// x, y and yaw move by the odometry's planar motion; z keeps the estimate's, and so do roll and
+// pitch unless an attitude sensor measured them (wheel odometry says nothing about them, and
+// composing a planar turn onto a tilted frame would leak the tilt into the heading).
+Eigen::Isometry3d Propagate(const Eigen::Isometry3d& T_world_base_at_ref,
+                            const sensors::Odometry& ref, const sensors::Odometry& now,
+                            const std::optional<Eigen::Vector2d>& roll_pitch_rad) {
+  const Eigen::Matrix3d R = T_world_base_at_ref.linear();
+  const double yaw = std::atan2(R(1, 0), R(0, 0));
+  const double pitch =
+      roll_pitch_rad ? roll_pitch_rad->y() : std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+  const double roll = roll_pitch_rad ? roll_pitch_rad->x() : std::atan2(R(2, 1), R(2, 2));
+  const double c = std::cos(ref.yaw_rad), s = std::sin(ref.yaw_rad);
+  const double dx = now.x_m - ref.x_m, dy = now.y_m - ref.y_m;
+  const Eigen::Vector3d step_base(c * dx + s * dy, -s * dx + c * dy, 0);  // in ref's frame
+  const double new_yaw = yaw + std::remainder(now.yaw_rad - ref.yaw_rad, 2.0 * kPi);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = (Eigen::AngleAxisd(new_yaw, Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
+  // The wheels roll along base_link's tilted x-y plane: a drive up a slope climbs. Rotated by the
+  // attitude between the two readings (the wheel odometry's frame is the ref's, turned by yaw).
+  const Eigen::Matrix3d R_mid = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                                 Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                                 Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+                                    .toRotationMatrix();
+  T.translation() = T_world_base_at_ref.translation() + R_mid * step_base;
+  return T;
+}
+
+// The first `length_m` of the path's (x, y) polyline.
+std::vector<Eigen::Vector2d> PathPrefix(const planning::Path& path, double length_m) {
+  std::vector<Eigen::Vector2d> out;
+  double arc = 0;
+  for (const planning::Waypoint& w : path.waypoints) {
+    const Eigen::Vector2d p(w.x_m, w.y_m);
+    if (!out.empty()) {
+      const double seg = (p - out.back()).norm();
+      if (arc + seg > length_m) {
+        out.push_back(out.back() + (p - out.back()) * ((length_m - arc) / seg));
+        break;
+      }
+      arc += seg;
+    }
+    out.push_back(p);
+  }
+  return out;
+}
+
+// Inserts the scan (map frame, rays from `laser`) into the cells of `map` that have no point yet;
+// the others stay as they are, clearance included. Returns the cells it filled.
+std::size_t FillUnknown(mapping::ElevationMap& map, const std::vector<Eigen::Vector3f>& points,
+                        const Eigen::Vector3f& laser) {
+  // A scratch grid over the scan's extent (rays included), aligned to the map's cells.
+  const mapping::GridGeometry& g = map.geometry();
+  Eigen::Vector2f lo = laser.head<2>(), hi = laser.head<2>();
+  for (const Eigen::Vector3f& p : points) {
+    lo = lo.cwiseMin(p.head<2>());
+    hi = hi.cwiseMax(p.head<2>());
+  }
+  const mapping::CellIndex a = g.IndexOf(lo.x(), lo.y()), b = g.IndexOf(hi.x(), hi.y());
+  const int i0 = std::clamp(a.i, 0, g.size_x - 1), j0 = std::clamp(a.j, 0, g.size_y - 1);
+  const int i1 = std::clamp(b.i, 0, g.size_x - 1), j1 = std::clamp(b.j, 0, g.size_y - 1);
+  mapping::GridGeometry local = g;
+  local.x_min_m = g.x_min_m + i0 * g.cell_m;
+  local.y_min_m = g.y_min_m + j0 * g.cell_m;
+  local.size_x = i1 - i0 + 1;
+  local.size_y = j1 - j0 + 1;
+  mapping::ElevationMap view(local);
+  view.InsertScan(points.data(), points.size(), laser);
+  std::size_t filled = 0;
+  for (int j = 0; j < local.size_y; ++j) {
+    for (int i = 0; i < local.size_x; ++i) {
+      filled += view.at({i, j}).known() && !map.at({i + i0, j + j0}).known();
+    }
+  }
+  const auto merged = map.Merge(view, mapping::ElevationMap::MergeCells::kUnknown);
+  if (!merged) throw std::logic_error("mission: " + merged.error().message);  // same alignment
+  return filled;
+}
+
+// The scan-to-map settings with the laser where the mount puts it (its mirror at zero pitch).
+mapping::MapConfig WithSensor(mapping::MapConfig map, const sensors::MountConfig& mount) {
+  map.sensor_base = mount.BaseToLaser(0.0).translation().cast<float>();
+  return map;
+}
+
+class Mission {
+ public:
+  Mission(sensors::ScanSource& source, sensors::MobileBase& base, const MissionConfig& config,
+          const MissionProbes& probes, const MissionObserver& observer)
+      : source_(source),
+        base_(base),
+        config_(config),
+        probes_(probes),
+        observer_(observer),
+        builder_(WithSensor(config.registration, config.mount)) {}
+
+  MissionResult Run(const Eigen::Isometry3d& T_world_start);
+
+ private:
+  bool Stop(int k);  // false: the mission ends (result_.reason says why)
+  // Inserts the scan (within map_range_m) at stop.T_world_base; at an odometry pose (registration
+  // failed) the pose's height is first taken from the map's ground (FitHeightOffset), and the scan
+  // fills only the cells the map has not seen (FillUnknown).
+  void UpdateElevation(StopRecord& stop);
+  void Plan(StopRecord& stop) const;
+  tl::expected<planning::Path, planning::NoPath> PlanOn(const planning::TraversabilityGrid& grid,
+                                                        const Eigen::Vector2d& here) const;
+  bool Drive(const StopRecord& stop);
+  bool Follow(const planning::Path& path, double length_m);
+  // Marks the ground ahead as felt (`obstacle`: the tilt came from something it ran onto), then
+  // backs off. false: the mission ends.
+  bool BackOff(const sensors::Odometry& odo, double tilt_rad, bool obstacle);
+  // Drives back kBackOff_m the way it came (or as far as it goes). false: the mission ends.
+  bool DriveBack(const sensors::Odometry& odo);
+  std::optional<Eigen::Vector2d> Attitude() const {
+    if (!probes_.roll_pitch_rad) return std::nullopt;
+    return probes_.roll_pitch_rad();
+  }
+  // The attitude standing still: the mean of kStillReads reads, whose noise averages out (what
+  // is left is the sensor's bias, the same for every stop: the map is consistently tilted by it,
+  // the scans agree with each other).
+  std::optional<Eigen::Vector2d> StillAttitude() const {
+    constexpr int kStillReads = 25;
+    if (!probes_.roll_pitch_rad) return std::nullopt;
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    for (int i = 0; i < kStillReads; ++i) sum += probes_.roll_pitch_rad();
+    return sum / kStillReads;
+  }
+  // Angle of base_link's z from vertical [rad]; 0 without an attitude sensor.
+  double Tilt() const {
+    const std::optional<Eigen::Vector2d> a = Attitude();
+    return a ? std::acos(std::clamp(std::cos(a->x()) * std::cos(a->y()), -1.0, 1.0)) : 0.0;
+  }
+  bool TurnTo(double yaw_rad);
+  bool Rebase();  // the map frame = base_link where the robot is now (before the first scan)
+  bool RecordSample(const sensors::Odometry& odo);  // false: tipping over (reason set)
+  Eigen::Isometry3d Estimate(const sensors::Odometry& odo) const {
+    return Propagate(T_world_base_, odo_ref_, odo, Attitude());
+  }
+  bool OverBudget();
+  void Progress(const std::string& text) const {
+    if (observer_.on_progress) observer_.on_progress(text);
+  }
+
+  sensors::ScanSource& source_;
+  sensors::MobileBase& base_;
+  const MissionConfig& config_;
+  const MissionProbes& probes_;
+  const MissionObserver& observer_;
+  mapping::MapBuilder builder_;
+  MissionResult result_;
+  Eigen::Isometry3d T_world_map_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_world_base_ = Eigen::Isometry3d::Identity();  // estimate at odo_ref_
+  sensors::Odometry odo_ref_;
+  // Odometry distance [m] and clock [s] at the last merged scan: the prior's error bound grows
+  // from there.
+  double merged_distance_m_ = 0, merged_stamp_s_ = 0;
+  bool last_stop_turned_only_ = false;  // the previous stop only turned to look ahead
+  bool backed_off_ = false;             // the last drive ended backing off from a tilt
+  std::vector<FeltHazard> felt_;
+  // Per map cell, the shortest range a registered scan saw it from [m] (+inf: never so). A
+  // recovery doubts only what was never seen from close: doubt measured from where the robot
+  // stands made it walk back and forth between two routes, each far from the other's end.
+  std::vector<float> nearest_view_m_;
+};
+
+MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
+  result_.start_s = probes_.now_s();
+  result_.elevation = mapping::ElevationMap(config_.map_area);
+  nearest_view_m_.assign(config_.map_area.cell_count(), std::numeric_limits<float>::infinity());
+  T_world_map_ = T_world_base_ = T_world_start;
+  Result<sensors::Odometry> odo = base_.ReadOdometry();
+  if (!odo) {
+    result_.reason = "base: " + odo.error().message;
+  } else {
+    odo_ref_ = *odo;
+    result_.reason = "stop limit reached (" + std::to_string(config_.max_stops) + " stops)";
+    // The laser sees 180 deg ahead: the first scan should look where the robot will go.
+    const Eigen::Vector2d to_goal = config_.goal_m - T_world_start.translation().head<2>();
+    if (TurnTo(std::atan2(to_goal.y(), to_goal.x())) && Rebase()) {
+      for (int k = 0; k < config_.max_stops && Stop(k); ++k) {
+      }
+    }
+  }
+  result_.end_s = probes_.now_s();
+  result_.map_cloud_world = mapping::TransformCloud(builder_.MapCloud(), T_world_map_);
+  return std::move(result_);
+}
+
+bool Mission::OverBudget() {
+  if (probes_.interrupted && probes_.interrupted()) {
+    result_.reason = "interrupted";
+    return true;
+  }
+  if (probes_.now_s() - result_.start_s <= config_.time_budget_s) return false;
+  result_.reason = "time budget of " + std::to_string(config_.time_budget_s) + " s spent";
+  return true;
+}
+
+bool Mission::Stop(int k) {
+  if (OverBudget()) return false;
+  StopRecord stop;
+  stop.index = k;
+  Result<sensors::Scan3D> scan = source_.Acquire();
+  if (!scan && scan.error().code == Error::Code::kTimeout && !OverBudget()) {
+    // The scan waits for a standstill in vain where the base creeps: the wheel hold on a slope,
+    // or a rigid four-wheeler rocking on two diagonal tyres over a bump. Back off the way it came
+    // (marking the ground as too steep only when standing on a slope) and scan once more.
+    Progress("scan at stop " + std::to_string(k) + " timed out waiting for a standstill (" +
+             scan.error().message + "): backing off to scan again");
+    Result<sensors::Odometry> odo = base_.ReadOdometry();
+    const bool steep = Tilt() > config_.slope_tilt_deg * kPi / 180;
+    if (odo && (steep ? BackOff(*odo, Tilt(), false) : DriveBack(*odo))) scan = source_.Acquire();
+  }
+  if (!scan) {
+    result_.reason = "scan at stop " + std::to_string(k) + " failed: " + scan.error().message;
+    return false;
+  }
+  stop.scan = std::move(*scan);
+  stop.stamp_s = stop.scan.stamp_s;
+  if (probes_.true_pose) stop.T_world_base_true = probes_.true_pose();
+  Result<sensors::Odometry> odo = base_.ReadOdometry();
+  if (!odo) {
+    result_.reason = "base: " + odo.error().message;
+    return false;
+  }
+  const std::optional<Eigen::Vector2d> attitude = StillAttitude();
+  stop.T_world_base_odom = Propagate(T_world_base_, odo_ref_, *odo, attitude);
+  // Algorithm 1 against the map, odometry as the prior (none for the scan that starts the map).
+  const std::optional<Eigen::Isometry3d> prior =
+      k == 0 ? std::nullopt
+             : std::optional<Eigen::Isometry3d>(T_world_map_.inverse() * stop.T_world_base_odom);
+  const mapping::GuessUncertainty bound{
+      config_.odometry_error_m +
+          config_.odometry_error_per_m * (result_.odometry_distance_m - merged_distance_m_),
+      config_.odometry_error_deg + config_.odometry_error_dps * (stop.stamp_s - merged_stamp_s_)};
+  // The attitude sensor's roll and pitch at standstill: the prior's tilt is right within
+  // tilt_tolerance_deg, up being the world's z seen from the map frame.
+  std::optional<mapping::MeasuredTilt> tilt;
+  if (attitude) {
+    tilt = mapping::MeasuredTilt{T_world_map_.linear().transpose() * Eigen::Vector3d::UnitZ(),
+                                 config_.tilt_tolerance_deg};
+  }
+  Result<mapping::MergeStep> merge =
+      builder_.Add(mapping::CloudFromScan(stop.scan), prior, bound, tilt);
+  if (merge) stop.merge = *merge;
+  if (stop.merge.merged) {
+    merged_distance_m_ = result_.odometry_distance_m;
+    merged_stamp_s_ = stop.stamp_s;
+  }
+  if (!merge) stop.merge.registration.reason = merge.error().message;
+  // A failed registration is never merged: the pose comes from odometry and the map keeps
+  // what it had.
+  stop.T_world_base =
+      stop.merge.merged ? T_world_map_ * stop.merge.T_map_base : stop.T_world_base_odom;
+  // A scan whose registration failed is never merged into the map cloud; the elevation map
+  // still takes it at the odometry pose (said in the stop record), or an unregistrable stretch
+  // of terrain would stay unknown and the robot could never plan across it. That pose's height
+  // comes from the map's ground where the scan overlaps it.
+  stop.elevation_from_odometry = !stop.merge.merged;
+  UpdateElevation(stop);
+  T_world_base_ = stop.T_world_base;
+  odo_ref_ = *odo;
+  stop.distance_to_goal_m = (config_.goal_m - stop.T_world_base.translation().head<2>()).norm();
+  const bool arrived = stop.distance_to_goal_m <= config_.goal_tolerance_m;
+  if (!arrived) Plan(stop);
+  result_.stops.push_back(std::move(stop));
+  const StopRecord& s = result_.stops.back();
+  if (observer_.on_stop) observer_.on_stop(s, result_);
+  char line[200];
+  std::snprintf(line, sizeof(line), "stop %d: %.1f m to goal, registration %s, %s", k,
+                s.distance_to_goal_m,
+                s.merge.merged ? mapping::ToString(s.merge.registration.path) : "FAILED",
+                arrived         ? "goal reached"
+                : !s.plan       ? "no path"
+                : s.look_closer ? "path planned through doubtful hazards, to look closer"
+                                : "path planned");
+  Progress(line);
+  if (arrived) {
+    result_.success = true;
+    result_.reason = "goal reached";
+    return false;
+  }
+  if (!s.plan) {
+    result_.reason = "no path at stop " + std::to_string(k) + ": " + s.plan_error;
+    return false;
+  }
+  return Drive(s);
+}
+
+void Mission::UpdateElevation(StopRecord& stop) {
+  const Eigen::Isometry3f T = stop.T_world_base.cast<float>();
+  std::vector<Eigen::Vector3f> near;  // map frame, within map_range_m of the laser
+  near.reserve(stop.scan.points.size());
+  const mapping::GridGeometry& g = config_.map_area;
+  for (const sensors::ScanPoint& p : stop.scan.points) {
+    if (p.range_m > config_.map_range_m) continue;
+    near.push_back(T * Eigen::Vector3f(p.x, p.y, p.z));
+    if (stop.elevation_from_odometry) continue;  // a registered view only
+    const mapping::CellIndex c = g.IndexOf(near.back().x(), near.back().y());
+    if (g.Contains(c)) {
+      float& nearest = nearest_view_m_[g.Linear(c)];
+      nearest = std::min(nearest, p.range_m);
+    }
+  }
+  // At the odometry pose, the height comes from the map's ground where the scan overlaps it.
+  if (stop.elevation_from_odometry) {
+    constexpr double kMaxShift_m = 2.0;  // beyond: the map or the scan gone wrong, not drift
+    const std::optional<HeightOffset> fit = FitHeightOffset(result_.elevation, near);
+    if (fit && std::abs(fit->dz_m) <= kMaxShift_m) {
+      stop.T_world_base.translation().z() -= fit->dz_m;
+      for (Eigen::Vector3f& p : near) p.z() -= static_cast<float>(fit->dz_m);
+      stop.height_fit = fit;
+    }
+  }
+  const Eigen::Vector3f laser =
+      (stop.T_world_base * config_.mount.BaseToLaser(0.0)).translation().cast<float>();
+  if (stop.elevation_from_odometry) {
+    // Odometry slips by up to a metre on rugged ground: the scan only fills the map's unknown
+    // cells. Blended into the ground the map has seen, a shifted view of it makes steps and
+    // drops all over the overlap (the fake hazards that sealed the terrain runs' way).
+    stop.elevation_cells_filled = FillUnknown(result_.elevation, near, laser);
+    return;
+  }
+  result_.elevation.InsertScan(near.data(), near.size(), laser);
+  // The laser cannot see under the robot, but the robot stands on that ground; only a registered
+  // pose knows its height well enough (odometry's z drifts, and a wrong one makes a step around
+  // the robot that traps it).
+  std::vector<Eigen::Vector3f> ground;
+  for (double x = -kFootprintHalf_m; x <= kFootprintHalf_m + 1e-9; x += 0.1) {
+    for (double y = -kFootprintHalf_m; y <= kFootprintHalf_m + 1e-9; y += 0.1) {
+      ground.push_back(T * Eigen::Vector3f(float(x), float(y), 0.0f));
+    }
+  }
+  result_.elevation.InsertPoints(ground.data(), ground.size());
+}
+
+// The robot may stand where the footprint rule forbids a path to go (a hazard seen late, drift):
+// the nearest free cell it can reach in a straight line, crossing no step, slope or drop beyond
+// the footprint it stands on.
+std::optional<Eigen::Vector2d> EscapeCell(const planning::TraversabilityGrid& grid,
+                                          const Eigen::Vector2d& from, double radius_m,
+                                          double footprint_radius_m) {
+  const mapping::GridGeometry& g = grid.geometry;
+  const int reach = static_cast<int>(std::ceil(radius_m / g.cell_m));
+  const mapping::CellIndex c = g.IndexOf(from.x(), from.y());
+  std::optional<Eigen::Vector2d> best;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (int j = c.j - reach; j <= c.j + reach; ++j) {
+    for (int i = c.i - reach; i <= c.i + reach; ++i) {
+      if (!g.Contains({i, j}) || !grid.Free(g.Linear({i, j}))) continue;
+      const Eigen::Vector2d to = g.CenterOf({i, j});
+      const double d = (to - from).norm();
+      if (d >= best_d || d > radius_m) continue;
+      bool clear = true;
+      for (double t = 0; t <= 1.0 && clear; t += 0.5 * g.cell_m / std::max(d, g.cell_m)) {
+        const Eigen::Vector2d p = from + t * (to - from);
+        // What the robot stands on it has already crossed (a slope it backed down, a step it
+        // straddles): only the ground beyond its footprint decides.
+        if (t * d < footprint_radius_m) continue;
+        const planning::Blocked b = grid.blocked[g.Linear(g.IndexOf(p.x(), p.y()))];
+        clear = b == planning::Blocked::kFree || b == planning::Blocked::kNearHazard ||
+                b == planning::Blocked::kUnknown;
+      }
+      if (clear) best = to, best_d = d;
+    }
+  }
+  return best;
+}
+
+// A path from `here` on `grid`: out of a hazard margin first if the robot stands in one, and to
+// the nearest free cell by a blocked goal (within kGoalApproach_m from afar, where the hazard may
+// be a sparse view; within the goal tolerance from close by, which counts as arriving).
+tl::expected<planning::Path, planning::NoPath> Mission::PlanOn(
+    const planning::TraversabilityGrid& grid, const Eigen::Vector2d& here) const {
+  auto path = planning::PlanPath(grid, here, config_.goal_m, config_.algorithm);
+  if (!path && path.error().reason == planning::NoPath::Reason::kStartBlocked) {
+    if (const auto escape =
+            EscapeCell(grid, here, kEscapeRadius_m, config_.planner.robot.width_m / 2)) {
+      path = planning::PlanPath(grid, *escape, config_.goal_m, config_.algorithm);
+      if (path) {  // drive out to the free cell first
+        path->waypoints.insert(path->waypoints.begin(),
+                               planning::Waypoint{here.x(), here.y(), path->waypoints[0].z_m});
+      }
+    }
+  }
+  if (!path && path.error().reason == planning::NoPath::Reason::kGoalBlocked) {
+    const bool far = (config_.goal_m - here).norm() > kGoalApproach_m;
+    const double radius = far ? kGoalApproach_m : config_.goal_tolerance_m;
+    if (const auto near = EscapeCell(grid, config_.goal_m, radius, 0.0)) {
+      auto to_near = planning::PlanPath(grid, here, *near, config_.algorithm);
+      if (to_near) path = std::move(to_near);
+    }
+  }
+  return path;
+}
+
+void Mission::Plan(StopRecord& stop) const {
+  mapping::ElevationLayers layers = mapping::ComputeLayers(result_.elevation, config_.layers);
+  for (const FeltHazard& f : felt_) MarkFelt(layers, f);
+  stop.felt_hazards = static_cast<int>(felt_.size());
+  const planning::PlannerConfig planner = MissionPlanner(config_);
+  planning::TraversabilityGrid grid = planning::BuildTraversability(layers, planner);
+  const Eigen::Vector2d here = stop.T_world_base.translation().head<2>();
+  auto path = PlanOn(grid, here);
+  // Recoveries, when the map cuts every way: plan through the cells it is least sure of, as
+  // unknown. The robot drives only over what it has seen, stops short of them (never onto one)
+  // and looks from closer; what is truly there stays in the map and ends the run honestly.
+  const auto look_closer = [&](const std::function<bool(std::size_t)>& doubtful,
+                               const std::string& what) {
+    mapping::ElevationLayers relaxed_layers = layers;
+    std::vector<bool> doubt(layers.state.size(), false);
+    std::size_t n = 0;
+    for (std::size_t k = 0; k < layers.state.size(); ++k) {
+      if (!doubtful(k)) continue;
+      relaxed_layers.state[k] = mapping::CellState::kUnknown;
+      doubt[k] = true;
+      ++n;
+    }
+    if (n == 0) return;
+    planning::TraversabilityGrid relaxed = planning::BuildTraversability(relaxed_layers, planner);
+    auto through = PlanOn(relaxed, here);
+    if (!through) return;
+    stop.plan_note = "no path: planning through " + what + " as unknown, to look from closer (" +
+                     path.error().message + ")";
+    stop.look_closer = true;
+    stop.plan_to_doubt_m = 0;  // how far the robot may go before the first of those cells
+    for (std::size_t i = 1; i < through->waypoints.size(); ++i) {
+      const planning::Waypoint &v = through->waypoints[i - 1], &w = through->waypoints[i];
+      if (doubt[relaxed.geometry.Linear(relaxed.geometry.IndexOf(w.x_m, w.y_m))]) break;
+      stop.plan_to_doubt_m += std::hypot(w.x_m - v.x_m, w.y_m - v.y_m);
+    }
+    path = std::move(through);
+    grid = std::move(relaxed);
+  };
+  // Drops are inferred from rays passing low; at range a small attitude error makes them where
+  // there are none.
+  if (!path) {
+    look_closer([&](std::size_t k) { return layers.state[k] == mapping::CellState::kDrop; },
+                "the inferred drops");
+  }
+  // A goal seen from afar on sparse points can look steep or stepped.
+  if (!path && path.error().reason == planning::NoPath::Reason::kGoalBlocked &&
+      (config_.goal_m - here).norm() > kGoalApproach_m) {
+    look_closer(
+        [&](std::size_t k) {
+          if (layers.state[k] == mapping::CellState::kDrop) return true;  // as above, too
+          return layers.state[k] != mapping::CellState::kUnknown &&
+                 (layers.geometry.CenterOf(layers.geometry.FromLinear(k)) - config_.goal_m).norm() <
+                     kGoalApproach_m;
+        },
+        "the inferred drops and the hazards seen around the goal");
+  }
+  // Far ground is seen on sparse points at a grazing angle: a few of them make a step or a slope
+  // that closer scans do not confirm (the corridor's far end, distant hill sides).
+  if (!path && (path.error().reason == planning::NoPath::Reason::kDisconnected ||
+                path.error().reason == planning::NoPath::Reason::kGoalBlocked)) {
+    look_closer(
+        [&](std::size_t k) {
+          if (layers.state[k] == mapping::CellState::kDrop) return true;
+          return layers.state[k] != mapping::CellState::kUnknown &&
+                 nearest_view_m_[k] > kFarDoubt_m;
+        },
+        "the inferred drops and everything never seen from closer than " +
+            std::to_string(int(kFarDoubt_m)) + " m");
+  }
+  if (!path) {
+    stop.plan_error = path.error().message;
+    return;
+  }
+  // How far the plan runs over ground the laser has seen (the robot's own cells count).
+  stop.plan_known_m = 0;
+  for (std::size_t i = 1; i < path->waypoints.size(); ++i) {
+    const planning::Waypoint& w = path->waypoints[i];
+    const mapping::CellIndex c = grid.geometry.IndexOf(w.x_m, w.y_m);
+    if (!std::isfinite(grid.z_m[grid.geometry.Linear(c)])) break;
+    const planning::Waypoint& v = path->waypoints[i - 1];
+    stop.plan_known_m += std::hypot(w.x_m - v.x_m, w.y_m - v.y_m);
+  }
+  stop.plan = std::move(*path);
+}
+
+// Heading of the path just after arc length `arc_m` (looking one metre on).
+double PathHeading(const planning::Path& path, double arc_m) {
+  const std::vector<Eigen::Vector2d> upto = PathPrefix(path, arc_m);
+  const std::vector<Eigen::Vector2d> beyond = PathPrefix(path, arc_m + 1.0);
+  const Eigen::Vector2d d = beyond.back() - upto.back();
+  if (d.norm() > 1e-6) return std::atan2(d.y(), d.x());
+  const Eigen::Vector2d e = upto.back() - upto.front();
+  return std::atan2(e.y(), e.x());
+}
+
+bool Mission::Drive(const StopRecord& stop) {
+  const planning::Path& path = *stop.plan;
+  // Drive over what was seen, stopping short of the first unobserved cell; when that is too
+  // close, only turn to face the path so the next scan sees it (once: then drive a little).
+  double length = std::min(config_.drive_per_stop_m, stop.plan_known_m - config_.unknown_margin_m);
+  const bool turn_only = length < config_.unknown_margin_m && !last_stop_turned_only_;
+  // After a turn that showed nothing new, the unknown ground is in the laser's blind zone just
+  // ahead: drive a little onto it, but never up to a cell the map took for a drop.
+  if (!turn_only) {
+    length = std::max(length, std::min(config_.drive_per_stop_m, 1.0));
+    if (stop.look_closer)
+      length = std::min(length, stop.plan_to_doubt_m - config_.unknown_margin_m);
+    if (length < kMinDrive_m) {
+      // Looked from as close as it may go: the hazards stand, so there is no way on.
+      result_.reason = "no path at stop " + std::to_string(stop.index) +
+                       ": the hazards that block the way stay hazards seen from close by";
+      return false;
+    }
+  }
+  last_stop_turned_only_ = turn_only;
+  backed_off_ = false;
+  if (!turn_only && !Follow(path, length)) return false;
+  // After backing off, the next scan looks at the slope from where the robot stands.
+  if (!backed_off_ && !TurnTo(PathHeading(path, turn_only ? 0.0 : length))) return false;
+  // Never scan standing steeply: back off the way it came (once) and mark what it stood on.
+  if (!backed_off_ && Tilt() > config_.scan_tilt_deg * kPi / 180) {
+    Result<sensors::Odometry> odo = base_.ReadOdometry();
+    if (!odo) {
+      result_.reason = "base: " + odo.error().message;
+      return false;
+    }
+    if (!BackOff(*odo, Tilt(), false)) return false;
+  }
+  Result<sensors::Odometry> stopped = base_.Drive(0.0, 0.0, kStopTime_s);
+  if (!stopped) {
+    result_.reason = "base: " + stopped.error().message;
+    return false;
+  }
+  return true;
+}
+
+bool Mission::Rebase() {
+  Result<sensors::Odometry> odo = base_.ReadOdometry();
+  if (!odo) {
+    result_.reason = "base: " + odo.error().message;
+    return false;
+  }
+  T_world_map_ = T_world_base_ = Propagate(T_world_base_, odo_ref_, *odo, StillAttitude());
+  odo_ref_ = *odo;
+  return true;
+}
+
+bool Mission::TurnTo(double yaw_rad) {
+  const double start_s = probes_.now_s();
+  while (true) {
+    if (OverBudget()) return false;
+    Result<sensors::Odometry> odo = base_.ReadOdometry();
+    if (!odo) {
+      result_.reason = "base: " + odo.error().message;
+      return false;
+    }
+    const double error = std::remainder(yaw_rad - Yaw(Estimate(*odo)), 2.0 * kPi);
+    if (std::abs(error) < kHeadingTolerance_rad) return true;
+    if (probes_.now_s() - start_s > config_.stuck_timeout_s) {
+      result_.reason = "stuck: cannot turn to " + std::to_string(yaw_rad * 180 / kPi) + " deg";
+      return false;
+    }
+    const double omega = std::clamp(kTurnGain_per_s * error, -config_.follower.max_yaw_rate_rps,
+                                    config_.follower.max_yaw_rate_rps);
+    Result<sensors::Odometry> next = base_.Drive(0.0, omega, config_.control_period_s);
+    if (!next) {
+      result_.reason = "base: " + next.error().message;
+      return false;
+    }
+    if (!RecordSample(*next)) return false;
+  }
+}
+
+bool Mission::RecordSample(const sensors::Odometry& odo) {
+  TrajectorySample sample{probes_.now_s(), Estimate(odo), std::nullopt};
+  if (probes_.true_pose) sample.T_world_base_true = probes_.true_pose();
+  result_.trajectory.push_back(sample);
+  if (!probes_.roll_pitch_rad) return true;
+  const double tilt = Tilt();
+  result_.max_tilt_rad = std::max(result_.max_tilt_rad, tilt);
+  if (tilt <= config_.max_tilt_deg * kPi / 180) return true;
+  result_.reason = "tipping over: tilt " + std::to_string(tilt * 180 / kPi) + " deg";
+  return false;
+}
+
+bool Mission::Follow(const planning::Path& path, double length_m) {
+  const std::vector<Eigen::Vector2d> prefix = PathPrefix(path, length_m);
+  double prefix_m = 0;
+  for (std::size_t i = 1; i < prefix.size(); ++i) prefix_m += (prefix[i] - prefix[i - 1]).norm();
+  const double slope_grade = std::tan(config_.slope_tilt_deg * kPi / 180);
+  const PathGrade grade(path);
+  PurePursuit follower(prefix, config_.follower);
+  sensors::Odometry odo = odo_ref_;
+  if (Result<sensors::Odometry> now = base_.ReadOdometry(); now) odo = *now;
+  Eigen::Vector2d progress_xy(odo.x_m, odo.y_m);
+  double progress_s = probes_.now_s();
+  while (true) {
+    if (OverBudget()) return false;
+    const Eigen::Isometry3d T_est = Estimate(odo);
+    DriveCommand cmd =
+        follower.Command(T_est.translation().x(), T_est.translation().y(), Yaw(T_est));
+    if (cmd.done) return true;
+    const double tilt = Tilt();
+    if (tilt > config_.caution_tilt_deg * kPi / 180) return BackOff(odo, tilt, false);
+    const double arc = prefix_m - follower.remaining_m();
+    // A tilt the planned ground does not explain is something the robot ran onto.
+    if (tilt > std::atan(grade.Max(arc - 0.5, arc + 0.5)) + kUnexpectedTilt_rad) {
+      return BackOff(odo, tilt, true);
+    }
+    // Speed and turn rate scale together, so the robot stays on the follower's arc. Turning fast
+    // while driving fast makes the skid-steer P3-AT brake its inner wheels hard and a top-heavy
+    // robot pitch over its front wheels: keep the centripetal acceleration v * omega small. On
+    // slopes (ahead on the path, or under the robot) drive slower still.
+    const auto scale = [&cmd](double s) {
+      cmd.v_mps *= s;
+      cmd.omega_rps *= s;
+    };
+    const double centripetal = std::abs(cmd.v_mps * cmd.omega_rps);
+    if (centripetal > kMaxCentripetal_mps2) scale(std::sqrt(kMaxCentripetal_mps2 / centripetal));
+    if (tilt > config_.slope_tilt_deg * kPi / 180 ||
+        grade.Max(arc, arc + kSlopeLookahead_m) > slope_grade) {
+      scale(std::min({1.0, config_.slope_speed_mps / std::max(std::abs(cmd.v_mps), 1e-9),
+                      kSlopeYawRate_rps / std::max(std::abs(cmd.omega_rps), 1e-9)}));
+    }
+    Result<sensors::Odometry> next =
+        base_.Drive(cmd.v_mps, cmd.omega_rps, config_.control_period_s);
+    if (!next) {
+      result_.reason = "base: " + next.error().message;
+      return false;
+    }
+    result_.odometry_distance_m += std::hypot(next->x_m - odo.x_m, next->y_m - odo.y_m);
+    odo = *next;
+    if (!RecordSample(odo)) return false;
+    if ((Eigen::Vector2d(odo.x_m, odo.y_m) - progress_xy).norm() > kMinProgress_m) {
+      progress_xy = Eigen::Vector2d(odo.x_m, odo.y_m);
+      progress_s = probes_.now_s();
+    } else if (probes_.now_s() - progress_s > config_.stuck_timeout_s) {
+      result_.reason = "stuck: no progress for " + std::to_string(config_.stuck_timeout_s) + " s";
+      return false;
+    }
+  }
+}
+
+// Reverses straight out of a tilt beyond caution and remembers the ground ahead as too steep.
+bool Mission::BackOff(const sensors::Odometry& odo, double tilt_rad, bool obstacle) {
+  const Eigen::Isometry3d T = Estimate(odo);
+  const double heading = Yaw(T);
+  FeltHazard felt;
+  felt.centre_m = T.translation().head<2>() +
+                  kFeltAhead_m * Eigen::Vector2d(std::cos(heading), std::sin(heading));
+  felt.heading_rad = heading;
+  felt.tilt_rad = tilt_rad;
+  felt.z_m = T.translation().z();
+  felt.obstacle = obstacle;
+  felt_.push_back(felt);
+  backed_off_ = true;
+  char line[160];
+  std::snprintf(line, sizeof(line), "tilt %.1f deg at (%.2f, %.2f): backing off, %s",
+                tilt_rad * 180 / kPi, T.translation().x(), T.translation().y(),
+                obstacle ? "ran onto something ahead" : "the ground ahead is too steep");
+  Progress(line);
+  return DriveBack(odo);
+}
+
+bool Mission::DriveBack(const sensors::Odometry& odo) {
+  const Eigen::Vector2d from(odo.x_m, odo.y_m);
+  const double start_s = probes_.now_s();
+  // Reversing blind over a rim or into a hollow can tilt it more than what it backs away from:
+  // stop once it tilts kBackOffTiltRise_rad more, or past caution (from below caution).
+  const double start_tilt = Tilt();
+  const double stop_tilt = std::min(start_tilt + kBackOffTiltRise_rad,
+                                    std::max(start_tilt, config_.caution_tilt_deg * kPi / 180));
+  sensors::Odometry now = odo;
+  while ((Eigen::Vector2d(now.x_m, now.y_m) - from).norm() < kBackOff_m) {
+    if (OverBudget()) return false;
+    if (probes_.now_s() - start_s > config_.stuck_timeout_s) break;  // as far as it goes
+    if (Tilt() > stop_tilt) break;
+    Result<sensors::Odometry> next = base_.Drive(-kBackOffSpeed_mps, 0.0, config_.control_period_s);
+    if (!next) {
+      result_.reason = "base: " + next.error().message;
+      return false;
+    }
+    result_.odometry_distance_m += std::hypot(next->x_m - now.x_m, next->y_m - now.y_m);
+    now = *next;
+    if (!RecordSample(now)) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+planning::PlannerConfig MissionPlanner(const MissionConfig& config) {
+  planning::PlannerConfig planner = config.planner;
+  planner.robot.width_m += 2.0 * config.safety_margin_m;  // the follower cuts corners a little
+  return planner;
+}
+
+MissionResult RunMission(sensors::ScanSource& source, sensors::MobileBase& base,
+                         const Eigen::Isometry3d& T_world_start, const MissionConfig& config,
+                         const MissionProbes& probes, const MissionObserver& observer) {
+  if (!probes.now_s) throw std::invalid_argument("mission: a clock (probes.now_s) is required");
+  config.follower.Validate();
+  config.planner.Validate();
+  config.registration.Validate();
+  if (config.map_area.cell_count() == 0) throw std::invalid_argument("mission: empty map area");
+  if (!(config.caution_tilt_deg > 0 && config.caution_tilt_deg < config.max_tilt_deg) ||
+      !(config.slope_tilt_deg > 0 && config.slope_tilt_deg < config.caution_tilt_deg) ||
+      !(config.scan_tilt_deg > 0 && config.scan_tilt_deg < config.caution_tilt_deg) ||
+      !(config.slope_speed_mps > 0)) {
+    throw std::invalid_argument(
+        "mission: need 0 < slope_tilt_deg < caution_tilt_deg < max_tilt_deg, "
+        "0 < scan_tilt_deg < caution_tilt_deg and slope_speed_mps > 0");
+  }
+  if (!(config.drive_per_stop_m > 0) || config.max_stops < 1 || !(config.goal_tolerance_m > 0)) {
+    throw std::invalid_argument(
+        "mission: drive_per_stop_m, max_stops, goal_tolerance_m must be > 0");
+  }
+  Mission mission(source, base, config, probes, observer);
+  return mission.Run(T_world_start);
+}
+
+}  // namespace pitchlab::mission

@@ -1,0 +1,122 @@
+#include "report_summary.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace pitchlab::mission {
+namespace {
+
+// The report prints distances to 0.1 m, the elevation map's usual cell: closer than half of
+// that reads as 0.0 m, i.e. on the hazard cell's edge.
+constexpr double kTouch_m = 0.05;
+
+const nlohmann::json* At(const nlohmann::json& j, const std::string& path) {
+  const nlohmann::json* p = &j;
+  std::size_t from = 0;
+  while (true) {
+    const std::size_t dot = path.find('.', from);
+    const std::string key = path.substr(from, dot - from);
+    if (!p->is_object() || !p->contains(key)) return nullptr;
+    p = &(*p)[key];
+    if (dot == std::string::npos) break;
+    from = dot + 1;
+  }
+  return p->is_null() ? nullptr : p;
+}
+
+std::string Count(std::size_t n, const std::string& one, const std::string& many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
+}  // namespace
+
+std::string Significant(double v, int digits) {
+  if (!std::isfinite(v)) return "-";
+  if (v == 0) return "0";
+  if (v == std::round(v) && std::abs(v) >= std::pow(10.0, digits - 1)) {
+    char buf[32];
+    std::snprintf(buf, sizeof(buf), "%.0f", v);
+    return buf;
+  }
+  const int magnitude = static_cast<int>(std::floor(std::log10(std::abs(v))));
+  const int decimals = std::clamp(digits - 1 - magnitude, 0, 9);
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.*f", decimals, v);
+  return buf;
+}
+
+Outcome ReadOutcome(const nlohmann::json& m) {
+  Outcome o;
+  o.success = m.value("success", false);
+  o.reason = m.value("reason", std::string("(no reason recorded)"));
+  if (const auto* n = At(m, "hazard_cells_crossed"); n && n->get<std::size_t>() > 0) {
+    o.safety.push_back("the true trajectory crossed " +
+                       Count(n->get<std::size_t>(), "true hazard cell", "true hazard cells") +
+                       " (step, drop or too steep)");
+  }
+  const auto* hazard = At(m, "hazard_cells_crossed");
+  if (const auto* n = At(m, "forbidden_cells_crossed");
+      n && n->get<std::size_t>() > (hazard ? hazard->get<std::size_t>() : 0)) {
+    o.safety.push_back("it drove over " +
+                       Count(n->get<std::size_t>(), "forbidden cell", "forbidden cells") +
+                       " (closer to a true hazard than half the robot's width)");
+  }
+  if (const auto* d = At(m, "closest_approach_to_forbidden_m"); d && d->get<double>() < kTouch_m) {
+    o.safety.push_back("its centre came " + Significant(d->get<double>(), 2) +
+                       " m from a true hazard cell");
+  }
+  o.safe = o.safety.empty();
+  o.headline = !o.success ? "Failed" : o.safe ? "Goal reached" : "Goal reached, but unsafe";
+  return o;
+}
+
+std::vector<MetricRow> KeyMetrics(const nlohmann::json& m) {
+  struct Spec {
+    const char* key;
+    const char* label;
+    const char* unit;
+    const char* note;
+  };
+  static const Spec kSpecs[] = {
+      {"final_true_distance_to_goal_m", "distance to the goal at the end", "m", "true position"},
+      {"distance_m", "distance driven", "m", "along the true trajectory"},
+      {"sim_time_s", "mission time", "s", "simulated clock"},
+      {"stops", "stops", "", "scan, register, plan, drive"},
+      {"closest_approach_to_forbidden_m", "closest approach to a true hazard", "m",
+       "robot centre to a step, drop or too-steep cell"},
+      {"hazard_cells_crossed", "true hazard cells crossed", "", "0 is safe"},
+      {"forbidden_cells_crossed", "forbidden cells crossed", "",
+       "within half the robot's width of a hazard; 0 is safe"},
+      {"cost_ratio", "path cost / optimal cost", "", "on the true map; 1 is optimal"},
+      {"final_pose_error.translation_m", "final pose error", "m", "estimate against truth"},
+      {"final_pose_error.rotation_deg", "final heading error", "deg", "estimate against truth"},
+      {"max_registration_error.translation_m", "worst pose error at a stop", "m", ""},
+      {"registration_step_error.p95_m", "registration step error, 95th percentile", "m",
+       "motion between stops against truth"},
+      {"registration_step_error.p95_deg", "registration step error, 95th percentile", "deg", ""},
+      {"registration_failures", "registration failures", "", "stops that fell back to odometry"},
+      {"map_hazards.false_hazard_cells", "false hazard cells in the final map", "",
+       "hazards where the truth is free"},
+      {"map_hazards.missed_hazard_cells", "missed hazard cells in the final map", "",
+       "true hazards the map calls free"},
+      {"max_tilt_deg", "largest tilt", "deg", "roll/pitch of the base"},
+      {"wall_time_s", "wall time", "s", "including set-up"},
+  };
+  std::vector<MetricRow> rows;
+  for (const Spec& s : kSpecs) {
+    const nlohmann::json* v = At(m, s.key);
+    if (!v || !v->is_number()) continue;
+    const std::string value = v->is_number_integer() ? v->dump() : Significant(v->get<double>());
+    std::string note = s.note;
+    // A count of map cells means little without how many were compared.
+    const nlohmann::json* compared = At(m, "map_hazards.cells_compared");
+    if (std::string(s.key).rfind("map_hazards.", 0) == 0 && compared) {
+      note += ", of " + compared->dump() + " cells compared";
+    }
+    rows.push_back({s.label, value, s.unit, note});
+  }
+  return rows;
+}
+
+}  // namespace pitchlab::mission

@@ -1,0 +1,150 @@
+#include "run_pictures.hpp"
+
+#include <stdexcept>
+
+#include "map_figure.hpp"
+#include "pitchlab/planning/path_io.hpp"
+#include "pitchlab/mission/traversability_image.hpp"
+
+namespace pitchlab::mission {
+namespace {
+
+void Write(const mapping::RgbImage& image, const std::filesystem::path& file) {
+  if (Result<void> r = mapping::WritePng(image, file.string()); !r) {
+    throw std::runtime_error(r.error().message);
+  }
+}
+
+// A 3 px line through the map points, on a picture rendered from `g`.
+void DrawPolyline(mapping::RgbImage& image, const mapping::GridGeometry& g,
+                  const std::vector<Eigen::Vector2d>& points_m, std::uint8_t r, std::uint8_t gr,
+                  std::uint8_t b) {
+  for (std::size_t k = 1; k < points_m.size(); ++k) {
+    const Eigen::Vector2d a =
+        mapping::MapToPixel(g, image, points_m[k - 1].x(), points_m[k - 1].y());
+    const Eigen::Vector2d c = mapping::MapToPixel(g, image, points_m[k].x(), points_m[k].y());
+    const int steps = std::max(1, static_cast<int>(std::ceil((c - a).norm())));
+    for (int s = 0; s <= steps; ++s) {
+      const Eigen::Vector2d p = a + (c - a) * (double(s) / steps);
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          image.Set(static_cast<int>(p.x()) + dx, static_cast<int>(p.y()) + dy, r, gr, b);
+    }
+  }
+}
+
+ColourBar HeightBar(const mapping::ElevationLayers& layers) {
+  const auto [lo, hi] = mapping::ElevationRampRange(layers);
+  return {lo, hi, mapping::ElevationRamp};
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector2d> TrajectoryXy(const MissionResult& r, bool truth) {
+  std::vector<Eigen::Vector2d> xy;
+  for (const TrajectorySample& s : r.trajectory) {
+    if (!truth) {
+      xy.push_back(s.T_world_base_est.translation().head<2>());
+    } else if (s.T_world_base_true) {
+      xy.push_back(s.T_world_base_true->translation().head<2>());
+    }
+  }
+  return xy;
+}
+
+void WriteRunPictures(RunFolder& folder, const RunContext& c, const MissionResult& r,
+                      const mapping::ElevationLayers& layers, const mapping::ElevationLayers* truth,
+                      const std::optional<planning::Path>& truth_optimum) {
+  const std::vector<Eigen::Vector2d> est = TrajectoryXy(r, false), tru = TrajectoryXy(r, true);
+  std::vector<Eigen::Vector2d> keep = est;
+  keep.insert(keep.end(), tru.begin(), tru.end());
+  keep.push_back(c.start.head<2>());
+  keep.push_back(c.goal);
+  const MapWindow window = ExploredWindow(layers, keep);
+  const mapping::GridGeometry& g = layers.geometry;
+  mapping::ImageOptions options;
+  options.pixels_per_cell = FigurePixelsPerCell(g, window);
+  const FigureMarks marks{c.start.head<2>(), c.goal, std::nullopt};
+  FigureMarks height_marks = marks;
+  height_marks.colour_bar = HeightBar(layers);
+
+  mapping::RgbImage image = mapping::RenderElevationImage(layers, options);
+  for (const StopRecord& s : r.stops) {
+    if (s.plan) planning::DrawPath(*s.plan, g, image);
+  }
+  DrawPolyline(image, g, est, 255, 140, 0);
+  DrawPolyline(image, g, tru, 30, 80, 255);
+  Write(ComposeMapFigure(image, g, window, height_marks), folder.File("elevation.png"));
+  const planning::TraversabilityGrid estimated = planning::BuildTraversability(layers, c.planner);
+  Write(ComposeMapFigure(RenderTraversability(estimated, options), g, window, marks),
+        folder.File("traversability.png"));
+  if (!truth) return;
+  const mapping::GridGeometry& tg = truth->geometry;
+  mapping::ImageOptions truth_options;
+  truth_options.pixels_per_cell = FigurePixelsPerCell(tg, window);
+  const planning::TraversabilityGrid true_grid = planning::BuildTraversability(*truth, c.planner);
+  Write(ComposeMapFigure(RenderTraversability(true_grid, truth_options), tg, window, marks),
+        folder.File("truth_traversability.png"));
+  mapping::RgbImage truth_image = mapping::RenderElevationImage(*truth, truth_options);
+  if (truth_optimum) planning::DrawPath(*truth_optimum, tg, truth_image);
+  DrawPolyline(truth_image, tg, tru, 30, 80, 255);
+  FigureMarks truth_marks = marks;
+  truth_marks.colour_bar = HeightBar(*truth);
+  Write(ComposeMapFigure(truth_image, tg, window, truth_marks), folder.File("truth_elevation.png"));
+  // The picture of map_hazards: the same grids ScoreRun compares (same layers, same planner).
+  Write(ComposeMapFigure(RenderHazardErrors(estimated, true_grid, options), g, window, marks),
+        folder.File("hazard_errors.png"));
+}
+
+mapping::RgbImage Downscale(const mapping::RgbImage& image, int max_width_px) {
+  const int f = std::max(1, (image.width + max_width_px - 1) / std::max(1, max_width_px));
+  mapping::RgbImage out;
+  out.pixels_per_cell = image.pixels_per_cell;
+  out.width = image.width / f;
+  out.height = image.height / f;
+  out.rgb.assign(static_cast<std::size_t>(out.width) * out.height * 3, 0);
+  for (int y = 0; y < out.height; ++y) {
+    for (int x = 0; x < out.width; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        int sum = 0;
+        for (int dy = 0; dy < f; ++dy)
+          for (int dx = 0; dx < f; ++dx)
+            sum +=
+                image.rgb[((static_cast<std::size_t>(y) * f + dy) * image.width + x * f + dx) * 3 +
+                          c];
+        out.rgb[(static_cast<std::size_t>(y) * out.width + x) * 3 + c] =
+            static_cast<std::uint8_t>((sum + f * f / 2) / (f * f));
+      }
+    }
+  }
+  return out;
+}
+
+void WriteStopPictures(RunFolder& folder, const std::string& dir, const MissionResult& so_far,
+                       const std::optional<planning::Path>& plan) {
+  const mapping::RgbImage picture = StopPicture(so_far, plan);
+  Write(picture, folder.File(dir + "map.png"));
+  Write(Downscale(picture, kThumbnailWidth_px), folder.File(dir + "map_small.png"));
+}
+
+mapping::RgbImage StopPicture(const MissionResult& so_far,
+                              const std::optional<planning::Path>& plan) {
+  const mapping::ElevationLayers layers = mapping::ComputeLayers(so_far.elevation);
+  const mapping::GridGeometry& g = layers.geometry;
+  std::vector<Eigen::Vector2d> keep = TrajectoryXy(so_far, false);
+  FigureMarks marks;
+  if (!keep.empty()) marks.start_m = keep.front();
+  if (plan && !plan->waypoints.empty()) {
+    for (const planning::Waypoint& w : plan->waypoints) keep.emplace_back(w.x_m, w.y_m);
+    marks.goal_m = keep.back();
+  }
+  const MapWindow window = ExploredWindow(layers, keep);
+  mapping::ImageOptions options;
+  options.pixels_per_cell = FigurePixelsPerCell(g, window);
+  mapping::RgbImage image = mapping::RenderElevationImage(layers, options);
+  if (plan) planning::DrawPath(*plan, g, image);
+  marks.colour_bar = HeightBar(layers);
+  return ComposeMapFigure(image, g, window, marks);
+}
+
+}  // namespace pitchlab::mission

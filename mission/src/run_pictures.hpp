@@ -1,0 +1,49 @@
+#pragma once
+// The map pictures of a run folder, each cropped to the explored area with axes in metres, a
+// scale bar and start/goal markers (map_figure.hpp): the same crop for the estimated and the true
+// map, so the two can be compared side by side.
+
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "pitchlab/mission/mission.hpp"
+#include "pitchlab/mapping/elevation_io.hpp"
+#include "pitchlab/mapping/elevation_layers.hpp"
+#include "pitchlab/mission/run_folder.hpp"
+#include "pitchlab/mission/run_outputs.hpp"
+
+namespace pitchlab::mission {
+
+/// The estimated (or, with `truth`, the true) x, y of every trajectory sample [m].
+std::vector<Eigen::Vector2d> TrajectoryXy(const MissionResult& result, bool truth);
+
+/// Writes elevation.png (estimated map, every plan in red, estimated trajectory orange, true
+/// blue, colour bar), traversability.png and, with `truth`: truth_elevation.png (true optimal
+/// path red, true trajectory blue), truth_traversability.png and hazard_errors.png. Throws
+/// std::runtime_error naming the file on a write failure.
+void WriteRunPictures(RunFolder& folder, const RunContext& context, const MissionResult& result,
+                      const mapping::ElevationLayers& layers, const mapping::ElevationLayers* truth,
+                      const std::optional<planning::Path>& truth_optimum);
+
+/// A stop's map.png: the map so far with the stop's plan, cropped to what is known, the start
+/// (the first trajectory sample) and the plan's goal marked.
+mapping::RgbImage StopPicture(const MissionResult& so_far,
+                              const std::optional<planning::Path>& plan);
+
+/// The report's thumbnails are this wide [px]: twice the 240 px they are shown at, sharp on a
+/// high-density screen. Measured on the default terrain run: 66 KB a thumbnail, so the default
+/// run.max_stops (40) puts ~3.5 MB of base64 into a page that must stay under 10 MB.
+inline constexpr int kThumbnailWidth_px = 480;
+
+/// `image` shrunk by a whole factor to at most `max_width_px` wide, each pixel the mean of the
+/// block it replaces.
+mapping::RgbImage Downscale(const mapping::RgbImage& image, int max_width_px);
+
+/// Writes `dir`map.png (StopPicture) and `dir`map_small.png (its thumbnail). Throws
+/// std::runtime_error naming the file on a write failure.
+void WriteStopPictures(RunFolder& folder, const std::string& dir, const MissionResult& so_far,
+                       const std::optional<planning::Path>& plan);
+
+}  // namespace pitchlab::mission

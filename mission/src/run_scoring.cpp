@@ -1,0 +1,173 @@
+#include "pitchlab/mission/run_scoring.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <tuple>
+#include <utility>
+
+namespace pitchlab::mission {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+constexpr double kHazardSearch_m = 5.0;
+
+struct PoseDelta {
+  double translation_m, rotation_deg;
+};
+
+PoseDelta Compare(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth) {
+  const Eigen::Isometry3d d = truth.inverse() * estimate;
+  return {d.translation().norm(), Eigen::AngleAxisd(d.linear()).angle() * kRadToDeg};
+}
+
+double Tilt(const Eigen::Isometry3d& T) {
+  return std::acos(std::clamp(T.linear()(2, 2), -1.0, 1.0));
+}
+
+bool IsHazard(planning::Blocked b) {
+  return b != planning::Blocked::kFree && b != planning::Blocked::kNearHazard &&
+         b != planning::Blocked::kUnknown;
+}
+
+// The true trajectory as an 8-connected chain of cells (gaps between samples filled in).
+planning::Path CellChain(const std::vector<Eigen::Vector2d>& xy, const mapping::GridGeometry& g) {
+  planning::Path path;
+  for (const Eigen::Vector2d& p : xy) {
+    const mapping::CellIndex c = g.IndexOf(p.x(), p.y());
+    if (!g.Contains(c)) continue;
+    while (!path.cells.empty() && !(path.cells.back() == c)) {
+      const mapping::CellIndex b = path.cells.back();
+      const mapping::CellIndex step{b.i + (c.i > b.i) - (c.i < b.i),
+                                    b.j + (c.j > b.j) - (c.j < b.j)};
+      path.cells.push_back(step);
+    }
+    if (path.cells.empty()) path.cells.push_back(c);
+  }
+  return path;
+}
+
+double ClosestHazard(const std::vector<Eigen::Vector2d>& xy, const planning::TraversabilityGrid& t,
+                     Eigen::Vector2d* where) {
+  const mapping::GridGeometry& g = t.geometry;
+  const int reach = static_cast<int>(std::ceil(kHazardSearch_m / g.cell_m));
+  double best = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector2d& p : xy) {
+    const mapping::CellIndex c = g.IndexOf(p.x(), p.y());
+    for (int j = std::max(0, c.j - reach); j <= std::min(g.size_y - 1, c.j + reach); ++j) {
+      for (int i = std::max(0, c.i - reach); i <= std::min(g.size_x - 1, c.i + reach); ++i) {
+        if (!IsHazard(t.blocked[g.Linear({i, j})])) continue;
+        // Distance to the cell's nearest point, not its centre.
+        const Eigen::Vector2d centre = g.CenterOf({i, j});
+        const Eigen::Vector2d d = ((p - centre).cwiseAbs().array() - g.cell_m / 2).cwiseMax(0);
+        if (d.norm() < best) best = d.norm(), *where = p;
+      }
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+HazardVerdict CompareHazard(const planning::TraversabilityGrid& estimated,
+                            const planning::TraversabilityGrid& truth, std::size_t k) {
+  const auto known = [k](const planning::TraversabilityGrid& g) {
+    return g.blocked[k] != planning::Blocked::kUnknown &&
+           (std::isfinite(g.z_m[k]) || IsHazard(g.blocked[k]));
+  };
+  if (!known(truth) || !known(estimated)) return HazardVerdict::kNotCompared;
+  const planning::Blocked t = truth.blocked[k], e = estimated.blocked[k];
+  if (IsHazard(e) && t == planning::Blocked::kFree) return HazardVerdict::kFalseHazard;
+  if (IsHazard(t) && e == planning::Blocked::kFree) return HazardVerdict::kMissedHazard;
+  return HazardVerdict::kAgree;
+}
+
+RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGrid& truth,
+                  const planning::TraversabilityGrid& estimated,
+                  const Eigen::Vector2d& start_m, const Eigen::Vector2d& goal_m,
+                  planning::Algorithm algorithm) {
+  RunScore s;
+  std::vector<Eigen::Vector2d> xy{start_m};
+  Eigen::Isometry3d last_true = Eigen::Isometry3d::Identity();
+  bool have_true = false;
+  std::vector<double> step_m, step_deg;
+  const StopRecord* last_merged = nullptr;
+  for (const StopRecord& stop : result.stops) {
+    if (!stop.T_world_base_true) continue;
+    const PoseDelta e = Compare(stop.T_world_base, *stop.T_world_base_true);
+    if (stop.merge.merged && last_merged) {
+      const PoseDelta step =
+          Compare(last_merged->T_world_base.inverse() * stop.T_world_base,
+                  last_merged->T_world_base_true->inverse() * *stop.T_world_base_true);
+      step_m.push_back(step.translation_m);
+      step_deg.push_back(step.rotation_deg);
+    }
+    if (stop.merge.merged) last_merged = &stop;
+    if (stop.merge.merged) {
+      s.max_registration_translation_error_m =
+          std::max(s.max_registration_translation_error_m, e.translation_m);
+      s.max_registration_rotation_error_deg =
+          std::max(s.max_registration_rotation_error_deg, e.rotation_deg);
+    }
+    s.final_translation_error_m = e.translation_m;
+    s.final_rotation_error_deg = e.rotation_deg;
+    s.max_true_tilt_deg = std::max(s.max_true_tilt_deg, Tilt(*stop.T_world_base_true) * kRadToDeg);
+    last_true = *stop.T_world_base_true;
+    have_true = true;
+  }
+  s.registration_steps = static_cast<int>(step_m.size());
+  if (!step_m.empty()) {
+    const auto p95_max = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      const std::size_t k = static_cast<std::size_t>(std::ceil(0.95 * v.size())) - 1;
+      return std::pair{v[k], v.back()};
+    };
+    std::tie(s.registration_step_p95_m, s.registration_step_max_m) = p95_max(step_m);
+    std::tie(s.registration_step_p95_deg, s.registration_step_max_deg) = p95_max(step_deg);
+  }
+  for (const TrajectorySample& sample : result.trajectory) {
+    if (!sample.T_world_base_true) continue;
+    const Eigen::Vector2d p = sample.T_world_base_true->translation().head<2>();
+    s.true_distance_m += (p - xy.back()).norm();
+    xy.push_back(p);
+    s.max_true_tilt_deg =
+        std::max(s.max_true_tilt_deg, Tilt(*sample.T_world_base_true) * kRadToDeg);
+  }
+  if (have_true) s.final_distance_to_goal_m = (last_true.translation().head<2>() - goal_m).norm();
+  const planning::Path driven = CellChain(xy, truth.geometry);
+  const planning::PathOnMap on_truth = planning::EvaluatePath(truth, driven);
+  s.driven_cost_on_true_map = on_truth.cost;
+  s.forbidden_cells_crossed = on_truth.forbidden_cells;
+  for (std::size_t i = 1; i < driven.cells.size(); ++i) {  // the start excluded, as above
+    const planning::Blocked b = truth.blocked[truth.geometry.Linear(driven.cells[i])];
+    s.hazard_cells_crossed += b == planning::Blocked::kStep || b == planning::Blocked::kDrop ||
+                              b == planning::Blocked::kTooSteep;
+  }
+  auto optimum = planning::PlanPath(truth, start_m, goal_m, algorithm);
+  if (optimum) {
+    s.true_optimal_cost = optimum->cost;
+    if (optimum->cost > 0) s.cost_ratio = on_truth.cost / optimum->cost;
+  } else {
+    s.true_optimum_note = optimum.error().message;
+  }
+  s.closest_hazard_m = ClosestHazard(xy, truth, &s.closest_hazard_at);
+  if (!estimated.geometry.SameAs(truth.geometry)) {
+    throw std::invalid_argument("score: the estimated and the true map are on different grids");
+  }
+  for (std::size_t k = 0; k < truth.blocked.size(); ++k) {
+    const HazardVerdict v = CompareHazard(estimated, truth, k);
+    s.map_cells_compared += v != HazardVerdict::kNotCompared;
+    s.missed_hazard_cells += v == HazardVerdict::kMissedHazard;
+    if (v == HazardVerdict::kFalseHazard) {
+      const planning::Blocked e = estimated.blocked[k];
+      ++s.false_hazard_cells;
+      s.false_steps += e == planning::Blocked::kStep;
+      s.false_drops += e == planning::Blocked::kDrop;
+      s.false_too_steep += e == planning::Blocked::kTooSteep;
+    }
+  }
+  return s;
+}
+
+}  // namespace pitchlab::mission

@@ -1,0 +1,236 @@
+#include "pitchlab/mission/sim_mission.hpp"
+
+#include <mujoco/mujoco.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include "pitchlab/mapping/elevation_layers.hpp"
+#include "pitchlab/mapping/elevation_truth.hpp"
+#include "pitchlab/mission/run_folder.hpp"
+#include "pitchlab/planning/planner.hpp"
+#include "pitchlab/planning/traversability.hpp"
+#include "pitchlab/sim/sim_rig.hpp"
+
+namespace pitchlab::mission {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegToRad = kPi / 180.0;
+// The map covers the world's bounds and this much around them: a robot at the edge of the bounds
+// still has its own footprint and the ground beside it on the map [m].
+constexpr double kMapMargin_m = 1.0;
+// The attitude sensor, a MEMS inclinometer: 0.2 deg of noise per read, and a calibration residual
+// of 0.1 deg per axis, constant over a run (drawn per seed).
+constexpr double kAttitudeSigma_rad = 0.2 * kDegToRad;
+constexpr double kAttitudeBiasSigma_rad = 0.1 * kDegToRad;
+constexpr std::uint64_t kAttitudeSeedSalt = 0x6174746974756465;  // "attitude": its own stream
+
+// The run's start (given or the world's) and goal (given or the world's), checked on its map.
+void ResolveEnds(const SimMissionSpec& spec, const worlds::WorldMetadata& meta,
+                 Eigen::Vector3d& start, Eigen::Vector2d& goal) {
+  start = spec.start.value_or(
+      Eigen::Vector3d(meta.default_start.x_m, meta.default_start.y_m, meta.default_start.yaw_rad));
+  if (spec.goal_m) {
+    goal = *spec.goal_m;
+  } else if (meta.default_goal) {
+    goal = Eigen::Vector2d(meta.default_goal->x_m, meta.default_goal->y_m);
+  } else {
+    throw std::invalid_argument("world '" + spec.world_file.string() +
+                                "' names no default goal: give one");
+  }
+  const worlds::Bounds2d& b = meta.bounds;
+  if (goal.x() < b.x_min_m || goal.x() > b.x_max_m || goal.y() < b.y_min_m ||
+      goal.y() > b.y_max_m) {
+    throw std::runtime_error("goal (" + std::to_string(goal.x()) + ", " + std::to_string(goal.y()) +
+                             ") is off the map: the world spans x " + std::to_string(b.x_min_m) +
+                             " .. " + std::to_string(b.x_max_m) + ", y " +
+                             std::to_string(b.y_min_m) + " .. " + std::to_string(b.y_max_m));
+  }
+}
+
+// What the truth knows on the mission's grid: the true map's traversability and the optimum.
+struct Truth {
+  mapping::ElevationLayers layers;
+  planning::TraversabilityGrid grid;
+  planning::Path optimum;
+};
+
+Truth ComputeTruth(sim::SimRig& rig, const MissionConfig& mission, const Eigen::Vector2d& start,
+                   const SimMissionObserver& observer) {
+  mapping::TruthConfig truth_config;
+  truth_config.progress = observer.on_truth_rows;
+  const mapping::ElevationMap map =
+      mapping::ComputeTrueElevationMap(rig.caster(), mission.map_area, truth_config);
+  Truth truth;
+  truth.layers = mapping::ComputeLayers(map, mission.layers);
+  truth.grid = planning::BuildTraversability(truth.layers, mission.planner);
+  if (observer.on_setup) observer.on_setup("ground truth: the best path on the true map");
+  auto optimum = planning::PlanPath(truth.grid, start, mission.goal_m, mission.algorithm);
+  if (!optimum) {
+    throw std::runtime_error("the goal is unreachable on the true map: " + optimum.error().message);
+  }
+  truth.optimum = std::move(*optimum);
+  return truth;
+}
+
+// The probes of a simulated run: its clock, its ground truth and its attitude sensor, the
+// inclinometer's roll and pitch (truth plus a seeded bias and noise).
+MissionProbes SimProbes(sim::Simulation& sim, std::uint64_t seed) {
+  // One generator and one noise distribution for the whole run (the distribution keeps state
+  // between draws): the same seed gives the same readings.
+  struct Inclinometer {
+    std::mt19937_64 rng;
+    std::normal_distribution<double> noise{0.0, kAttitudeSigma_rad};
+    Eigen::Vector2d bias = Eigen::Vector2d::Zero();
+  };
+  auto sensor = std::make_shared<Inclinometer>();
+  sensor->rng.seed(seed ^ kAttitudeSeedSalt);
+  std::normal_distribution<double> attitude_bias(0.0, kAttitudeBiasSigma_rad);
+  // Both draws in one expression, as every recorded run made them (which one a compiler makes
+  // first is its choice): the same seed keeps giving the same bytes.
+  sensor->bias = Eigen::Vector2d(attitude_bias(sensor->rng), attitude_bias(sensor->rng));
+  MissionProbes probes;
+  probes.now_s = [&sim] { return sim.time_s(); };
+  probes.true_pose = [&sim] { return sim.T_world_base(); };
+  probes.roll_pitch_rad = [&sim, sensor] {
+    const Eigen::Matrix3d R = sim.T_world_base().linear();
+    const double roll = std::atan2(R(2, 1), R(2, 2));
+    const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+    return Eigen::Vector2d(roll + sensor->bias.x() + sensor->noise(sensor->rng),
+                           pitch + sensor->bias.y() + sensor->noise(sensor->rng));
+  };
+  return probes;
+}
+
+// What the run folder says about a simulated run besides the mission's result; its config.yaml
+// is the configuration as used plus the mount error the simulator drew from the seed
+// (lms200.mount_error_sigma_deg): truth the pipeline never saw, so a comment, not a setting.
+RunContext SimContext(const SimMissionSpec& spec, const RunSettings& settings,
+                      const Eigen::Vector3d& start,
+                      const std::optional<mapping::GeodeticOrigin>& origin,
+                      const sim::SimRig& rig) {
+  RunContext context;
+  context.world = spec.world_name.empty() ? spec.world_file.stem().string() : spec.world_name;
+  context.world_file = spec.world_file.string();
+  context.robot = spec.config.rig.robot.model == sim::P3Model::kP3AT ? "p3at" : "p3dx";
+  context.seed = spec.config.seed;
+  context.start = start;
+  context.goal = settings.mission.goal_m;
+  context.geodetic_origin = origin;
+  const Eigen::Vector3d mount_error_deg = rig.mount_error_rpy_rad() * 180.0 / kPi;
+  std::ostringstream truth;
+  truth.precision(6);
+  truth << "# sim truth: scanner mount error drawn for this run, roll/pitch/yaw [deg]: ["
+        << mount_error_deg.x() << ", " << mount_error_deg.y() << ", " << mount_error_deg.z()
+        << "]\n";
+  context.config_yaml = AppConfigToYaml(spec.config) + RunSettingsToYaml(settings) + truth.str();
+  context.planner = MissionPlanner(settings.mission);
+  context.layers = settings.mission.layers;
+  return context;
+}
+
+}  // namespace
+
+SimMissionSpec LoadSimMissionSpec(const std::optional<std::string>& config_path,
+                                  std::optional<std::uint64_t> seed,
+                                  std::optional<sim::P3Model> robot) {
+  SimMissionSpec spec;
+  spec.config = LoadAppConfig(config_path);
+  if (seed) {
+    spec.config.seed = *seed;
+    spec.config.sensors.lms200.seed = spec.config.rig.lms200.seed = spec.config.rig.odometry.seed =
+        spec.config.rig.imu.seed = *seed;
+  }
+  if (robot) spec.config.rig.robot.model = *robot;
+  const std::string text = config_path ? ReadBinaryFile(*config_path) : std::string();
+  spec.settings = ParseRunSettings(text, spec.config.source, spec.config.rig.robot.model);
+  return spec;
+}
+
+worlds::WorldMetadata LoadWorldMetadata(const std::filesystem::path& world_file) {
+  char error[1000] = "";
+  mjModel* model = mj_loadXML(world_file.string().c_str(), nullptr, error, sizeof(error));
+  if (model == nullptr)
+    throw std::runtime_error("cannot load world '" + world_file.string() + "': " + error);
+  try {
+    const worlds::WorldMetadata meta = worlds::ReadWorldMetadata(model);
+    mj_deleteModel(model);
+    return meta;
+  } catch (...) {
+    mj_deleteModel(model);
+    throw;
+  }
+}
+
+SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesystem::path& out,
+                                const SimMissionObserver& observer) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  if (spec.world_file.empty()) throw std::invalid_argument("mission: no world file given");
+  const worlds::WorldMetadata meta = LoadWorldMetadata(spec.world_file);
+  Eigen::Vector3d start;
+  Eigen::Vector2d goal;
+  ResolveEnds(spec, meta, start, goal);
+  const std::string world_stem = spec.world_file.stem().string();
+
+  RunFolder folder(out);
+  sim::SimRig rig(spec.world_file.string(), spec.config.rig);
+  Result<Eigen::Isometry3d> placed = rig.PlaceRobot(start.x(), start.y(), start.z());
+  if (!placed) throw std::runtime_error("cannot place the robot: " + placed.error().message);
+
+  RunSettings settings = spec.settings;
+  MissionConfig& mission = settings.mission;
+  mission.goal_m = goal;
+  mission.mount = spec.config.rig.robot.mount;
+  const worlds::Bounds2d& b = meta.bounds;
+  mission.map_area = mapping::GridGeometry::Covering(Eigen::Vector2d(b.x_min_m, b.y_min_m),
+                                                     Eigen::Vector2d(b.x_max_m, b.y_max_m),
+                                                     settings.cell_m, kMapMargin_m);
+  std::optional<mapping::GeodeticOrigin> origin;
+  if (meta.geodetic_origin) {
+    origin = mapping::GeodeticOrigin{meta.geodetic_origin->latitude_deg,
+                                     meta.geodetic_origin->longitude_deg,
+                                     meta.geodetic_origin->height_m};
+  }
+  if (observer.on_setup) {
+    observer.on_setup("ground truth of " +
+                      (spec.world_name.empty() ? world_stem : spec.world_name) +
+                      ": true surface on " + std::to_string(mission.map_area.size_x) + " x " +
+                      std::to_string(mission.map_area.size_y) + " cells");
+  }
+  const Truth truth = ComputeTruth(rig, mission, start.head<2>(), observer);
+
+  sim::Simulation& sim = rig.sim();
+  MissionObserver mission_observer;
+  mission_observer.on_stop = [&](const StopRecord& stop, const MissionResult& so_far) {
+    WriteStopOutputs(folder, stop, so_far, origin, world_stem);
+  };
+  if (observer.on_progress) {
+    mission_observer.on_progress = [&](const std::string& text) {
+      observer.on_progress(text, sim.time_s());
+    };
+  }
+  SimMissionOutcome run;
+  run.result = RunMission(rig, rig.base(), *placed, mission, SimProbes(sim, spec.config.seed),
+                          mission_observer);
+  const planning::TraversabilityGrid final_grid = planning::BuildTraversability(
+      mapping::ComputeLayers(run.result.elevation, mission.layers), mission.planner);
+  run.score =
+      ScoreRun(run.result, truth.grid, final_grid, start.head<2>(), goal, mission.algorithm);
+
+  run.context = SimContext(spec, settings, start, origin, rig);
+  run.context.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  WriteFinalOutputs(folder, run.context, run.result, run.score, &truth.layers, truth.optimum);
+  folder.Commit();
+  run.metrics = RunMetrics(run.context, run.result, run.score);
+  run.folder = folder.final_path();
+  return run;
+}
+
+}  // namespace pitchlab::mission

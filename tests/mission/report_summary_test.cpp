@@ -1,0 +1,106 @@
+#include "report_summary.hpp"
+
+#include <algorithm>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+namespace pitchlab::mission {
+namespace {
+
+TEST(Significant, KeepsThreeDigitsWithoutExponents) {
+  EXPECT_EQ(Significant(25.68077843840243), "25.7");
+  EXPECT_EQ(Significant(0.22125407960202068), "0.221");
+  EXPECT_EQ(Significant(233.52000000038808), "234");
+  EXPECT_EQ(Significant(0.0771), "0.0771");
+  EXPECT_EQ(Significant(1.1012593157578525), "1.10");
+  EXPECT_EQ(Significant(10205), "10205");  // whole numbers are never rounded
+  EXPECT_EQ(Significant(-2.35321), "-2.35");
+  EXPECT_EQ(Significant(0), "0");
+  EXPECT_EQ(Significant(0.342, 2), "0.34");
+  EXPECT_EQ(Significant(std::numeric_limits<double>::infinity()), "-");
+}
+
+nlohmann::json SafeSuccess() {
+  return {{"success", true},
+          {"reason", "goal reached"},
+          {"hazard_cells_crossed", 0},
+          {"forbidden_cells_crossed", 0},
+          {"closest_approach_to_forbidden_m", 0.34}};
+}
+
+TEST(ReadOutcome, ASafeRunReachedItsGoal) {
+  const Outcome o = ReadOutcome(SafeSuccess());
+  EXPECT_TRUE(o.success);
+  EXPECT_TRUE(o.safe);
+  EXPECT_EQ(o.headline, "Goal reached");
+  EXPECT_EQ(o.reason, "goal reached");
+  EXPECT_TRUE(o.safety.empty());
+}
+
+TEST(ReadOutcome, CrossingTrueHazardsMakesASuccessUnsafe) {
+  nlohmann::json m = SafeSuccess();
+  m["hazard_cells_crossed"] = 3;
+  m["forbidden_cells_crossed"] = 7;
+  m["closest_approach_to_forbidden_m"] = 0.0;
+  const Outcome o = ReadOutcome(m);
+  EXPECT_TRUE(o.success);
+  EXPECT_FALSE(o.safe);
+  EXPECT_EQ(o.headline, "Goal reached, but unsafe");
+  ASSERT_EQ(o.safety.size(), 3u);
+  EXPECT_NE(o.safety[0].find("3 true hazard cells"), std::string::npos);
+  EXPECT_NE(o.safety[1].find("7 forbidden cells"), std::string::npos);
+  EXPECT_NE(o.safety[2].find("0 m from a true hazard cell"), std::string::npos);
+}
+
+TEST(ReadOutcome, TouchingAHazardIsUnsafeEvenWithoutCrossingIt) {
+  nlohmann::json m = SafeSuccess();
+  m["closest_approach_to_forbidden_m"] = 0.02;  // prints as 0.0 m at the report's precision
+  EXPECT_FALSE(ReadOutcome(m).safe);
+  m["closest_approach_to_forbidden_m"] = 0.1;  // one cell away: not touching
+  EXPECT_TRUE(ReadOutcome(m).safe);
+  m["closest_approach_to_forbidden_m"] = nullptr;  // no hazard within 5 m
+  EXPECT_TRUE(ReadOutcome(m).safe);
+}
+
+TEST(ReadOutcome, AFailedRunKeepsItsReason) {
+  const Outcome o = ReadOutcome({{"success", false}, {"reason", "no path: goal walled in"}});
+  EXPECT_FALSE(o.success);
+  EXPECT_EQ(o.headline, "Failed");
+  EXPECT_EQ(o.reason, "no path: goal walled in");
+  EXPECT_TRUE(o.safe);  // a hardware run has no truth: nothing known to be unsafe
+}
+
+TEST(KeyMetrics, ShowsUnitsAndLeavesOutWhatIsUnknown) {
+  nlohmann::json m = SafeSuccess();
+  m["distance_m"] = 25.68077843840243;
+  m["stops"] = 9;
+  m["final_pose_error"] = {{"translation_m", 0.2212}, {"rotation_deg", 1.1012}};
+  m["cost_ratio"] = nullptr;  // failed runs have none
+  const std::vector<MetricRow> rows = KeyMetrics(m);
+  auto find = [&](const std::string& label) -> const MetricRow* {
+    for (const MetricRow& r : rows)
+      if (r.label == label) return &r;
+    return nullptr;
+  };
+  ASSERT_NE(find("distance driven"), nullptr);
+  EXPECT_EQ(find("distance driven")->value, "25.7");
+  EXPECT_EQ(find("distance driven")->unit, "m");
+  ASSERT_NE(find("stops"), nullptr);
+  EXPECT_EQ(find("stops")->value, "9");  // a count, not 9.00
+  ASSERT_NE(find("final heading error"), nullptr);
+  EXPECT_EQ(find("final heading error")->unit, "deg");
+  EXPECT_EQ(find("path cost / optimal cost"), nullptr);
+  m["map_hazards"] = {{"cells_compared", 10205}, {"false_hazard_cells", 31}};
+  const std::vector<MetricRow> with_map = KeyMetrics(m);
+  const auto false_hazards = std::find_if(with_map.begin(), with_map.end(), [](const MetricRow& r) {
+    return r.label == "false hazard cells in the final map";
+  });
+  ASSERT_NE(false_hazards, with_map.end());
+  EXPECT_EQ(false_hazards->value, "31");
+  EXPECT_NE(false_hazards->note.find("of 10205 cells compared"), std::string::npos);
+  EXPECT_EQ(find("wall time"), nullptr);
+}
+
+}  // namespace
+}  // namespace pitchlab::mission

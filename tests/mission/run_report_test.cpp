@@ -1,0 +1,92 @@
+#include "run_report.hpp"
+
+#include <gtest/gtest.h>
+
+#include "report_scene.hpp"
+#include "synthetic_report.hpp"
+
+namespace pitchlab::mission {
+namespace {
+
+namespace fs = std::filesystem;
+
+class RunReport : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(::testing::TempDir()) /
+           ("run_report_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+TEST_F(RunReport, AFailedRunShowsItsReasonBeforeEverythingElse) {
+  const RunReportInput in = testing::SyntheticReport(dir_, 1000, 40);
+  const std::string html = RenderRunReport(in, LoadThreeJs(DefaultThreeJsDir()));
+  const std::size_t outcome = html.find("<div id=outcome class=\"outcome failed\"");
+  ASSERT_NE(outcome, std::string::npos);
+  EXPECT_NE(html.find("<div class=headline>Failed</div>"), std::string::npos);
+  const std::size_t reason = html.find(std::string("Reason: ") + testing::kSyntheticReason);
+  ASSERT_NE(reason, std::string::npos);
+  EXPECT_LT(outcome, reason);
+  EXPECT_LT(reason, html.find("id=key-metrics"));
+  EXPECT_LT(html.find("id=key-metrics"), html.find("id=view3d"));
+  EXPECT_LT(html.find("id=view3d"), html.find("<details>"));
+  // The key metrics carry their units and a few digits, not JSON.
+  EXPECT_NE(html.find("<td class=l>distance driven</td><td>3.14</td><td class=l>m</td>"),
+            std::string::npos);
+}
+
+TEST_F(RunReport, ASuccessThatCrossedHazardsSaysSoBesideTheOutcome) {
+  RunReportInput in = testing::SyntheticReport(dir_, 1000, 40);
+  in.metrics["success"] = true;
+  in.metrics["reason"] = "goal reached";
+  in.metrics["hazard_cells_crossed"] = 2;
+  in.metrics["forbidden_cells_crossed"] = 2;
+  const std::string html = RenderRunReport(in, LoadThreeJs(DefaultThreeJsDir()));
+  const std::size_t outcome =
+      html.find("<div id=outcome class=\"outcome unsafe\" data-success=true data-safe=false>");
+  ASSERT_NE(outcome, std::string::npos);
+  EXPECT_NE(html.find("Goal reached, but unsafe"), std::string::npos);
+  const std::size_t unsafe = html.find("Unsafe: the true trajectory crossed 2 true hazard cells");
+  ASSERT_NE(unsafe, std::string::npos);
+  EXPECT_LT(unsafe, html.find("id=key-metrics"));
+}
+
+TEST_F(RunReport, WithoutThreeJsThePageSaysWhyAndHasNoViewer) {
+  const RunReportInput in = testing::SyntheticReport(dir_, 1000, 40);
+  const Result<ThreeJs> missing = LoadThreeJs(dir_ / "no_such_folder");
+  ASSERT_FALSE(missing);
+  EXPECT_NE(missing.error().message.find("three.min.js"), std::string::npos);
+  EXPECT_NE(missing.error().message.find("libjs-three"), std::string::npos);
+  const std::string html = RenderRunReport(in, missing);
+  EXPECT_NE(html.find("<div id=view3d data-status=unavailable>"), std::string::npos);
+  EXPECT_NE(html.find("The 3D view is unavailable: "), std::string::npos);
+  EXPECT_EQ(html.find("scene-data"), std::string::npos);
+  EXPECT_NE(html.find(testing::kSyntheticReason), std::string::npos);  // the rest is all there
+}
+
+TEST_F(RunReport, LinksTheRunFiles) {
+  const RunReportInput in = testing::SyntheticReport(dir_, 1000, 40);
+  const std::string html = RenderRunReport(in, LoadThreeJs(DefaultThreeJsDir()));
+  EXPECT_NE(html.find("<a href=\"metrics.json\">metrics.json</a>: every metric"),
+            std::string::npos);
+  EXPECT_NE(html.find("<a href=\"stops/000/map.png\">stops/000/map.png</a>"), std::string::npos);
+  EXPECT_NE(html.find("<a href=\"elevation.png\">elevation.png</a>"), std::string::npos);
+}
+
+// The largest scene a run can put in a page (kSceneMaxPoints points, kSceneMaxCells cells)
+// with three.js inlined stays under the 10 MB a browser opens without a pause.
+TEST_F(RunReport, TheLargestPageStaysUnderTenMegabytes) {
+  const Result<ThreeJs> three = LoadThreeJs(DefaultThreeJsDir());
+  ASSERT_TRUE(three) << three.error().message << " (scripts/setup.sh installs libjs-three)";
+  const RunReportInput in = testing::SyntheticReport(dir_, kSceneMaxPoints, 400);
+  const std::string html = RenderRunReport(in, three);
+  EXPECT_NE(html.find("REVISION=\"111\""), std::string::npos);  // three.js is in it
+  EXPECT_LT(html.size(), 10u * 1000 * 1000);
+}
+
+}  // namespace
+}  // namespace pitchlab::mission
