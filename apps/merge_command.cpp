@@ -70,8 +70,8 @@ std::vector<mapping::StampedPose> Stamped(const std::vector<mapping::TrajectoryP
   }
   std::vector<mapping::StampedPose> out;
   for (const mapping::TrajectoryPose& p : trajectory) {
-    out.push_back({increasing ? stamps_s[p.scan_index] : static_cast<double>(p.scan_index),
-                   p.T_map_base});
+    out.push_back(
+        {increasing ? stamps_s[p.scan_index] : static_cast<double>(p.scan_index), p.T_map_base});
   }
   return out;
 }
@@ -166,8 +166,8 @@ int RunMerge(int argc, char** argv) {
     }
     std::optional<Eigen::Isometry3d> odometry;
     if (T_odom_first && scan->has_odometry) odometry = T_odom_first->inverse() * scan->T_world_base;
-    Result<mapping::MergeStep> step = builder->Add(mapping::CloudFromScan(*scan), odometry,
-                                                   odometry ? bound : std::nullopt);
+    Result<mapping::MergeStep> step =
+        builder->Add(mapping::CloudFromScan(*scan), odometry, odometry ? bound : std::nullopt);
     if (!step) throw std::runtime_error(file + ": " + step.error().message);
     failed += step->merged ? 0 : 1;
     stamps_s.push_back(scan->stamp_s);
@@ -210,8 +210,8 @@ int RunMerge(int argc, char** argv) {
   const std::string trajectory_path = TrajectoryPath(args, out);
   WriteTrajectory(trajectory_path, files, builder->trajectory());
   const std::string tum_path = TumPath(trajectory_path);
-  if (Result<void> tum = mapping::WriteTumTrajectory(
-          tum_path, Stamped(builder->trajectory(), stamps_s));
+  if (Result<void> tum =
+          mapping::WriteTumTrajectory(tum_path, Stamped(builder->trajectory(), stamps_s));
       !tum) {
     throw std::runtime_error(tum_path + ": " + tum.error().message);
   }
@@ -233,13 +233,14 @@ int RunMerge(int argc, char** argv) {
     std::cout << summary.dump(2) << "\n";
   } else {
     std::printf("wrote %s (%zu points), %s and %s: %zu of %zu scans merged\n", out.c_str(),
-                map.points.size(), trajectory_path.c_str(), tum_path.c_str(),
-                files.size() - failed, files.size());
+                map.points.size(), trajectory_path.c_str(), tum_path.c_str(), files.size() - failed,
+                files.size());
     if (config.loop_closure.enabled) {
       const mapping::LoopClosureCounts c = builder->loop_closures();
-      std::printf("loop closures: %zu accepted, %zu rejected by the graph's test, %zu of %zu "
-                  "registrations failed\n",
-                  c.accepted, c.rejected, c.registration_failed, c.registered);
+      std::printf(
+          "loop closures: %zu accepted, %zu rejected by the graph's test, %zu of %zu "
+          "registrations failed\n",
+          c.accepted, c.rejected, c.registration_failed, c.registered);
     }
   }
   return failed == 0 ? 0 : 1;

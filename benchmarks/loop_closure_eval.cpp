@@ -51,9 +51,9 @@ std::vector<Stop> Route(const std::string& world) {
     return r;
   }
   if (world == "urban") {
-    return {{0, 0, 0},    {1.5, 0, 0},   {3, 0, 0},     {3, 0, 90},    {3, 1.5, 90},
-            {3, 3, 90},   {3, 3, 180},   {1.5, 3, 180}, {0, 3, 180},   {0, 3, 270},
-            {0, 1.5, 270}, {0, 0, 270},  {0, 0, 360}};
+    return {{0, 0, 0},     {1.5, 0, 0}, {3, 0, 0},     {3, 0, 90},  {3, 1.5, 90},
+            {3, 3, 90},    {3, 3, 180}, {1.5, 3, 180}, {0, 3, 180}, {0, 3, 270},
+            {0, 1.5, 270}, {0, 0, 270}, {0, 0, 360}};
   }
   throw std::invalid_argument("loop_closure_eval: no route for world '" + world + "'");
 }
@@ -143,8 +143,7 @@ nlohmann::json Run(const std::vector<sensors::Scan3D>& scans, bool loops, double
                           {"chi2_increase", a.decision.chi2_increase},
                           {"reason", a.registration.reason.substr(0, 160)}});
       if (!a.registration.success) continue;
-      loop_chi2.push_back(
-          Chi2(a.registration, truth[a.target_scan_index].inverse() * truth[k]));
+      loop_chi2.push_back(Chi2(a.registration, truth[a.target_scan_index].inverse() * truth[k]));
     }
     merged_last = k;
   }
@@ -159,7 +158,8 @@ nlohmann::json Run(const std::vector<sensors::Scan3D>& scans, bool loops, double
         l.T_from_to, truth[l.from_scan_index].inverse() * truth[l.to_scan_index]);
   }
   const auto ate = mapping::AbsoluteTrajectoryErrorUnaligned(estimate, truth_merged);
-  const mapping::PoseError final_error = mapping::ComparePoses(estimate.back(), truth_merged.back());
+  const mapping::PoseError final_error =
+      mapping::ComparePoses(estimate.back(), truth_merged.back());
   const mapping::LoopClosureCounts c = builder.loop_closures();
   return {{"loop_closure", loops},
           {"scans", scans.size()},
@@ -168,11 +168,12 @@ nlohmann::json Run(const std::vector<sensors::Scan3D>& scans, bool loops, double
           {"final_error_deg", final_error.rotation_deg},
           {"ate_rmse_m", ate ? ate->rmse_m : -1.0},
           {"ate_max_m", ate ? ate->max_m : -1.0},
-          {"loops", {{"registered", c.registered},
-                     {"registration_failed", c.registration_failed},
-                     {"accepted", c.accepted},
-                     {"rejected", c.rejected},
-                     {"wrong", wrong}}},
+          {"loops",
+           {{"registered", c.registered},
+            {"registration_failed", c.registration_failed},
+            {"accepted", c.accepted},
+            {"rejected", c.rejected},
+            {"wrong", wrong}}},
           {"sequential_edge_chi2", Summary(sequential_chi2)},
           {"loop_edge_chi2", Summary(loop_chi2)},
           {"loop_attempts", attempts}};

@@ -1,13 +1,14 @@
 // Re-posing the maps after a pose-graph optimisation (issue 20 target: 40 scans <= 0.2 s, map
 // cloud and elevation map): 40 simulated scans along the office's corridor (the seed pattern,
 // 361 x 200 readings, kept within the mission's 10 m map range, MissionConfig::map_range_m; the
-// map frame's poses are the stops' shifted to start near the origin), all moved to new poses at once: ScanVoxelMap::Repose (the
-// map cloud from the scans kept at the 0.1 m map voxel, as MapBuilder keeps them) and
-// PerScanElevationMap::Repose (every scan re-inserted with its rays, then the contributions
-// combined). Iterations alternate between two pose sets 1 cm / 0.1 deg apart, so every scan
-// moves every time. The elevation map is timed with the scans as cast (argument 0) and with the
-// 2 cm voxel copies MapBuilder's loop closure keeps (argument 20, LoopClosureConfig::scan_voxel_m:
-// half the points of a simulated office scan within 10 m, 28-37k of 67k).
+// map frame's poses are the stops' shifted to start near the origin), all moved to new poses at
+// once: ScanVoxelMap::Repose (the map cloud from the scans kept at the 0.1 m map voxel, as
+// MapBuilder keeps them) and PerScanElevationMap::Repose (every scan re-inserted with its rays,
+// then the contributions combined). Iterations alternate between two pose sets 1 cm / 0.1 deg
+// apart, so every scan moves every time. The elevation map is timed with the scans as cast
+// (argument 0) and with the 2 cm voxel copies MapBuilder's loop closure keeps (argument 20,
+// LoopClosureConfig::scan_voxel_m: half the points of a simulated office scan within 10 m, 28-37k
+// of 67k).
 //
 //   build/benchmarks/repose_benchmark --benchmark_counters_tabular=true
 //
@@ -43,7 +44,8 @@ const Eigen::Vector3f kSensorBase =
 // The simulated office's corridor (y in [-1, 1]), a stop every 0.45 m from x = -9 m, each scan
 // the default SimRig's (the seed pattern), in base_link, within the map range.
 PointCloud Scan(pitchlab::sim::SimRig& rig, int k) {
-  auto placed = rig.PlaceRobot(-9.0 + 0.45 * k, 0.3 * std::sin(0.5 * k), 10 * std::sin(0.3 * k) * kDeg);
+  auto placed =
+      rig.PlaceRobot(-9.0 + 0.45 * k, 0.3 * std::sin(0.5 * k), 10 * std::sin(0.3 * k) * kDeg);
   if (!placed) throw std::runtime_error("office: " + placed.error().message);
   auto scan = rig.Acquire();
   if (!scan) throw std::runtime_error("office: " + scan.error().message);
@@ -57,7 +59,7 @@ PointCloud Scan(pitchlab::sim::SimRig& rig, int k) {
 // Stop k's pose in the map, `shift` [m] (and 10 * shift [deg]) off.
 Eigen::Isometry3d StopPose(int k, double shift) {
   Eigen::Isometry3d T = pitchlab::mapping::PoseFromXyzRpyDeg(0.45 * k, 0.3 * std::sin(0.5 * k), 0,
-                                                              0, 0, 10 * std::sin(0.3 * k));
+                                                             0, 0, 10 * std::sin(0.3 * k));
   T.translation() += Eigen::Vector3d(shift, shift, 0);
   T.rotate(Eigen::AngleAxisd(10 * shift * kDeg, Eigen::Vector3d::UnitZ()));
   return T;
@@ -104,8 +106,9 @@ void BM_ReposeElevationMap(benchmark::State& state) {
   std::vector<std::pair<std::size_t, Eigen::Isometry3d>> poses[2];
   std::size_t points = 0;
   for (int k = 0; k < kScans; ++k) {
-    const PointCloud scan = voxel_m > 0 ? pitchlab::mapping::VoxelDownsample(Scans().scans[k], voxel_m)
-                                        : Scans().scans[k];
+    const PointCloud scan = voxel_m > 0
+                                ? pitchlab::mapping::VoxelDownsample(Scans().scans[k], voxel_m)
+                                : Scans().scans[k];
     points += scan.size();
     if (!map.Insert(k, scan, kSensorBase, StopPose(k, 0))) state.SkipWithError("insert failed");
     poses[0].emplace_back(k, StopPose(k, 0.01));

@@ -17,10 +17,9 @@ constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
 // Largest variance of the rotation part of a covariance [rad^2].
 double LargestRotationVariance(const Matrix6d& covariance) {
-  const Eigen::Matrix3d R = 0.5 * (covariance.topLeftCorner<3, 3>() +
-                                   covariance.topLeftCorner<3, 3>().transpose());
-  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(R, Eigen::EigenvaluesOnly)
-      .eigenvalues()(2);
+  const Eigen::Matrix3d R =
+      0.5 * (covariance.topLeftCorner<3, 3>() + covariance.topLeftCorner<3, 3>().transpose());
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(R, Eigen::EigenvaluesOnly).eigenvalues()(2);
 }
 
 // Share of `source`'s points that land, moved by T_target_source, in a voxel of edge `voxel_m`
@@ -51,8 +50,7 @@ Result<Matrix6d> EdgeInformation(const RegistrationResult& registration, double 
                 "(smallest eigenvalue " +
                     std::to_string(eigen.eigenvalues()(0)) + "): no ICP result was scored");
   }
-  const Matrix6d inverse = eigen.eigenvectors() *
-                           eigen.eigenvalues().cwiseInverse().asDiagonal() *
+  const Matrix6d inverse = eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().asDiagonal() *
                            eigen.eigenvectors().transpose();
   return Matrix6d(scale * 0.5 * (inverse + inverse.transpose()));
 }
@@ -138,8 +136,7 @@ Result<void> LoopCloser::TryLoop(int node, const LoopCandidate& candidate, Merge
   prior.odometry_uncertainty =
       GuessUncertainty{candidate.uncertainty_m, RotationBoundDeg(target, node)};
   prior.source_sensor = prior.target_sensor = sensor_base_;  // the target is one scan
-  const Result<RegistrationResult> r =
-      Register(scans_[target], scans_[node], prior, registration_);
+  const Result<RegistrationResult> r = Register(scans_[target], scans_[node], prior, registration_);
   if (!r) return tl::make_unexpected(r.error());
   LoopAttempt attempt;
   attempt.target_scan_index = scan_indices_[target];
@@ -153,16 +150,16 @@ Result<void> LoopCloser::TryLoop(int node, const LoopCandidate& candidate, Merge
   }
   const Result<Matrix6d> information = EdgeInformation(*r, config_.information_scale);
   if (!information) return tl::make_unexpected(information.error());
-  const Result<LoopDecision> decision = graph_.TryAddLoopEdge(
-      {target, node, r->T_target_source, *information, EdgeKind::kLoop});
+  const Result<LoopDecision> decision =
+      graph_.TryAddLoopEdge({target, node, r->T_target_source, *information, EdgeKind::kLoop});
   if (!decision) return tl::make_unexpected(decision.error());
   attempt.tested = true;
   attempt.decision = *decision;
   if (decision->accepted) {
     ++counts_.accepted;
     ++step.loops_accepted;
-    accepted_.push_back({scan_indices_[target], scan_indices_[node], r->T_target_source,
-                         decision->chi2_increase});
+    accepted_.push_back(
+        {scan_indices_[target], scan_indices_[node], r->T_target_source, decision->chi2_increase});
   } else {
     ++counts_.rejected;
     ++step.loops_rejected;

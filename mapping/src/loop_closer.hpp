@@ -55,9 +55,9 @@ class LoopCloser {
   RegistrationConfig registration_;
   std::optional<Eigen::Vector3f> sensor_base_;
   PoseGraph graph_;
-  std::vector<PointCloud> scans_;             // per node: the scan at scan_voxel_m, in base_link
-  std::vector<std::size_t> scan_indices_;     // per node: its position in the sequence
-  std::vector<double> rotation_variance_;     // per node: its sequential edge's, largest [rad^2]
+  std::vector<PointCloud> scans_;          // per node: the scan at scan_voxel_m, in base_link
+  std::vector<std::size_t> scan_indices_;  // per node: its position in the sequence
+  std::vector<double> rotation_variance_;  // per node: its sequential edge's, largest [rad^2]
   LoopClosureCounts counts_;
   std::vector<LoopClosure> accepted_;
 };

@@ -10,8 +10,8 @@ namespace pitchlab::mapping {
 
 void LoopClosureConfig::Validate() const {
   const auto fail = [](const std::string& field, double value, const std::string& rule) {
-    throw std::invalid_argument("map.loop_closure." + field + " = " + std::to_string(value) +
-                                ": " + rule);
+    throw std::invalid_argument("map.loop_closure." + field + " = " + std::to_string(value) + ": " +
+                                rule);
   };
   if (!(std::isfinite(candidates.max_distance_m) && candidates.max_distance_m > 0)) {
     fail("candidates.max_distance_m", candidates.max_distance_m, "must be finite and > 0");
@@ -135,9 +135,8 @@ Result<MergeStep> MapBuilder::Add(const PointCloud& cloud_base,
   prior.previous_motion = last_motion_ ? *last_motion_ : Eigen::Isometry3d::Identity();
   prior.target_scan = &last_scan_;  // the map was seen from many places; free space from one
   prior.source_sensor = prior.target_sensor = config_.sensor_base;  // target: the last base_link
-  Result<RegistrationResult> r =
-      Register(map_.Around(T_map_last, config_.local_map_radius_m), cloud_base, prior,
-               config_.registration);
+  Result<RegistrationResult> r = Register(map_.Around(T_map_last, config_.local_map_radius_m),
+                                          cloud_base, prior, config_.registration);
   if (!r) return tl::make_unexpected(r.error());
   step.registration = *r;
   if (!r->success) return step;  // reported, never merged

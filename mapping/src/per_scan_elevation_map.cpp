@@ -13,8 +13,8 @@ namespace {
 // doubles stays orthonormal to ~1e-12; a scaled or sheared matrix is far off).
 Result<void> CheckPose(const Eigen::Isometry3d& T, std::size_t id) {
   const Eigen::Matrix3d R = T.linear();
-  if (!T.matrix().allFinite() ||
-      !(R.transpose() * R).isApprox(Eigen::Matrix3d::Identity(), 1e-6) || R.determinant() < 0) {
+  if (!T.matrix().allFinite() || !(R.transpose() * R).isApprox(Eigen::Matrix3d::Identity(), 1e-6) ||
+      R.determinant() < 0) {
     return Fail(Error::Code::kInvalidArgument,
                 "per-scan elevation map: scan " + std::to_string(id) +
                     ": T_map_base is not a finite rotation and translation");

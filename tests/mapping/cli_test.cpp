@@ -133,14 +133,14 @@ TEST_F(Cli, MergeWithLoopClosureClosesTheLoopOfASequenceBackAtItsStart) {
   struct Stop {
     double x_m, y_m, yaw_deg;
   };
-  const Stop route[] = {{-8, 0, 0},      {-7.4, 0.2, 8},  {-6.8, 0.3, 15}, {-6.2, 0.2, 10},
+  const Stop route[] = {{-8, 0, 0},      {-7.4, 0.2, 8},   {-6.8, 0.3, 15}, {-6.2, 0.2, 10},
                         {-5.6, 0, 0},    {-5.0, -0.1, -5}, {-5.6, 0.1, 0},  {-6.2, 0, 5},
-                        {-6.8, -0.1, 0}, {-7.4, 0.1, -5}, {-8, 0, 0}};
+                        {-6.8, -0.1, 0}, {-7.4, 0.1, -5},  {-8, 0, 0}};
   std::vector<std::string> scans;
   for (std::size_t i = 0; i < std::size(route); ++i) {
-    scans.push_back(Write(SimulatedScan("office", route[i].x_m, route[i].y_m, route[i].yaw_deg,
-                                        400 + i),
-                          "s" + std::to_string(i) + ".pcd"));
+    scans.push_back(
+        Write(SimulatedScan("office", route[i].x_m, route[i].y_m, route[i].yaw_deg, 400 + i),
+              "s" + std::to_string(i) + ".pcd"));
   }
   const auto merge = [&](bool loops) {
     std::vector<std::string> args = scans;

@@ -24,16 +24,16 @@ constexpr double kRangeResolutionM = 0.001;
 struct Stop {
   double x_m, y_m, yaw_deg;
 };
-const Stop kRoute[] = {{-8, 0, 0},    {-7, 0, 0},    {-6, 0, 0},    {-5, 0, 0},   {-4, 0, 0},
-                       {-4, 0, 90},   {-4, 0, 180},  {-5, 0, 180},  {-6, 0, 180}, {-7, 0, 180},
-                       {-8, 0, 180},  {-8, 0, 270},  {-8, 0, 360}};
+const Stop kRoute[] = {{-8, 0, 0},   {-7, 0, 0},   {-6, 0, 0},   {-5, 0, 0},   {-4, 0, 0},
+                       {-4, 0, 90},  {-4, 0, 180}, {-5, 0, 180}, {-6, 0, 180}, {-7, 0, 180},
+                       {-8, 0, 180}, {-8, 0, 270}, {-8, 0, 360}};
 
 const std::vector<sensors::Scan3D>& Scans() {
   static const std::vector<sensors::Scan3D> scans = [] {
     std::vector<sensors::Scan3D> out;
     for (std::size_t k = 0; k < std::size(kRoute); ++k) {
-      out.push_back(SimulatedScan("office", kRoute[k].x_m, kRoute[k].y_m, kRoute[k].yaw_deg,
-                                  300 + k));
+      out.push_back(
+          SimulatedScan("office", kRoute[k].x_m, kRoute[k].y_m, kRoute[k].yaw_deg, 300 + k));
     }
     return out;
   }();
@@ -108,9 +108,10 @@ TEST(LoopClosure, AnOfficeRoundTripClosesLoopsNoneWrongAndEndsNoWorse) {
   }
   const double with = FinalError(looped), without = FinalError(plain);
   EXPECT_LE(with, without + kRangeResolutionM) << "with " << with << " m, without " << without;
-  std::printf("final pose error: %.4f m with loop closure (%zu accepted, %zu refused, %zu "
-              "registrations failed), %.4f m without\n",
-              with, c.accepted, c.rejected, c.registration_failed, without);
+  std::printf(
+      "final pose error: %.4f m with loop closure (%zu accepted, %zu refused, %zu "
+      "registrations failed), %.4f m without\n",
+      with, c.accepted, c.rejected, c.registration_failed, without);
 
   // The map cloud is the one the optimised poses give, point for point.
   ScanVoxelMap at_optimum(Config(true).map_voxel_m, false);

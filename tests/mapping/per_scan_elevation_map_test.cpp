@@ -68,9 +68,8 @@ void ExpectSameCells(const ElevationMap& a, const ElevationMap& b) {
     const CellStats& y = b.at(k);
     differing += !(x.count == y.count && x.mean_x == y.mean_x && x.mean_y == y.mean_y &&
                    x.mean_z == y.mean_z && x.c_xx == y.c_xx && x.c_xy == y.c_xy &&
-                   x.c_xz == y.c_xz && x.c_yy == y.c_yy && x.c_yz == y.c_yz &&
-                   x.c_zz == y.c_zz && x.min_z == y.min_z && x.max_z == y.max_z &&
-                   x.clearance_z == y.clearance_z);
+                   x.c_xz == y.c_xz && x.c_yy == y.c_yy && x.c_yz == y.c_yz && x.c_zz == y.c_zz &&
+                   x.min_z == y.min_z && x.max_z == y.max_z && x.clearance_z == y.clearance_z);
   }
   EXPECT_EQ(differing, 0u);
 }
@@ -88,7 +87,8 @@ TEST(PerScanElevationMap, ARePosedMapEqualsOneBuiltFromScratchAtTheNewPosesBitFo
   PerScanElevationMap drifted(Area());
   for (int k = 0; k < 5; ++k) {
     scans.push_back(Scan(Stop(k)));
-    const Eigen::Isometry3d off = Stop(k) * PoseFromXyzRpyDeg(0.01 * k, -0.01 * k, 0, 0, 0, 0.2 * k);
+    const Eigen::Isometry3d off =
+        Stop(k) * PoseFromXyzRpyDeg(0.01 * k, -0.01 * k, 0, 0, 0, 0.2 * k);
     ASSERT_TRUE(drifted.Insert(k, scans[k], kSensorBase, off));
   }
   const ElevationMap before = drifted.map();

@@ -104,7 +104,7 @@ struct LoopClosure {
   std::size_t from_scan_index = 0;  ///< the earlier scan (the registration's target)
   std::size_t to_scan_index = 0;    ///< the scan that came back (its source)
   Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();  ///< measured
-  double chi2_increase = 0;  ///< LoopDecision::chi2_increase [1]
+  double chi2_increase = 0;                                     ///< LoopDecision::chi2_increase [1]
 };
 
 /// Loop closures over the whole sequence.
