@@ -55,7 +55,7 @@ struct LoopClosureConfig {
   /// Measured by benchmarks/loop_closure_eval (office and urban routes back to their start,
   /// the default SimRig): the true error e of each edge scored under its own unscaled
   /// information, chi2 = e^T C^-1 e, which averages 6 (its degrees of freedom) when C is right.
-  /// Sequential (scan-to-map) edges without loop closure: urban mean 61, median 42 (12 edges);
+  /// Sequential (scan-to-map) edges without loop closure: urban mean 61, median 43 (12 edges);
   /// office mean 112, median 24 (18 edges, one at 1340); loop edges: urban mean 15, office 48
   /// (9 each). The information is over-confident by 10-20x
   /// on the sequential edges, 2.5-8x on the loop edges: 0.1 takes the sequential ones to their
