@@ -45,6 +45,9 @@ CliArgs MergeArgs() {
               "how far each scan's odometry pose may be off since the last merged scan")
       .Option("sensor-origin", "x,y,z", kSensorOriginHelp)
       .Flag("loop-closure", "close loops over a pose graph of the merged scans")
+      .Option("information-scale", "S",
+              "with --loop-closure: factor in (0, 1] on every edge's information (default 0.1; "
+              "mapping/README.md)")
       .Flag("json", "print the per-scan results as JSON on stdout");
   return args;
 }
@@ -154,6 +157,12 @@ int RunMerge(int argc, char** argv) {
   std::optional<Eigen::Isometry3d> T_odom_first;   // odometry of the first scan, if it has one
   std::optional<mapping::MapBuilder> builder;
   config.loop_closure.enabled = args.Flagged("loop-closure");
+  if (args.Has("information-scale")) {
+    if (!config.loop_closure.enabled) throw CliError("--information-scale needs --loop-closure");
+    const double scale = args.GetNumbers("information-scale", 1)[0];
+    if (!(scale > 0 && scale <= 1)) throw CliError("--information-scale must lie in (0, 1]");
+    config.loop_closure.information_scale = scale;
+  }
   std::vector<double> stamps_s;
   std::vector<std::optional<Eigen::Isometry3d>> truth;  // T_map_base of each scan, when known
   for (const std::string& file : files) {

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_args.hpp"
 #include "pitchlab/mapping/tum_trajectory.hpp"
 #include "pitchlab/sensors/scan_pcd.hpp"
 #include "sim_scans.hpp"
@@ -171,6 +172,25 @@ TEST_F(Cli, MergeWithLoopClosureClosesTheLoopOfASequenceBackAtItsStart) {
   Result<std::vector<StampedPose>> tum = ReadTumTrajectory(looped["trajectory_tum"]);
   ASSERT_TRUE(tum) << tum.error().message;
   EXPECT_EQ(tum->size(), std::size(route));
+}
+
+TEST_F(Cli, MergeRefusesAnInformationScaleOutOfRangeOrWithoutLoopClosure) {
+  const std::string scan = Write(SimulatedScan("office", -8, 0, 0, 1), "a.pcd");
+  const std::string map = (dir_ / "map.pcd").string();
+  const auto message = [&](std::vector<std::string> args) -> std::string {
+    try {
+      RunCommand(apps::RunMerge, args);
+    } catch (const apps::CliError& e) {
+      ::testing::internal::GetCapturedStdout();
+      return e.what();
+    }
+    return "no error";
+  };
+  EXPECT_EQ(message({scan, "--out", map, "--loop-closure", "--information-scale", "0"}),
+            "--information-scale must lie in (0, 1]");
+  EXPECT_EQ(message({scan, "--out", map, "--information-scale", "0.5"}),
+            "--information-scale needs --loop-closure");
+  EXPECT_FALSE(fs::exists(map));  // nothing written
 }
 
 }  // namespace
