@@ -1,7 +1,7 @@
 # Evaluation programs of the mapping module (*_eval.cpp print JSON). Include from
 # benchmarks/CMakeLists.txt after pitchlab_all_modules is set:  include(mapping.cmake)
 find_package(nlohmann_json 3 REQUIRED)
-foreach(name registration_eval real_eval)
+foreach(name registration_eval real_eval loop_closure_eval)
   add_executable(${name} "${CMAKE_CURRENT_LIST_DIR}/${name}.cpp")
   target_link_libraries(${name} PRIVATE ${pitchlab_all_modules} nlohmann_json::nlohmann_json)
   target_compile_options(${name} PRIVATE -Wall -Wextra -Wpedantic)

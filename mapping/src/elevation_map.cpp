@@ -380,6 +380,8 @@ Result<std::size_t> ElevationMap::Merge(const ElevationMap& other, MergeCells ce
   return dropped;
 }
 
+void CombineCells(CellStats& into, const CellStats& from) { CombineInto(into, from, 0.0f, 0.0f); }
+
 void ElevationMap::SetCells(std::vector<CellStats> cells) {
   if (cells.size() != geometry_.cell_count()) {
     throw std::invalid_argument("elevation map: " + std::to_string(cells.size()) +

@@ -1,11 +1,36 @@
 #include "pitchlab/mapping/map_builder.hpp"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
-#include "voxel_hash.hpp"
+#include "loop_closer.hpp"
 
 namespace pitchlab::mapping {
+
+void LoopClosureConfig::Validate() const {
+  const auto fail = [](const std::string& field, double value, const std::string& rule) {
+    throw std::invalid_argument("map.loop_closure." + field + " = " + std::to_string(value) + ": " +
+                                rule);
+  };
+  if (!(std::isfinite(candidates.max_distance_m) && candidates.max_distance_m > 0)) {
+    fail("candidates.max_distance_m", candidates.max_distance_m, "must be finite and > 0");
+  }
+  if (!(candidates.probability > 0 && candidates.probability < 1)) {
+    fail("candidates.probability", candidates.probability, "must lie in (0, 1)");
+  }
+  if (!(std::isfinite(candidates.min_travel_m) && candidates.min_travel_m >= 0)) {
+    fail("candidates.min_travel_m", candidates.min_travel_m, "must be finite and >= 0");
+  }
+  if (max_registrations < 1) fail("max_registrations", max_registrations, "must be >= 1");
+  if (!(std::isfinite(scan_voxel_m) && scan_voxel_m > 0)) {
+    fail("scan_voxel_m", scan_voxel_m, "must be finite and > 0");
+  }
+  if (!(information_scale > 0 && information_scale <= 1)) {
+    fail("information_scale", information_scale, "must lie in (0, 1]");
+  }
+  graph.Validate();
+}
 
 void MapConfig::Validate() const {
   if (!(map_voxel_m > 0)) {
@@ -17,36 +42,58 @@ void MapConfig::Validate() const {
                                 ": must be > 0");
   }
   registration.Validate();
+  if (loop_closure.enabled) loop_closure.Validate();
 }
 
-MapBuilder::MapBuilder(const MapConfig& config) : config_(config) { config_.Validate(); }
+namespace {
+const MapConfig& Validated(const MapConfig& config) {
+  config.Validate();
+  return config;
+}
+}  // namespace
 
-void MapBuilder::Insert(const PointCloud& cloud_map) {
-  const float inv = static_cast<float>(1.0 / config_.map_voxel_m);
-  for (const Eigen::Vector3f& p : cloud_map) {
-    Voxel& v = voxels_[CellKey(p, inv)];
-    v.sum += p.cast<double>();
-    ++v.count;
+MapBuilder::MapBuilder(const MapConfig& config)
+    : config_(Validated(config)),
+      map_(config.map_voxel_m, config.loop_closure.enabled),
+      loops_(config.loop_closure.enabled
+                 ? std::make_unique<LoopCloser>(config.loop_closure, config.registration,
+                                                config.sensor_base)
+                 : nullptr) {}
+
+MapBuilder::~MapBuilder() = default;
+MapBuilder::MapBuilder(MapBuilder&&) noexcept = default;
+MapBuilder& MapBuilder::operator=(MapBuilder&&) noexcept = default;
+
+PointCloud MapBuilder::MapCloud() const { return map_.Cloud(); }
+
+LoopClosureCounts MapBuilder::loop_closures() const {
+  return loops_ ? loops_->counts() : LoopClosureCounts{};
+}
+
+std::vector<LoopClosure> MapBuilder::accepted_loops() const {
+  return loops_ ? loops_->accepted() : std::vector<LoopClosure>{};
+}
+
+// The merged scan joins the pose graph and the loop search runs; when the graph's optimum moved
+// earlier poses, the trajectory and the map cloud follow it.
+Result<void> MapBuilder::CloseLoops(const PointCloud& cloud_base, MergeStep& step) {
+  Result<void> added = trajectory_.size() == 1
+                           ? loops_->AddFirst(cloud_base, step.scan_index)
+                           : loops_->AddMerged(cloud_base, step.scan_index, step.T_map_base,
+                                               step.registration, step);
+  if (!added) return added;
+  // The graph keeps rotations as quaternions: a pose read back differs from the one composed by
+  // ~1e-16. 1e-9 (m, and rad in the rotation's entries) is far below anything a scan measures
+  // and far above that round-off: a pose that moved less has not moved.
+  constexpr double kRoundOff = 1e-9;
+  const std::vector<Eigen::Isometry3d> poses = loops_->Poses();
+  for (std::size_t i = 0; i < poses.size() && !step.reposed; ++i) {
+    step.reposed =
+        (poses[i].matrix() - trajectory_[i].T_map_base.matrix()).cwiseAbs().maxCoeff() > kRoundOff;
   }
-}
-
-PointCloud MapBuilder::MapCloud() const {
-  PointCloud out;
-  out.reserve(voxels_.size());
-  for (const auto& [key, v] : voxels_) out.push_back((v.sum / v.count).cast<float>());
-  return out;
-}
-
-// Map points near the last pose, expressed in the last scan's base_link (the registration target).
-PointCloud MapBuilder::LocalTarget(const Eigen::Isometry3d& T_map_last) const {
-  const Eigen::Isometry3f T_last_map = T_map_last.inverse().cast<float>();
-  const float r2 = static_cast<float>(config_.local_map_radius_m * config_.local_map_radius_m);
-  PointCloud out;
-  for (const auto& [key, v] : voxels_) {
-    const Eigen::Vector3f p = T_last_map * (v.sum / v.count).cast<float>();
-    if (p.head<2>().squaredNorm() <= r2) out.push_back(p);
-  }
-  return out;
+  if (!step.reposed) return {};
+  for (std::size_t i = 0; i < poses.size(); ++i) trajectory_[i].T_map_base = poses[i];
+  return map_.Repose(poses);
 }
 
 Result<MergeStep> MapBuilder::Add(const PointCloud& cloud_base,
@@ -63,13 +110,18 @@ Result<MergeStep> MapBuilder::Add(const PointCloud& cloud_base,
       return Fail(Error::Code::kInvalidArgument, "first scan has " + std::to_string(bad) +
                                                      " points that are not finite (NaN/inf)");
     }
-    Insert(VoxelDownsample(cloud_base, config_.map_voxel_m));
+    map_.Add(cloud_base, Eigen::Isometry3d::Identity());
     last_scan_ = cloud_base;
     trajectory_.push_back({step.scan_index, Eigen::Isometry3d::Identity()});
     step.merged = true;
     step.registration.success = true;
     step.registration.outcome = RegistrationOutcome::kSuccess;
     step.registration.reason = "first scan: defines the map frame";
+    if (loops_) {
+      if (Result<void> closed = CloseLoops(cloud_base, step); !closed) {
+        return tl::make_unexpected(closed.error());
+      }
+    }
     return step;
   }
   const Eigen::Isometry3d T_map_last = trajectory_.back().T_map_base;
@@ -83,17 +135,22 @@ Result<MergeStep> MapBuilder::Add(const PointCloud& cloud_base,
   prior.previous_motion = last_motion_ ? *last_motion_ : Eigen::Isometry3d::Identity();
   prior.target_scan = &last_scan_;  // the map was seen from many places; free space from one
   prior.source_sensor = prior.target_sensor = config_.sensor_base;  // target: the last base_link
-  Result<RegistrationResult> r =
-      Register(LocalTarget(T_map_last), cloud_base, prior, config_.registration);
+  Result<RegistrationResult> r = Register(map_.Around(T_map_last, config_.local_map_radius_m),
+                                          cloud_base, prior, config_.registration);
   if (!r) return tl::make_unexpected(r.error());
   step.registration = *r;
   if (!r->success) return step;  // reported, never merged
   step.T_map_base = T_map_last * r->T_target_source;
-  Insert(TransformCloud(VoxelDownsample(cloud_base, config_.map_voxel_m), step.T_map_base));
+  map_.Add(cloud_base, step.T_map_base);
   trajectory_.push_back({step.scan_index, step.T_map_base});
   last_scan_ = cloud_base;
   last_motion_ = r->T_target_source;
   step.merged = true;
+  if (loops_) {
+    if (Result<void> closed = CloseLoops(cloud_base, step); !closed) {
+      return tl::make_unexpected(closed.error());
+    }
+  }
   return step;
 }
 

@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_args.hpp"
+#include "pitchlab/mapping/tum_trajectory.hpp"
 #include "pitchlab/sensors/scan_pcd.hpp"
 #include "sim_scans.hpp"
 
@@ -123,6 +125,72 @@ TEST_F(Cli, MergeWritesTheMapAndTheTrajectory) {
     if (!step.contains("ground_truth_error")) continue;
     EXPECT_LT(step["ground_truth_error"]["translation_m"].get<double>(), 0.03);
   }
+}
+
+// A sequence 3 m along the office's corridor and back, reversing to where it began (no odometry:
+// the scans carry only their truth). With --loop-closure the JSON counts the loops, none wrong,
+// the final pose is no worse than without, and the TUM trajectory has every merged pose.
+TEST_F(Cli, MergeWithLoopClosureClosesTheLoopOfASequenceBackAtItsStart) {
+  struct Stop {
+    double x_m, y_m, yaw_deg;
+  };
+  const Stop route[] = {{-8, 0, 0},      {-7.4, 0.2, 8},   {-6.8, 0.3, 15}, {-6.2, 0.2, 10},
+                        {-5.6, 0, 0},    {-5.0, -0.1, -5}, {-5.6, 0.1, 0},  {-6.2, 0, 5},
+                        {-6.8, -0.1, 0}, {-7.4, 0.1, -5},  {-8, 0, 0}};
+  std::vector<std::string> scans;
+  for (std::size_t i = 0; i < std::size(route); ++i) {
+    scans.push_back(
+        Write(SimulatedScan("office", route[i].x_m, route[i].y_m, route[i].yaw_deg, 400 + i),
+              "s" + std::to_string(i) + ".pcd"));
+  }
+  const auto merge = [&](bool loops) {
+    std::vector<std::string> args = scans;
+    const std::string map = (dir_ / (loops ? "looped.pcd" : "plain.pcd")).string();
+    args.insert(args.end(), {"--out", map, "--json"});
+    if (loops) args.push_back("--loop-closure");
+    auto [code, out] = RunCommand(apps::RunMerge, args);
+    EXPECT_EQ(code, 0) << out;
+    return nlohmann::json::parse(out);
+  };
+  const nlohmann::json plain = merge(false), looped = merge(true);
+  EXPECT_FALSE(plain.contains("loop_closures"));
+  ASSERT_EQ(looped["merged"], std::size(route));
+  const nlohmann::json& loops = looped["loop_closures"];
+  EXPECT_GE(loops["accepted"].get<int>(), 1) << loops.dump();
+  EXPECT_EQ(loops["wrong"].get<int>(), 0) << loops.dump();
+  EXPECT_EQ(loops["registered"].get<int>(), loops["accepted"].get<int>() +
+                                                loops["rejected"].get<int>() +
+                                                loops["registration_failed"].get<int>());
+  // Differences below the LMS200's mm-mode range resolution (1 mm) cannot be told apart.
+  constexpr double kRangeResolutionM = 0.001;
+  const double with = looped["final_ground_truth_error"]["translation_m"].get<double>();
+  const double without = plain["final_ground_truth_error"]["translation_m"].get<double>();
+  EXPECT_LE(with, without + kRangeResolutionM) << "with " << with << " m, without " << without;
+  std::printf("merge --loop-closure: %s; final pose error %.4f m (without: %.4f m)\n",
+              loops.dump().c_str(), with, without);
+  EXPECT_EQ(looped["trajectory_tum"], (dir_ / "looped_trajectory.tum").string());
+  Result<std::vector<StampedPose>> tum = ReadTumTrajectory(looped["trajectory_tum"]);
+  ASSERT_TRUE(tum) << tum.error().message;
+  EXPECT_EQ(tum->size(), std::size(route));
+}
+
+TEST_F(Cli, MergeRefusesAnInformationScaleOutOfRangeOrWithoutLoopClosure) {
+  const std::string scan = Write(SimulatedScan("office", -8, 0, 0, 1), "a.pcd");
+  const std::string map = (dir_ / "map.pcd").string();
+  const auto message = [&](std::vector<std::string> args) -> std::string {
+    try {
+      RunCommand(apps::RunMerge, args);
+    } catch (const apps::CliError& e) {
+      ::testing::internal::GetCapturedStdout();
+      return e.what();
+    }
+    return "no error";
+  };
+  EXPECT_EQ(message({scan, "--out", map, "--loop-closure", "--information-scale", "0"}),
+            "--information-scale must lie in (0, 1]");
+  EXPECT_EQ(message({scan, "--out", map, "--information-scale", "0.5"}),
+            "--information-scale needs --loop-closure");
+  EXPECT_FALSE(fs::exists(map));  // nothing written
 }
 
 }  // namespace

@@ -102,6 +102,11 @@ struct CellStats {
 };
 static_assert(sizeof(CellStats) <= 64, "issue 4: map memory <= 64 bytes per cell");
 
+/// Adds `from`'s points into `into` as if they had been inserted there: Chan's parallel update of
+/// the moments (both cells' positions relative to the same cell centre), min, max and the lower
+/// clearance. Order matters to the last float bit only.
+void CombineCells(CellStats& into, const CellStats& from);
+
 /// Insertion options.
 struct InsertConfig {
   /// Length of each ray, back from its hit, along which cells get their clearance updated [m];
