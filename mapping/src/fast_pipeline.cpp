@@ -309,6 +309,9 @@ IcpResult PointToPlaneLm(const IcpTarget& target, const PointCloud& source,
   IcpResult result;
   result.T_target_source = init;
   double gate = config.icp_max_distance_m, lambda = 1e-4, prev_mean = -1;
+  // The gate shrinks to icp_min_distance_m, then to the inlier band (registration_config.hpp).
+  double gate_floor = config.icp_min_distance_m;
+  const double band = std::min(gate_floor, config.inlier_distance_m);
   std::vector<Pair> pairs;
   for (int iter = 0; iter < config.icp_max_iterations; ++iter) {
     FindPairs(target, source, result.T_target_source, static_cast<float>(gate), pairs);
@@ -350,14 +353,16 @@ IcpResult PointToPlaneLm(const IcpTarget& target, const PointCloud& source,
     }
     ++result.iterations;
     const double mean = err / static_cast<double>(pairs.size());
-    const bool at_final_gate = gate <= config.icp_min_distance_m + 1e-9;
-    if (at_final_gate && prev_mean >= 0 &&
+    const bool at_floor = gate <= gate_floor + 1e-9;
+    if (at_floor && prev_mean >= 0 &&
         (!stepped ||
          std::fabs(prev_mean - mean) <= config.icp_epsilon * std::max(prev_mean, 1e-12))) {
-      break;  // Algorithm 1: error change below epsilon
+      if (gate_floor <= band + 1e-9) break;  // Algorithm 1: error change below epsilon
+      gate_floor = band, gate = band, prev_mean = -1;  // converged: on at the inlier band
+      continue;
     }
-    prev_mean = at_final_gate ? mean : -1;
-    gate = std::max(config.icp_min_distance_m, gate * 0.7);
+    prev_mean = at_floor ? mean : -1;
+    gate = std::max(gate_floor, gate * 0.7);
   }
   const IcpResult score = Evaluate(target, source, result.T_target_source, config);
   result.rmse_m = score.rmse_m;

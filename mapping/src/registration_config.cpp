@@ -41,7 +41,7 @@ std::string FeatureName(FeatureKind f) {
 // The settings that may be `auto` (kAuto).
 bool MayBeAuto(const std::string& key) {
   return key == "length_scale" || key == "inlier_distance_m" || key == "max_rmse_m" ||
-         key == "free_space_margin_m" || key == "icp_min_distance_m";
+         key == "free_space_margin_m";
 }
 
 // One handler per key; visits every field of the config (so reading and writing cannot diverge).
@@ -187,9 +187,8 @@ void RegistrationConfig::Validate() const {
   require(icp_max_iterations >= 1, "icp_max_iterations", icp_max_iterations, "must be >= 1");
   require(icp_epsilon > 0, "icp_epsilon", icp_epsilon, "must be > 0");
   require(icp_max_distance_m > 0, "icp_max_distance_m", icp_max_distance_m, "must be > 0");
-  require(std::isnan(icp_min_distance_m) ||
-              (icp_min_distance_m > 0 && icp_min_distance_m <= icp_max_distance_m),
-          "icp_min_distance_m", icp_min_distance_m, "must be in (0, icp_max_distance_m] or auto");
+  require(icp_min_distance_m > 0 && icp_min_distance_m <= icp_max_distance_m, "icp_min_distance_m",
+          icp_min_distance_m, "must be in (0, icp_max_distance_m]");
   require(icp_max_points >= 50, "icp_max_points", icp_max_points, "must be >= 50");
   require(confined_scene_voxels >= 0, "confined_scene_voxels", confined_scene_voxels,
           "must be >= 0");
@@ -220,10 +219,6 @@ RegistrationConfig RegistrationConfig::Resolve(const CloudStatistics& source,
   const double noise = std::hypot(source.noise_m, target.noise_m);
   if (std::isnan(r.inlier_distance_m)) r.inlier_distance_m = std::max(r.icp_voxel_m, 3 * noise);
   if (std::isnan(r.max_rmse_m)) r.max_rmse_m = r.inlier_distance_m / std::sqrt(3.0);
-  // ICP ends on the pairs the acceptance test counts; never wider than where it starts.
-  if (std::isnan(r.icp_min_distance_m)) {
-    r.icp_min_distance_m = std::min(r.inlier_distance_m, r.icp_max_distance_m);
-  }
   if (std::isnan(r.free_space_margin_m)) {
     r.free_space_margin_m = std::max(0.1 * r.length_scale, 3 * noise);
   }

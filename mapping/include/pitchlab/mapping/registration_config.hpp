@@ -110,14 +110,14 @@ struct RegistrationConfig {
   int icp_max_iterations = 40;       ///< [1]
   double icp_epsilon = 1e-5;         ///< stop when the relative error change is below this [1]
   double icp_max_distance_m = 0.5;   ///< correspondences farther apart are ignored at first [m]
-  /// ... the gate shrinks to this as ICP converges [m]. auto: inlier_distance_m, so the final
-  /// iterations fit exactly the pairs the result is scored and accepted on. A wider final gate
-  /// (0.15 m fixed before) let pairs the acceptance test calls outliers pull the pose: on the
-  /// real corridor pair 0.79 deg / 3.3 cm from slam6d's pose, 69 % of points within 5 cm against
-  /// the reference's 75 %; at the inlier band 0.58 deg / 1.5 cm, 74 %. Simulated
-  /// (registration_eval): the measured LMS200 model's target pairs 24 -> 30 of 30, the legacy
-  /// model's 64 of 64 either way, no false success added (mapping/README.md).
-  double icp_min_distance_m = kAuto;
+  /// ... the gate shrinks to this as ICP converges [m]. Converged there, ICP goes on at the
+  /// inlier band (inlier_distance_m) when that is narrower, so its last iterations fit exactly the
+  /// pairs the result is scored and accepted on. Ending at this gate let pairs the acceptance test
+  /// calls outliers pull the pose: on the real corridor pair 0.79 deg / 3.3 cm from slam6d's pose,
+  /// 69 % of points within 5 cm against the reference's 75 %; ending at the band 0.58 deg / 1.5 cm,
+  /// 74 % (mapping/README.md). Going straight to the band instead (no stage here) narrowed the
+  /// basin restarts come back from: a room corner's degeneracy probe no longer returned.
+  double icp_min_distance_m = 0.15;
   int icp_max_points = 3000;         ///< source points ICP uses at most (evenly sampled) [1]
   /// A pair whose smaller cloud has fewer points than this after the icp_voxel_m grid is a
   /// confined scene (a room corner: the whole scan spans about a metre), where normals in
