@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "pitchlab/mapping/atomic_file.hpp"
 #include "pitchlab/sensors/scan3d.hpp"
 
 namespace pitchlab::mapping {
@@ -36,28 +37,6 @@ bool Get(const std::string& in, std::size_t& pos, T* v) {
   std::memcpy(v, in.data() + pos, sizeof(T));
   pos += sizeof(T);
   return true;
-}
-
-// Writes `bytes` to a temporary file beside `path`, then renames it over `path`.
-Result<void> WriteAtomically(const std::string& path, const std::string& bytes) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out)
-      return Fail(Error::Code::kInvalidArgument, path + ": cannot write: " + std::strerror(errno));
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    if (!out.flush()) {
-      std::remove(tmp.c_str());
-      return Fail(Error::Code::kFailed, path + ": write failed");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::remove(tmp.c_str());
-    return Fail(Error::Code::kFailed, path + ": rename failed: " + ec.message());
-  }
-  return {};
 }
 
 double LayerValue(const ElevationLayers& L, std::size_t k, RasterLayer layer) {
@@ -97,7 +76,7 @@ Result<void> SaveElevationMap(const ElevationMap& map, const std::string& path) 
   out.append(reinterpret_cast<const char*>(map.cells().data()),
              map.cells().size() * sizeof(CellStats));
   Put(out, Fnv1a(out));
-  return WriteAtomically(path, out);
+  return WriteFileAtomically(path, out);
 }
 
 namespace {
@@ -231,9 +210,9 @@ Result<void> WriteEsriAsciiGrid(const ElevationLayers& L,
     }
     out += '\n';
   }
-  if (auto r = WriteAtomically(asc_path, out); !r) return r;
+  if (auto r = WriteFileAtomically(asc_path, out); !r) return r;
   const std::filesystem::path prj = std::filesystem::path(asc_path).replace_extension(".prj");
-  return WriteAtomically(prj.string(), ProjectionWkt(origin) + "\n");
+  return WriteFileAtomically(prj.string(), ProjectionWkt(origin) + "\n");
 }
 
 }  // namespace pitchlab::mapping

@@ -11,6 +11,8 @@
 #include <system_error>
 #include <vector>
 
+#include "pitchlab/mapping/atomic_file.hpp"
+
 namespace pitchlab::mapping {
 
 namespace {
@@ -140,25 +142,7 @@ Result<std::vector<StampedPose>> ParseTumTrajectory(const std::string& text,
 Result<void> WriteTumTrajectory(const std::string& path, const std::vector<StampedPose>& poses) {
   const Result<std::string> text = FormatTumTrajectory(poses);
   if (!text) return Fail(text.error().code, path + ": " + text.error().message);
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) {
-      return Fail(Error::Code::kInvalidArgument, path + ": cannot write: " + std::strerror(errno));
-    }
-    out.write(text->data(), static_cast<std::streamsize>(text->size()));
-    if (!out.flush()) {
-      std::remove(tmp.c_str());
-      return Fail(Error::Code::kFailed, path + ": write failed");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::remove(tmp.c_str());
-    return Fail(Error::Code::kFailed, path + ": rename failed: " + ec.message());
-  }
-  return {};
+  return WriteFileAtomically(path, *text);
 }
 
 Result<std::vector<StampedPose>> ReadTumTrajectory(const std::string& path) {

@@ -13,7 +13,7 @@
 #include <map>
 #include <sstream>
 
-#include "atomic_file.hpp"
+#include "pitchlab/mapping/atomic_file.hpp"
 #include "pitchlab/planning/occupancy_grid.hpp"
 
 namespace pitchlab::planning {
@@ -266,8 +266,8 @@ Result<void> WriteOccupancyGrid(const OccupancyGrid& grid, const std::string& ya
                 "image: %s\nresolution: %.9g\norigin: [%.9g, %.9g, 0.0]\nnegate: 0\n"
                 "occupied_thresh: 0.65\nfree_thresh: 0.196\nmode: raw\n",
                 pgm_path.filename().string().c_str(), g.cell_m, g.x_min_m, g.y_min_m);
-  if (auto r = WriteFileAtomically(pgm_path.string(), pgm); !r) return r;
-  return WriteFileAtomically(yaml_path, yaml);
+  if (auto r = mapping::WriteFileAtomically(pgm_path.string(), pgm); !r) return r;
+  return mapping::WriteFileAtomically(yaml_path, yaml);
 }
 
 }  // namespace pitchlab::planning

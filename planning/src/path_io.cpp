@@ -7,13 +7,13 @@
 #include <filesystem>
 #include <fstream>
 
-#include "atomic_file.hpp"
+#include "pitchlab/mapping/atomic_file.hpp"
 
 namespace pitchlab::planning {
 namespace {
 
 Result<void> WriteText(const std::string& file, const std::string& text) {
-  return WriteFileAtomically(file, text);
+  return mapping::WriteFileAtomically(file, text);
 }
 
 std::string Num(double v, const char* fmt = "%.4f") {
