@@ -147,10 +147,11 @@ class Mission {
   // fills only the cells the map has not seen (FillUnknown).
   void UpdateElevation(StopRecord& stop);
   void Plan(StopRecord& stop);
-  planning::TraversabilityGrid Traversability(const mapping::ElevationLayers& layers,
-                                              const planning::PlannerConfig& planner) {
+  // planning::BuildTraversabilityInto `grid` (one of the members below, reused every stop).
+  void Traversability(const mapping::ElevationLayers& layers,
+                      const planning::PlannerConfig& planner, planning::TraversabilityGrid& grid) {
     const sensors::ScopedTime timing(result_.stages[Stage::kTraversability]);
-    return planning::BuildTraversability(layers, planner);
+    planning::BuildTraversabilityInto(layers, planner, grid);
   }
   tl::expected<planning::Path, planning::NoPath> PlanOn(const planning::TraversabilityGrid& grid,
                                                         const Eigen::Vector2d& here);
@@ -219,6 +220,11 @@ class Mission {
   // recovery doubts only what was never seen from close: doubt measured from where the robot
   // stands made it walk back and forth between two routes, each far from the other's end.
   std::vector<float> nearest_view_m_;
+  // Plan's working grids, kept between stops so that their buffers (about 80 bytes a cell: a
+  // 641 x 641 terrain map's are 33 MB) are allocated once, not at every stop (Plan says which
+  // holds what).
+  mapping::ElevationLayers layers_, relaxed_layers_;
+  planning::TraversabilityGrid grid_, relaxed_grid_;
 };
 
 MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
@@ -472,12 +478,14 @@ tl::expected<planning::Path, planning::NoPath> Mission::PlanOn(
 
 void Mission::Plan(StopRecord& stop) {
   sensors::Stopwatch watch;
-  mapping::ElevationLayers layers = mapping::ComputeLayers(result_.elevation, config_.layers);
-  for (const FeltHazard& f : felt_) MarkFelt(layers, f);
+  mapping::ComputeLayersInto(result_.elevation, config_.layers, layers_);
+  for (const FeltHazard& f : felt_) MarkFelt(layers_, f);
   result_.stages[Stage::kMapUpdate] += watch.Read();
+  const mapping::ElevationLayers& layers = layers_;
   stop.felt_hazards = static_cast<int>(felt_.size());
   const planning::PlannerConfig planner = MissionPlanner(config_);
-  planning::TraversabilityGrid grid = Traversability(layers, planner);
+  Traversability(layers, planner, grid_);
+  const planning::TraversabilityGrid& grid = grid_;  // the relaxed grid when a recovery plans
   const Eigen::Vector2d here = stop.T_world_base.translation().head<2>();
   auto path = PlanOn(grid, here);
   // Recoveries, when the map cuts every way: plan through the cells it is least sure of, as
@@ -485,17 +493,18 @@ void Mission::Plan(StopRecord& stop) {
   // and looks from closer; what is truly there stays in the map and ends the run honestly.
   const auto look_closer = [&](const std::function<bool(std::size_t)>& doubtful,
                                const std::string& what) {
-    mapping::ElevationLayers relaxed_layers = layers;
+    relaxed_layers_ = layers;
     std::vector<bool> doubt(layers.state.size(), false);
     std::size_t n = 0;
     for (std::size_t k = 0; k < layers.state.size(); ++k) {
       if (!doubtful(k)) continue;
-      relaxed_layers.state[k] = mapping::CellState::kUnknown;
+      relaxed_layers_.state[k] = mapping::CellState::kUnknown;
       doubt[k] = true;
       ++n;
     }
     if (n == 0) return;
-    planning::TraversabilityGrid relaxed = Traversability(relaxed_layers, planner);
+    planning::TraversabilityGrid& relaxed = relaxed_grid_;
+    Traversability(relaxed_layers_, planner, relaxed);
     auto through = PlanOn(relaxed, here);
     if (!through) return;
     stop.plan_note = "no path: planning through " + what + " as unknown, to look from closer (" +
@@ -508,7 +517,7 @@ void Mission::Plan(StopRecord& stop) {
       stop.plan_to_doubt_m += std::hypot(w.x_m - v.x_m, w.y_m - v.y_m);
     }
     path = std::move(through);
-    grid = std::move(relaxed);
+    std::swap(grid_, relaxed_grid_);  // `grid` is the relaxed one from here on
   };
   // Drops are inferred from rays passing low; at range a small attitude error makes them where
   // there are none.

@@ -355,12 +355,19 @@ const char* ToString(Blocked b) {
 }
 
 TraversabilityGrid BuildTraversability(const ElevationLayers& L, const PlannerConfig& config) {
+  TraversabilityGrid T;
+  BuildTraversabilityInto(L, config, T);
+  return T;
+}
+
+void BuildTraversabilityInto(const ElevationLayers& L, const PlannerConfig& config,
+                             TraversabilityGrid& T) {
   config.Validate();
   const GridGeometry& g = L.geometry;
   const std::size_t n = g.cell_count();
-  TraversabilityGrid T;
   T.geometry = g;
   T.config = config;
+  T.occupancy_cost.clear();  // an elevation map's grid has none
   T.z_m.assign(n, std::numeric_limits<float>::quiet_NaN());
   T.enter_cost.assign(n, 0.0f);
   T.roughness_m.assign(n, 0.0f);
@@ -404,7 +411,6 @@ TraversabilityGrid BuildTraversability(const ElevationLayers& L, const PlannerCo
       }
     }
   FinishTraversability(T);
-  return T;
 }
 
 void FinishTraversability(TraversabilityGrid& T) {
