@@ -251,7 +251,8 @@ MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
 }
 
 Result<sensors::Scan3D> Mission::AcquireScan() {
-  const sensors::Elapsed lines_before = probes_.line_time ? probes_.line_time() : sensors::Elapsed{};
+  const sensors::Elapsed lines_before =
+      probes_.line_time ? probes_.line_time() : sensors::Elapsed{};
   sensors::Stopwatch watch;
   Result<sensors::Scan3D> scan = source_.Acquire();
   const sensors::Elapsed scan_time = watch.Read();
@@ -705,8 +706,7 @@ bool Mission::Follow(const planning::Path& path, double length_m) {
       scale(std::min({1.0, config_.slope_speed_mps / std::max(std::abs(cmd.v_mps), 1e-9),
                       kSlopeYawRate_rps / std::max(std::abs(cmd.omega_rps), 1e-9)}));
     }
-    Result<sensors::Odometry> next =
-        DriveBase(cmd.v_mps, cmd.omega_rps, config_.control_period_s);
+    Result<sensors::Odometry> next = DriveBase(cmd.v_mps, cmd.omega_rps, config_.control_period_s);
     if (!next) {
       result_.reason = "base: " + next.error().message;
       return false;

@@ -34,16 +34,26 @@ std::string Count(std::size_t n, const std::string& one, const std::string& many
 // A stage's words in the report.
 const char* StageLabel(Stage stage) {
   switch (stage) {
-    case Stage::kPhysicsDriving: return "physics while driving";
-    case Stage::kPhysicsStanding: return "physics while standing to scan";
-    case Stage::kRayCasting: return "ray casting (the scan's lines)";
-    case Stage::kRegistration: return "registration";
-    case Stage::kMapUpdate: return "map update (elevation, layers)";
-    case Stage::kTraversability: return "traversability";
-    case Stage::kPlanning: return "planning";
-    case Stage::kOutputs: return "outputs (the run folder's files)";
-    case Stage::kGroundTruth: return "ground truth (set-up)";
-    case Stage::kScoring: return "scoring against the truth";
+    case Stage::kPhysicsDriving:
+      return "physics while driving";
+    case Stage::kPhysicsStanding:
+      return "physics while standing to scan";
+    case Stage::kRayCasting:
+      return "ray casting (the scan's lines)";
+    case Stage::kRegistration:
+      return "registration";
+    case Stage::kMapUpdate:
+      return "map update (elevation, layers)";
+    case Stage::kTraversability:
+      return "traversability";
+    case Stage::kPlanning:
+      return "planning";
+    case Stage::kOutputs:
+      return "outputs (the run folder's files)";
+    case Stage::kGroundTruth:
+      return "ground truth (set-up)";
+    case Stage::kScoring:
+      return "scoring against the truth";
   }
   return "?";
 }

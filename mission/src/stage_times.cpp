@@ -14,16 +14,26 @@ nlohmann::json TimeJson(const sensors::Elapsed& t, const sensors::Elapsed& run) 
 
 const char* StageKey(Stage stage) {
   switch (stage) {
-    case Stage::kPhysicsDriving: return "physics_driving";
-    case Stage::kPhysicsStanding: return "physics_standing";
-    case Stage::kRayCasting: return "ray_casting";
-    case Stage::kRegistration: return "registration";
-    case Stage::kMapUpdate: return "map_update";
-    case Stage::kTraversability: return "traversability";
-    case Stage::kPlanning: return "planning";
-    case Stage::kOutputs: return "outputs";
-    case Stage::kGroundTruth: return "ground_truth";
-    case Stage::kScoring: return "scoring";
+    case Stage::kPhysicsDriving:
+      return "physics_driving";
+    case Stage::kPhysicsStanding:
+      return "physics_standing";
+    case Stage::kRayCasting:
+      return "ray_casting";
+    case Stage::kRegistration:
+      return "registration";
+    case Stage::kMapUpdate:
+      return "map_update";
+    case Stage::kTraversability:
+      return "traversability";
+    case Stage::kPlanning:
+      return "planning";
+    case Stage::kOutputs:
+      return "outputs";
+    case Stage::kGroundTruth:
+      return "ground_truth";
+    case Stage::kScoring:
+      return "scoring";
   }
   return "?";
 }
