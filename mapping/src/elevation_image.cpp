@@ -129,6 +129,13 @@ Result<void> WritePng(const RgbImage& image, const std::string& path) {
     return Fail(Error::Code::kFailed, path + ": libpng failed");
   }
   png_init_io(png, f);
+  // Our pictures draw each map cell as a block of pixels, so most rows repeat the one above: the
+  // Up filter alone makes them zeros. libpng's default tries all five filters on every row, which
+  // took half the encoding time for files as small (issue 21: an office run's six pictures,
+  // 5.7 Mpixel, 217 ms -> 98 ms, 145.6 -> 145.9 kB; a terrain run's four, 3.5 Mpixel,
+  // 202 ms -> 101 ms, 451 -> 498 kB). Deflate stays at zlib's default level 6: level 3 took half
+  // as long again but made the office's files 56 % larger.
+  png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_UP);
   png_set_IHDR(png, info, image.width, image.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);

@@ -209,6 +209,12 @@ float ElevationLayers::Tilt(std::size_t k) const {
 }
 
 ElevationLayers ComputeLayers(const ElevationMap& map, const LayerConfig& config) {
+  ElevationLayers L;
+  ComputeLayersInto(map, config, L);
+  return L;
+}
+
+void ComputeLayersInto(const ElevationMap& map, const LayerConfig& config, ElevationLayers& L) {
   if (config.inclination_radius_cells < 1 || config.inclination_radius_cells > 16) {
     throw std::invalid_argument("LayerConfig::inclination_radius_cells = " +
                                 std::to_string(config.inclination_radius_cells) +
@@ -216,7 +222,6 @@ ElevationLayers ComputeLayers(const ElevationMap& map, const LayerConfig& config
   }
   const GridGeometry& g = map.geometry();
   const std::size_t n = g.cell_count();
-  ElevationLayers L;
   L.geometry = g;
   L.state.assign(n, CellState::kUnknown);
   L.count.assign(n, 0);
@@ -245,7 +250,6 @@ ElevationLayers ComputeLayers(const ElevationMap& map, const LayerConfig& config
     }
   }
   MarkDrops(L, config);
-  return L;
 }
 
 }  // namespace pitchlab::mapping

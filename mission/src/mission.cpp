@@ -146,9 +146,23 @@ class Mission {
   // failed) the pose's height is first taken from the map's ground (FitHeightOffset), and the scan
   // fills only the cells the map has not seen (FillUnknown).
   void UpdateElevation(StopRecord& stop);
-  void Plan(StopRecord& stop) const;
+  void Plan(StopRecord& stop);
+  // planning::BuildTraversabilityInto `grid` (one of the members below, reused every stop).
+  void Traversability(const mapping::ElevationLayers& layers,
+                      const planning::PlannerConfig& planner, planning::TraversabilityGrid& grid) {
+    const sensors::ScopedTime timing(result_.stages[Stage::kTraversability]);
+    planning::BuildTraversabilityInto(layers, planner, grid);
+  }
   tl::expected<planning::Path, planning::NoPath> PlanOn(const planning::TraversabilityGrid& grid,
-                                                        const Eigen::Vector2d& here) const;
+                                                        const Eigen::Vector2d& here);
+  // The base's Drive, its time counted as kPhysicsDriving.
+  Result<sensors::Odometry> DriveBase(double v_mps, double omega_rps, double duration_s) {
+    const sensors::ScopedTime timing(result_.stages[Stage::kPhysicsDriving]);
+    return base_.Drive(v_mps, omega_rps, duration_s);
+  }
+  // The scan source's Acquire, its time split into kRayCasting (the lines, by probes_.line_time)
+  // and kPhysicsStanding (the rest).
+  Result<sensors::Scan3D> AcquireScan();
   bool Drive(const StopRecord& stop);
   bool Follow(const planning::Path& path, double length_m);
   // Marks the ground ahead as felt (`obstacle`: the tilt came from something it ran onto), then
@@ -206,6 +220,11 @@ class Mission {
   // recovery doubts only what was never seen from close: doubt measured from where the robot
   // stands made it walk back and forth between two routes, each far from the other's end.
   std::vector<float> nearest_view_m_;
+  // Plan's working grids, kept between stops so that their buffers (about 80 bytes a cell: a
+  // 641 x 641 terrain map's are 33 MB) are allocated once, not at every stop (Plan says which
+  // holds what).
+  mapping::ElevationLayers layers_, relaxed_layers_;
+  planning::TraversabilityGrid grid_, relaxed_grid_;
 };
 
 MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
@@ -231,6 +250,19 @@ MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
   return std::move(result_);
 }
 
+Result<sensors::Scan3D> Mission::AcquireScan() {
+  const sensors::Elapsed lines_before =
+      probes_.line_time ? probes_.line_time() : sensors::Elapsed{};
+  sensors::Stopwatch watch;
+  Result<sensors::Scan3D> scan = source_.Acquire();
+  const sensors::Elapsed scan_time = watch.Read();
+  const sensors::Elapsed lines =
+      probes_.line_time ? probes_.line_time() - lines_before : sensors::Elapsed{};
+  result_.stages[Stage::kRayCasting] += lines;
+  result_.stages[Stage::kPhysicsStanding] += scan_time - lines;
+  return scan;
+}
+
 bool Mission::OverBudget() {
   if (probes_.interrupted && probes_.interrupted()) {
     result_.reason = "interrupted";
@@ -245,7 +277,7 @@ bool Mission::Stop(int k) {
   if (OverBudget()) return false;
   StopRecord stop;
   stop.index = k;
-  Result<sensors::Scan3D> scan = source_.Acquire();
+  Result<sensors::Scan3D> scan = AcquireScan();
   if (!scan && scan.error().code == Error::Code::kTimeout && !OverBudget()) {
     // The scan waits for a standstill in vain where the base creeps: the wheel hold on a slope,
     // or a rigid four-wheeler rocking on two diagonal tyres over a bump. Back off the way it came
@@ -254,7 +286,7 @@ bool Mission::Stop(int k) {
              scan.error().message + "): backing off to scan again");
     Result<sensors::Odometry> odo = base_.ReadOdometry();
     const bool steep = Tilt() > config_.slope_tilt_deg * kPi / 180;
-    if (odo && (steep ? BackOff(*odo, Tilt(), false) : DriveBack(*odo))) scan = source_.Acquire();
+    if (odo && (steep ? BackOff(*odo, Tilt(), false) : DriveBack(*odo))) scan = AcquireScan();
   }
   if (!scan) {
     result_.reason = "scan at stop " + std::to_string(k) + " failed: " + scan.error().message;
@@ -285,8 +317,10 @@ bool Mission::Stop(int k) {
     tilt = mapping::MeasuredTilt{T_world_map_.linear().transpose() * Eigen::Vector3d::UnitZ(),
                                  config_.tilt_tolerance_deg};
   }
-  Result<mapping::MergeStep> merge =
-      builder_.Add(mapping::CloudFromScan(stop.scan), prior, bound, tilt);
+  Result<mapping::MergeStep> merge = [&] {
+    const sensors::ScopedTime timing(result_.stages[Stage::kRegistration]);
+    return builder_.Add(mapping::CloudFromScan(stop.scan), prior, bound, tilt);
+  }();
   if (merge) stop.merge = *merge;
   if (stop.merge.merged) {
     merged_distance_m_ = result_.odometry_distance_m;
@@ -302,7 +336,10 @@ bool Mission::Stop(int k) {
   // of terrain would stay unknown and the robot could never plan across it. That pose's height
   // comes from the map's ground where the scan overlaps it.
   stop.elevation_from_odometry = !stop.merge.merged;
-  UpdateElevation(stop);
+  {
+    const sensors::ScopedTime timing(result_.stages[Stage::kMapUpdate]);
+    UpdateElevation(stop);
+  }
   T_world_base_ = stop.T_world_base;
   odo_ref_ = *odo;
   stop.distance_to_goal_m = (config_.goal_m - stop.T_world_base.translation().head<2>()).norm();
@@ -416,7 +453,8 @@ std::optional<Eigen::Vector2d> EscapeCell(const planning::TraversabilityGrid& gr
 // the nearest free cell by a blocked goal (within kGoalApproach_m from afar, where the hazard may
 // be a sparse view; within the goal tolerance from close by, which counts as arriving).
 tl::expected<planning::Path, planning::NoPath> Mission::PlanOn(
-    const planning::TraversabilityGrid& grid, const Eigen::Vector2d& here) const {
+    const planning::TraversabilityGrid& grid, const Eigen::Vector2d& here) {
+  const sensors::ScopedTime timing(result_.stages[Stage::kPlanning]);
   auto path = planning::PlanPath(grid, here, config_.goal_m, config_.algorithm);
   if (!path && path.error().reason == planning::NoPath::Reason::kStartBlocked) {
     if (const auto escape =
@@ -439,12 +477,16 @@ tl::expected<planning::Path, planning::NoPath> Mission::PlanOn(
   return path;
 }
 
-void Mission::Plan(StopRecord& stop) const {
-  mapping::ElevationLayers layers = mapping::ComputeLayers(result_.elevation, config_.layers);
-  for (const FeltHazard& f : felt_) MarkFelt(layers, f);
+void Mission::Plan(StopRecord& stop) {
+  sensors::Stopwatch watch;
+  mapping::ComputeLayersInto(result_.elevation, config_.layers, layers_);
+  for (const FeltHazard& f : felt_) MarkFelt(layers_, f);
+  result_.stages[Stage::kMapUpdate] += watch.Read();
+  const mapping::ElevationLayers& layers = layers_;
   stop.felt_hazards = static_cast<int>(felt_.size());
   const planning::PlannerConfig planner = MissionPlanner(config_);
-  planning::TraversabilityGrid grid = planning::BuildTraversability(layers, planner);
+  Traversability(layers, planner, grid_);
+  const planning::TraversabilityGrid& grid = grid_;  // the relaxed grid when a recovery plans
   const Eigen::Vector2d here = stop.T_world_base.translation().head<2>();
   auto path = PlanOn(grid, here);
   // Recoveries, when the map cuts every way: plan through the cells it is least sure of, as
@@ -452,17 +494,18 @@ void Mission::Plan(StopRecord& stop) const {
   // and looks from closer; what is truly there stays in the map and ends the run honestly.
   const auto look_closer = [&](const std::function<bool(std::size_t)>& doubtful,
                                const std::string& what) {
-    mapping::ElevationLayers relaxed_layers = layers;
+    relaxed_layers_ = layers;
     std::vector<bool> doubt(layers.state.size(), false);
     std::size_t n = 0;
     for (std::size_t k = 0; k < layers.state.size(); ++k) {
       if (!doubtful(k)) continue;
-      relaxed_layers.state[k] = mapping::CellState::kUnknown;
+      relaxed_layers_.state[k] = mapping::CellState::kUnknown;
       doubt[k] = true;
       ++n;
     }
     if (n == 0) return;
-    planning::TraversabilityGrid relaxed = planning::BuildTraversability(relaxed_layers, planner);
+    planning::TraversabilityGrid& relaxed = relaxed_grid_;
+    Traversability(relaxed_layers_, planner, relaxed);
     auto through = PlanOn(relaxed, here);
     if (!through) return;
     stop.plan_note = "no path: planning through " + what + " as unknown, to look from closer (" +
@@ -475,7 +518,7 @@ void Mission::Plan(StopRecord& stop) const {
       stop.plan_to_doubt_m += std::hypot(w.x_m - v.x_m, w.y_m - v.y_m);
     }
     path = std::move(through);
-    grid = std::move(relaxed);
+    std::swap(grid_, relaxed_grid_);  // `grid` is the relaxed one from here on
   };
   // Drops are inferred from rays passing low; at range a small attitude error makes them where
   // there are none.
@@ -567,7 +610,7 @@ bool Mission::Drive(const StopRecord& stop) {
     }
     if (!BackOff(*odo, Tilt(), false)) return false;
   }
-  Result<sensors::Odometry> stopped = base_.Drive(0.0, 0.0, kStopTime_s);
+  Result<sensors::Odometry> stopped = DriveBase(0.0, 0.0, kStopTime_s);
   if (!stopped) {
     result_.reason = "base: " + stopped.error().message;
     return false;
@@ -603,7 +646,7 @@ bool Mission::TurnTo(double yaw_rad) {
     }
     const double omega = std::clamp(kTurnGain_per_s * error, -config_.follower.max_yaw_rate_rps,
                                     config_.follower.max_yaw_rate_rps);
-    Result<sensors::Odometry> next = base_.Drive(0.0, omega, config_.control_period_s);
+    Result<sensors::Odometry> next = DriveBase(0.0, omega, config_.control_period_s);
     if (!next) {
       result_.reason = "base: " + next.error().message;
       return false;
@@ -663,8 +706,7 @@ bool Mission::Follow(const planning::Path& path, double length_m) {
       scale(std::min({1.0, config_.slope_speed_mps / std::max(std::abs(cmd.v_mps), 1e-9),
                       kSlopeYawRate_rps / std::max(std::abs(cmd.omega_rps), 1e-9)}));
     }
-    Result<sensors::Odometry> next =
-        base_.Drive(cmd.v_mps, cmd.omega_rps, config_.control_period_s);
+    Result<sensors::Odometry> next = DriveBase(cmd.v_mps, cmd.omega_rps, config_.control_period_s);
     if (!next) {
       result_.reason = "base: " + next.error().message;
       return false;
@@ -716,7 +758,7 @@ bool Mission::DriveBack(const sensors::Odometry& odo) {
     if (OverBudget()) return false;
     if (probes_.now_s() - start_s > config_.stuck_timeout_s) break;  // as far as it goes
     if (Tilt() > stop_tilt) break;
-    Result<sensors::Odometry> next = base_.Drive(-kBackOffSpeed_mps, 0.0, config_.control_period_s);
+    Result<sensors::Odometry> next = DriveBase(-kBackOffSpeed_mps, 0.0, config_.control_period_s);
     if (!next) {
       result_.reason = "base: " + next.error().message;
       return false;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "pitchlab/mission/stage_times.hpp"
+
 namespace pitchlab::mission {
 namespace {
 
@@ -29,7 +31,69 @@ std::string Count(std::size_t n, const std::string& one, const std::string& many
   return std::to_string(n) + " " + (n == 1 ? one : many);
 }
 
+// A stage's words in the report.
+const char* StageLabel(Stage stage) {
+  switch (stage) {
+    case Stage::kPhysicsDriving:
+      return "physics while driving";
+    case Stage::kPhysicsStanding:
+      return "physics while standing to scan";
+    case Stage::kRayCasting:
+      return "ray casting (the scan's lines)";
+    case Stage::kRegistration:
+      return "registration";
+    case Stage::kMapUpdate:
+      return "map update (elevation, layers)";
+    case Stage::kTraversability:
+      return "traversability";
+    case Stage::kPlanning:
+      return "planning";
+    case Stage::kOutputs:
+      return "outputs (the run folder's files)";
+    case Stage::kGroundTruth:
+      return "ground truth (set-up)";
+    case Stage::kScoring:
+      return "scoring against the truth";
+  }
+  return "?";
+}
+
+std::string Percent(const nlohmann::json& stage, const char* key) {
+  const auto v = stage.find(key);
+  return v != stage.end() && v->is_number() ? Significant(100.0 * v->get<double>(), 2) : "-";
+}
+
+std::string Seconds(const nlohmann::json& stage, const char* key) {
+  const auto v = stage.find(key);
+  return v != stage.end() && v->is_number() ? Significant(v->get<double>()) : "-";
+}
+
 }  // namespace
+
+std::vector<std::string> StageHeader() {
+  return {"stage", "wall [s]", "CPU [s]", "wall [%]", "CPU [%]"};
+}
+
+std::vector<std::vector<std::string>> StageRows(const nlohmann::json& m) {
+  const nlohmann::json* stages = At(m, "stages");
+  if (!stages || !stages->is_object()) return {};
+  std::vector<std::vector<std::string>> rows;
+  const auto row = [&](const std::string& key, const std::string& label) {
+    const auto s = stages->find(key);
+    if (s == stages->end() || !s->is_object()) return;
+    rows.push_back({label, Seconds(*s, "wall_s"), Seconds(*s, "cpu_s"), Percent(*s, "wall_share"),
+                    Percent(*s, "cpu_share")});
+  };
+  for (std::size_t i = 0; i < kStageCount; ++i) {
+    const Stage stage = static_cast<Stage>(i);
+    row(StageKey(stage), StageLabel(stage));
+  }
+  row("other", "other (set-up: world, ray caster scene, placement; the loop's bookkeeping)");
+  if (const nlohmann::json* run = At(*stages, "run"); run && run->is_object()) {
+    rows.push_back({"whole run", Seconds(*run, "wall_s"), Seconds(*run, "cpu_s"), "100", "100"});
+  }
+  return rows;
+}
 
 std::string Significant(double v, int digits) {
   if (!std::isfinite(v)) return "-";

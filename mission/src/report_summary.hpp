@@ -35,6 +35,14 @@ struct MetricRow {
 /// (hardware runs have no truth) or null are left out.
 std::vector<MetricRow> KeyMetrics(const nlohmann::json& metrics);
 
+/// The header of the stage table (StageRows).
+std::vector<std::string> StageHeader();
+
+/// Where the run's time went, from metrics.json's `stages` (stage_times.hpp): one row per stage in
+/// the loop's order, then "other" and the whole run; each row its label, wall and CPU seconds and
+/// their shares of the run in percent. Empty when the metrics have no stages (hardware runs).
+std::vector<std::vector<std::string>> StageRows(const nlohmann::json& metrics);
+
 /// `v` with `digits` significant digits in fixed notation ("25.7", "0.221", "234", "0");
 /// "-" for NaN or infinity.
 std::string Significant(double v, int digits = 3);

@@ -167,6 +167,7 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
       {"real_time_factor", c.wall_time_s > 0 ? sim_s / c.wall_time_s : 0.0},
       {"odometry_distance_m", r.odometry_distance_m},
       {"max_tilt_deg", r.max_tilt_rad * kRadToDeg}};
+  if (c.stages) m["stages"] = StagesJson(*c.stages);
   std::size_t failed = 0;
   for (const StopRecord& s : r.stops) failed += !s.merge.merged && s.index > 0;
   m["registration_failures"] = failed;
@@ -213,6 +214,13 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
 void WriteFinalOutputs(RunFolder& folder, const RunContext& c, const MissionResult& r,
                        const std::optional<RunScore>& score, const mapping::ElevationLayers* truth,
                        const std::optional<planning::Path>& truth_optimum) {
+  WriteSummary(folder, c, r, score, WriteFinalData(folder, c, r, truth, truth_optimum));
+}
+
+mapping::ElevationLayers WriteFinalData(RunFolder& folder, const RunContext& c,
+                                        const MissionResult& r,
+                                        const mapping::ElevationLayers* truth,
+                                        const std::optional<planning::Path>& truth_optimum) {
   WriteTextFile(folder.File("config.yaml"), c.config_yaml);
   sensors::Scan3D cloud;
   for (const Eigen::Vector3f& p : r.map_cloud_world) {
@@ -232,6 +240,11 @@ void WriteFinalOutputs(RunFolder& folder, const RunContext& c, const MissionResu
     WriteTrajectoryGeoJson(folder.File("trajectories.geojson"), r, *c.geodetic_origin);
   }
   WriteRunPictures(folder, c, r, layers, truth, truth_optimum);
+  return layers;
+}
+
+void WriteSummary(RunFolder& folder, const RunContext& c, const MissionResult& r,
+                  const std::optional<RunScore>& score, const mapping::ElevationLayers& layers) {
   const nlohmann::json metrics = RunMetrics(c, r, score);
   WriteTextFile(folder.File("metrics.json"), metrics.dump(2));
 

@@ -97,8 +97,10 @@ std::string RenderRunReport(const RunReportInput& in, const Result<ThreeJs>& thr
   page.Html(OutcomeHtml(m));
   page.Html(MetricsTableHtml(m));
   page.Html(
-      "<p>Jump to: <a href=#view>3D view</a> &middot; <a href=#maps>map pictures</a> &middot; "
-      "<a href=#trajectories>trajectories</a> &middot; <a href=#stops>stops</a> &middot; "
+      std::string(
+          "<p>Jump to: <a href=#view>3D view</a> &middot; <a href=#maps>map pictures</a> &middot; "
+          "<a href=#trajectories>trajectories</a> &middot; <a href=#stops>stops</a> &middot; ") +
+      std::string(m.contains("stages") ? "<a href=#stages>time by stage</a> &middot; " : "") +
       "<a href=#files>files</a> &middot; <a href=#details>all metrics, configuration</a></p>\n");
 
   page.Heading("3D view", "view");
@@ -131,6 +133,14 @@ std::string RenderRunReport(const RunReportInput& in, const Result<ThreeJs>& thr
         {ReadBinaryFile(in.folder / p.file), p.caption, p.full.empty() ? p.file : p.full});
   }
   page.PngStrip(strip, kStripWidth_px);
+
+  if (const auto rows = StageRows(m); !rows.empty()) {
+    page.Heading("Where the run's time went", "stages");
+    page.Paragraph(
+        "Wall-clock and CPU time (all the process's threads) per stage, up to writing "
+        "metrics.json and this page; shares of the whole run.");
+    page.Table(StageHeader(), rows);
+  }
 
   page.Heading("Files of this run", "files");
   page.Html(FilesHtml(in.files));

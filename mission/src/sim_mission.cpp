@@ -3,7 +3,6 @@
 #include <mujoco/mujoco.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -15,6 +14,7 @@
 #include "pitchlab/mission/run_folder.hpp"
 #include "pitchlab/planning/planner.hpp"
 #include "pitchlab/planning/traversability.hpp"
+#include "pitchlab/sensors/stopwatch.hpp"
 #include "pitchlab/sim/sim_rig.hpp"
 
 namespace pitchlab::mission {
@@ -80,8 +80,10 @@ Truth ComputeTruth(sim::SimRig& rig, const MissionConfig& mission, const Eigen::
 }
 
 // The probes of a simulated run: its clock, its ground truth and its attitude sensor, the
-// inclinometer's roll and pitch (truth plus a seeded bias and noise).
-MissionProbes SimProbes(sim::Simulation& sim, std::uint64_t seed) {
+// inclinometer's roll and pitch (truth plus a seeded bias and noise); the laser's line time for
+// the stage breakdown.
+MissionProbes SimProbes(sim::SimRig& rig, std::uint64_t seed) {
+  sim::Simulation& sim = rig.sim();
   // One generator and one noise distribution for the whole run (the distribution keeps state
   // between draws): the same seed gives the same readings.
   struct Inclinometer {
@@ -97,6 +99,7 @@ MissionProbes SimProbes(sim::Simulation& sim, std::uint64_t seed) {
   sensor->bias = Eigen::Vector2d(attitude_bias(sensor->rng), attitude_bias(sensor->rng));
   MissionProbes probes;
   probes.now_s = [&sim] { return sim.time_s(); };
+  probes.line_time = [&rig] { return rig.scanner().line_time(); };
   probes.true_pose = [&sim] { return sim.T_world_base(); };
   probes.roll_pitch_rad = [&sim, sensor] {
     const Eigen::Matrix3d R = sim.T_world_base().linear();
@@ -170,7 +173,8 @@ worlds::WorldMetadata LoadWorldMetadata(const std::filesystem::path& world_file)
 
 SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesystem::path& out,
                                 const SimMissionObserver& observer) {
-  const auto wall_start = std::chrono::steady_clock::now();
+  const sensors::Stopwatch run_clock;
+  StageTimes stages;  // the run's own; the loop's come with its result
   if (spec.world_file.empty()) throw std::invalid_argument("mission: no world file given");
   const worlds::WorldMetadata meta = LoadWorldMetadata(spec.world_file);
   Eigen::Vector3d start;
@@ -203,11 +207,15 @@ SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesyste
                       ": true surface on " + std::to_string(mission.map_area.size_x) + " x " +
                       std::to_string(mission.map_area.size_y) + " cells");
   }
-  const Truth truth = ComputeTruth(rig, mission, start.head<2>(), observer);
+  const Truth truth = [&] {
+    const sensors::ScopedTime timing(stages[Stage::kGroundTruth]);
+    return ComputeTruth(rig, mission, start.head<2>(), observer);
+  }();
 
   sim::Simulation& sim = rig.sim();
   MissionObserver mission_observer;
   mission_observer.on_stop = [&](const StopRecord& stop, const MissionResult& so_far) {
+    const sensors::ScopedTime timing(stages[Stage::kOutputs]);
     WriteStopOutputs(folder, stop, so_far, origin, world_stem);
   };
   if (observer.on_progress) {
@@ -216,17 +224,27 @@ SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesyste
     };
   }
   SimMissionOutcome run;
-  run.result = RunMission(rig, rig.base(), *placed, mission, SimProbes(sim, spec.config.seed),
+  run.result = RunMission(rig, rig.base(), *placed, mission, SimProbes(rig, spec.config.seed),
                           mission_observer);
-  const planning::TraversabilityGrid final_grid = planning::BuildTraversability(
-      mapping::ComputeLayers(run.result.elevation, mission.layers), mission.planner);
-  run.score =
-      ScoreRun(run.result, truth.grid, final_grid, start.head<2>(), goal, mission.algorithm);
+  {
+    const sensors::ScopedTime timing(stages[Stage::kScoring]);
+    const planning::TraversabilityGrid final_grid = planning::BuildTraversability(
+        mapping::ComputeLayers(run.result.elevation, mission.layers), mission.planner);
+    run.score =
+        ScoreRun(run.result, truth.grid, final_grid, start.head<2>(), goal, mission.algorithm);
+  }
 
   run.context = SimContext(spec, settings, start, origin, rig);
-  run.context.wall_time_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  WriteFinalOutputs(folder, run.context, run.result, run.score, &truth.layers, truth.optimum);
+  const mapping::ElevationLayers layers = [&] {
+    const sensors::ScopedTime timing(stages[Stage::kOutputs]);
+    return WriteFinalData(folder, run.context, run.result, &truth.layers, truth.optimum);
+  }();
+  // The run's time up to its summary, which holds it (metrics.json, report.html).
+  const sensors::Elapsed run_time = run_clock.Read();
+  run.context.wall_time_s = run_time.wall_s;
+  stages += run.result.stages;
+  run.context.stages = StageBreakdown{stages, run_time};
+  WriteSummary(folder, run.context, run.result, run.score, layers);
   folder.Commit();
   run.metrics = RunMetrics(run.context, run.result, run.score);
   run.folder = folder.final_path();

@@ -234,19 +234,23 @@ void ComputeMoveCosts(TraversabilityGrid& T) {
 void ComputeMoveCostRange(TraversabilityGrid& T) {
   const GridGeometry& g = T.geometry;
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  T.min_straight_cost = T.min_diagonal_cost = kInf;
-  T.max_edge_cost = 0;
+  // In locals, not in T's fields: the compiler cannot keep those in registers across the stores
+  // into T (a chain of loads and stores through memory took a third of FinishTraversability).
+  double min_straight = kInf, min_diagonal = kInf, max_edge = 0;
   for (std::size_t k = 0; k < g.cell_count(); ++k) {
     const bool source = T.Free(k) || T.blocked[k] == Blocked::kUnknown;
     if (!source) continue;
     for (int b = 0; b < 8; ++b) {
       if (!(T.moves[k] >> b & 1)) continue;
       const double c = T.move_cost[k][b];
-      double& lo = b < 4 ? T.min_straight_cost : T.min_diagonal_cost;
+      double& lo = b < 4 ? min_straight : min_diagonal;
       lo = std::min(lo, c);
-      T.max_edge_cost = std::max(T.max_edge_cost, c);
+      max_edge = std::max(max_edge, c);
     }
   }
+  T.min_straight_cost = min_straight;
+  T.min_diagonal_cost = min_diagonal;
+  T.max_edge_cost = max_edge;
 }
 
 }  // namespace
@@ -355,12 +359,19 @@ const char* ToString(Blocked b) {
 }
 
 TraversabilityGrid BuildTraversability(const ElevationLayers& L, const PlannerConfig& config) {
+  TraversabilityGrid T;
+  BuildTraversabilityInto(L, config, T);
+  return T;
+}
+
+void BuildTraversabilityInto(const ElevationLayers& L, const PlannerConfig& config,
+                             TraversabilityGrid& T) {
   config.Validate();
   const GridGeometry& g = L.geometry;
   const std::size_t n = g.cell_count();
-  TraversabilityGrid T;
   T.geometry = g;
   T.config = config;
+  T.occupancy_cost.clear();  // an elevation map's grid has none
   T.z_m.assign(n, std::numeric_limits<float>::quiet_NaN());
   T.enter_cost.assign(n, 0.0f);
   T.roughness_m.assign(n, 0.0f);
@@ -404,7 +415,6 @@ TraversabilityGrid BuildTraversability(const ElevationLayers& L, const PlannerCo
       }
     }
   FinishTraversability(T);
-  return T;
 }
 
 void FinishTraversability(TraversabilityGrid& T) {

@@ -70,22 +70,24 @@ Result<sensors::LaserLine> SimLineScanner::NextLine(std::chrono::milliseconds ti
                                            " ms, more than the " + std::to_string(timeout.count()) +
                                            " ms timeout");
   }
-  caster_.Refresh();
-  const Eigen::Isometry3d T_world_laser = sim_.T_world_laser();
   sensors::LaserLine line;
-  line.stamp_s = sim_.time_s();
-  CastAt(T_world_laser, 0.0, ranges_);
-  const bool mixed = model_.config().mixed_pixels;
-  if (mixed) {
-    const double half_div = 0.5 * model_.config().beam_divergence_deg * M_PI / 180.0;
-    CastAt(T_world_laser, -half_div, edge_lo_);
-    CastAt(T_world_laser, +half_div, edge_hi_);
+  {
+    const sensors::ScopedTime timing(line_time_);
+    caster_.Refresh();
+    const Eigen::Isometry3d T_world_laser = sim_.T_world_laser();
+    CastAt(T_world_laser, 0.0, ranges_);
+    const bool mixed = model_.config().mixed_pixels;
+    if (mixed) {
+      const double half_div = 0.5 * model_.config().beam_divergence_deg * M_PI / 180.0;
+      CastAt(T_world_laser, -half_div, edge_lo_);
+      CastAt(T_world_laser, +half_div, edge_hi_);
+    }
+    const bool incidence = model_.config().UsesIncidence();
+    if (incidence) CastIncidence(T_world_laser);
+    model_.Measure(ranges_.data(), mixed ? edge_lo_.data() : nullptr,
+                   mixed ? edge_hi_.data() : nullptr, line,
+                   incidence ? cos_incidence_.data() : nullptr);
   }
-  const bool incidence = model_.config().UsesIncidence();
-  if (incidence) CastIncidence(T_world_laser);
-  model_.Measure(ranges_.data(), mixed ? edge_lo_.data() : nullptr,
-                 mixed ? edge_hi_.data() : nullptr, line,
-                 incidence ? cos_incidence_.data() : nullptr);
   line.stamp_s = sim_.time_s();
   line.pitch_rad = 0.0;  // the caller fills it from the encoder
   sim_.StepFor(period_s);

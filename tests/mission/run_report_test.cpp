@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "pitchlab/mission/stage_times.hpp"
 #include "report_scene.hpp"
 #include "synthetic_report.hpp"
 
@@ -66,6 +67,45 @@ TEST_F(RunReport, WithoutThreeJsThePageSaysWhyAndHasNoViewer) {
   EXPECT_NE(html.find("The 3D view is unavailable: "), std::string::npos);
   EXPECT_EQ(html.find("scene-data"), std::string::npos);
   EXPECT_NE(html.find(testing::kSyntheticReason), std::string::npos);  // the rest is all there
+}
+
+TEST_F(RunReport, TabulatesWhereTheRunsTimeWentStageByStage) {
+  RunReportInput in = testing::SyntheticReport(dir_, 1000, 40);
+  StageBreakdown b;
+  b.run = {40.0, 32.0};
+  b.stages[Stage::kPhysicsDriving] = {20.0, 16.0};
+  b.stages[Stage::kRegistration] = {4.0, 8.0};
+  in.metrics["stages"] = StagesJson(b);
+  const std::string html = RenderRunReport(in, LoadThreeJs(DefaultThreeJsDir()));
+  const std::size_t heading = html.find("<h2 id=\"stages\">");
+  ASSERT_NE(heading, std::string::npos);
+  EXPECT_NE(html.find("<a href=#stages>"), std::string::npos) << "the jump list links it";
+  const auto row = [&](const std::string& cells) {
+    const std::size_t at = html.find(cells, heading);
+    EXPECT_NE(at, std::string::npos) << cells;
+    return at;
+  };
+  // Wall and CPU seconds, then their shares of the run in percent.
+  const std::size_t driving =
+      row("<td>physics while driving</td><td>20.0</td><td>16.0</td><td>50</td><td>50</td>");
+  const std::size_t registration =
+      row("<td>registration</td><td>4.00</td><td>8.00</td><td>10</td><td>25</td>");
+  // Other: 40 - 24 s wall, 32 - 24 s CPU; the whole run last.
+  const std::size_t other = row("</td><td>16.0</td><td>8.00</td><td>40</td><td>25</td>");
+  const std::size_t whole = row("<td>whole run</td><td>40.0</td><td>32.0</td><td>100</td>");
+  EXPECT_LT(driving, registration);
+  EXPECT_LT(registration, other);
+  EXPECT_LT(other, whole);
+  EXPECT_NE(html.find("<th>stage</th><th>wall [s]</th><th>CPU [s]</th><th>wall [%]</th>", heading),
+            std::string::npos);
+}
+
+TEST_F(RunReport, AHardwareRunWithoutStagesHasNoStageTable) {
+  const RunReportInput in = testing::SyntheticReport(dir_, 1000, 40);
+  ASSERT_FALSE(in.metrics.contains("stages"));
+  const std::string html = RenderRunReport(in, LoadThreeJs(DefaultThreeJsDir()));
+  EXPECT_EQ(html.find("<h2 id=\"stages\">"), std::string::npos);
+  EXPECT_EQ(html.find("href=#stages"), std::string::npos);
 }
 
 TEST_F(RunReport, LinksTheRunFiles) {

@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "pitchlab/mission/stage_times.hpp"
+
 namespace pitchlab::mission {
 namespace {
 
@@ -92,6 +94,46 @@ TEST(RunSimMission, NoGoalGivenAndNoneInTheWorldIsABadSpec) {
   spec.world_file = WriteFloorWorld(dir);
   EXPECT_THROW(RunSimMission(spec, dir / "run"), std::invalid_argument);
   EXPECT_FALSE(fs::exists(dir / "run"));
+}
+
+// A real run, 2 m across the floor: its breakdown in metrics.json covers every stage, each a
+// part of the run, and "other" is what they leave of it.
+TEST(RunSimMission, ItsStageBreakdownAddsUpToTheRunWithOtherAsTheRest) {
+  // Sums of up to a dozen clock readings in seconds: rounding far below the clocks' nanosecond.
+  constexpr double kSumTolerance_s = 1e-9;
+  const fs::path dir = Scratch();
+  SimMissionSpec spec = LoadSimMissionSpec(std::nullopt);
+  spec.world_file = WriteFloorWorld(dir);
+  spec.goal_m = Eigen::Vector2d(-2.0, 0.0);  // 2 m ahead of the default start (-4, 0)
+  const SimMissionOutcome run = RunSimMission(spec, dir / "run");
+  ASSERT_TRUE(run.result.success) << run.result.reason;
+  std::ifstream file(run.folder / "metrics.json");
+  const nlohmann::json metrics = nlohmann::json::parse(file);
+  ASSERT_TRUE(metrics.contains("stages"));
+  const nlohmann::json& stages = metrics["stages"];
+  const double run_wall = stages["run"]["wall_s"].get<double>();
+  const double run_cpu = stages["run"]["cpu_s"].get<double>();
+  EXPECT_DOUBLE_EQ(run_wall, metrics["wall_time_s"].get<double>()) << "one span, two names";
+  double wall = 0, cpu = 0;
+  for (std::size_t i = 0; i < kStageCount; ++i) {
+    const char* key = StageKey(static_cast<Stage>(i));
+    ASSERT_TRUE(stages.contains(key)) << key;
+    EXPECT_GE(stages[key]["wall_s"].get<double>(), 0.0) << key;
+    EXPECT_GE(stages[key]["cpu_s"].get<double>(), 0.0) << key;
+    wall += stages[key]["wall_s"].get<double>();
+    cpu += stages[key]["cpu_s"].get<double>();
+  }
+  EXPECT_LE(wall, run_wall);
+  EXPECT_LE(cpu, run_cpu);
+  ASSERT_TRUE(stages.contains("other"));
+  EXPECT_NEAR(stages["other"]["wall_s"].get<double>(), run_wall - wall, kSumTolerance_s);
+  EXPECT_NEAR(stages["other"]["cpu_s"].get<double>(), run_cpu - cpu, kSumTolerance_s);
+  // The run drove, scanned, registered and wrote files: those stages took time.
+  for (const char* key : {"physics_driving", "physics_standing", "ray_casting", "registration",
+                          "map_update", "outputs", "ground_truth"}) {
+    EXPECT_GT(stages[key]["cpu_s"].get<double>(), 0.0) << key;
+  }
+  fs::remove_all(dir);
 }
 
 TEST(RunSimMission, NoWorldFileIsABadSpec) {

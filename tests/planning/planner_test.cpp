@@ -6,6 +6,7 @@
 #include <boost/graph/adjacency_list.hpp>
 #include <boost/graph/dijkstra_shortest_paths.hpp>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -71,6 +72,81 @@ double BglCost(const TraversabilityGrid& T, std::size_t s, std::size_t t) {
   std::vector<double> d(T.geometry.cell_count());
   boost::dijkstra_shortest_paths(g, s, boost::distance_map(d.data()));
   return d[t];
+}
+
+// Bit for bit, NaN included: a reused buffer must leave nothing of what it held.
+template <typename T>
+bool SameBits(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+}
+
+// Rough ground with scattered unknown cells and a few spikes (steps): every layer and every
+// blocked kind has cells.
+ElevationLayers RoughLayers(int sx, int sy, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  return MakeLayers(sx, sy, 0.1, [&](int i, int j) {
+    if (u(rng) < 0.05) return std::nan("");
+    return 0.08 * std::sin(0.3 * i) * std::cos(0.25 * j) + 0.01 * u(rng) +
+           (u(rng) < 0.01 ? 0.3 : 0.0);
+  });
+}
+
+TEST(BuildTraversabilityInto, AReusedGridEqualsAFreshOne) {
+  const ElevationLayers before = RoughLayers(60, 50, 1), now = RoughLayers(48, 40, 2);
+  PlannerConfig first;  // the P3-AT's footprint, unknown cells forbidden
+  PlannerConfig second = PointRobot();
+  second.unknown = UnknownPolicy::kPenalise;
+  second.unknown_penalty = 0.5;
+  TraversabilityGrid reused;
+  BuildTraversabilityInto(before, first, reused);
+  reused.occupancy_cost.assign(reused.z_m.size(), 7.0f);  // as an occupancy grid's would be
+  BuildTraversabilityInto(now, second, reused);
+  const TraversabilityGrid fresh = BuildTraversability(now, second);
+  EXPECT_EQ(reused.geometry.size_x, fresh.geometry.size_x);
+  EXPECT_EQ(reused.geometry.size_y, fresh.geometry.size_y);
+  EXPECT_EQ(reused.config.robot.width_m, fresh.config.robot.width_m);
+  EXPECT_TRUE(SameBits(reused.z_m, fresh.z_m));
+  EXPECT_TRUE(SameBits(reused.enter_cost, fresh.enter_cost));
+  EXPECT_TRUE(SameBits(reused.roughness_m, fresh.roughness_m));
+  EXPECT_TRUE(SameBits(reused.phi_x_rad, fresh.phi_x_rad));
+  EXPECT_TRUE(SameBits(reused.phi_y_rad, fresh.phi_y_rad));
+  EXPECT_TRUE(reused.occupancy_cost.empty());
+  EXPECT_TRUE(SameBits(reused.blocked, fresh.blocked));
+  EXPECT_TRUE(SameBits(reused.moves, fresh.moves));
+  EXPECT_TRUE(SameBits(reused.move_cost, fresh.move_cost));
+  EXPECT_EQ(reused.min_straight_cost, fresh.min_straight_cost);
+  EXPECT_EQ(reused.min_diagonal_cost, fresh.min_diagonal_cost);
+  EXPECT_EQ(reused.max_edge_cost, fresh.max_edge_cost);
+  EXPECT_EQ(reused.min_enter_cost, fresh.min_enter_cost);
+  // Both kinds of cell the first build had (hazards, unknown) are in this one too: the check
+  // compared grids that differ from the first one's cell by cell.
+  EXPECT_NE(std::count(fresh.blocked.begin(), fresh.blocked.end(), Blocked::kStep), 0);
+  EXPECT_NE(std::count(fresh.blocked.begin(), fresh.blocked.end(), Blocked::kFree), 0);
+}
+
+TEST(ComputeLayersInto, AReusedSetOfLayersEqualsAFreshOne) {
+  ElevationLayers reused = RoughLayers(60, 50, 3);  // bigger, other heights and unknown cells
+  ElevationMap map(GridGeometry::FromArea(0, 0, 4.8, 4.0, 0.1));
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u(0, 1);
+  std::vector<Eigen::Vector3f> pts;
+  for (int n = 0; n < 4000; ++n) pts.emplace_back(4.8f * u(rng), 4.0f * u(rng), 0.05f * u(rng));
+  (void)map.InsertPoints(pts.data(), pts.size());
+  mapping::ComputeLayersInto(map, {}, reused);
+  const ElevationLayers fresh = mapping::ComputeLayers(map);
+  EXPECT_EQ(reused.geometry.size_x, fresh.geometry.size_x);
+  EXPECT_EQ(reused.geometry.size_y, fresh.geometry.size_y);
+  EXPECT_TRUE(SameBits(reused.state, fresh.state));
+  EXPECT_TRUE(SameBits(reused.count, fresh.count));
+  EXPECT_TRUE(SameBits(reused.mean_z, fresh.mean_z));
+  EXPECT_TRUE(SameBits(reused.min_z, fresh.min_z));
+  EXPECT_TRUE(SameBits(reused.max_z, fresh.max_z));
+  EXPECT_TRUE(SameBits(reused.roughness, fresh.roughness));
+  EXPECT_TRUE(SameBits(reused.phi_x, fresh.phi_x));
+  EXPECT_TRUE(SameBits(reused.phi_y, fresh.phi_y));
+  EXPECT_TRUE(SameBits(reused.clearance_z, fresh.clearance_z));
+  EXPECT_TRUE(SameBits(reused.plane_residual, fresh.plane_residual));
 }
 
 TEST(Planner, SerpentineCorridorGivesItsUniqueOptimalPath) {

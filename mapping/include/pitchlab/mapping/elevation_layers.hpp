@@ -92,7 +92,11 @@ struct ElevationLayers {
 /// Eq. 3: population standard deviation of the cell's heights [m]; NaN for an unknown cell.
 float Roughness(const CellStats& cell);
 
-/// Computes every layer. O(cells).
+/// Computes every layer. O(cells). Throws std::invalid_argument on a bad config.
 ElevationLayers ComputeLayers(const ElevationMap& map, const LayerConfig& config = {});
+
+/// The same into `layers`, reusing its buffers: a caller that derives the layers of one map at
+/// every stop allocates them (and the kernel clears their pages) once, not every time.
+void ComputeLayersInto(const ElevationMap& map, const LayerConfig& config, ElevationLayers& layers);
 
 }  // namespace pitchlab::mapping

@@ -12,6 +12,7 @@
 
 #include "pitchlab/mission/height_fit.hpp"
 #include "pitchlab/mission/path_follower.hpp"
+#include "pitchlab/mission/stage_times.hpp"
 #include "pitchlab/mapping/elevation_map.hpp"
 #include "pitchlab/mapping/map_builder.hpp"
 #include "pitchlab/planning/planner.hpp"
@@ -91,6 +92,10 @@ struct MissionProbes {
   std::function<Eigen::Isometry3d()> true_pose;
   /// True once the run should stop now (Ctrl-C on hardware); polled wherever the budget is.
   std::function<bool()> interrupted;
+  /// The time the scanner has spent making lines so far (simulation only: casting rays), which
+  /// splits a scan's time into ray casting and the physics stepped around it. May be empty: a
+  /// scan's whole time is then kPhysicsStanding.
+  std::function<sensors::Elapsed()> line_time;
 };
 
 /// The planner as the mission runs it: the robot's width grown by the safety margin each side.
@@ -142,6 +147,9 @@ struct MissionResult {
   double start_s = 0, end_s = 0;        ///< clock at start and end [s]
   double odometry_distance_m = 0;       ///< driven, by odometry [m]
   double max_tilt_rad = 0;              ///< largest tilt seen by the attitude probe [rad]
+  /// Time spent in the loop's stages (stage_times.hpp); those of a whole run (ground truth,
+  /// outputs, scoring) are the caller's to add.
+  StageTimes stages;
 };
 
 /// Called after each stop is planned (for output as it happens) and with progress text.

@@ -13,6 +13,7 @@
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mission/run_folder.hpp"
 #include "pitchlab/mission/run_scoring.hpp"
+#include "pitchlab/mission/stage_times.hpp"
 
 namespace pitchlab::mission {
 
@@ -28,6 +29,8 @@ struct RunContext {
   planning::PlannerConfig planner;
   mapping::LayerConfig layers;  ///< how the mission derived the map's layers
   double wall_time_s = 0;       ///< whole run including set-up [s]
+  /// Where the run's time went (simulated runs); its `run` is the same span as wall_time_s.
+  std::optional<StageBreakdown> stages;
 };
 
 /// Writes stops/NN/{scan.pcd, registration.json, path.csv, path.geojson, map.png, map_small.png}.
@@ -44,9 +47,20 @@ nlohmann::json RunMetrics(const RunContext& context, const MissionResult& result
 
 /// Everything written at the end (see the file comment), report.html last. `truth` may be null
 /// (hardware runs), `truth_optimum` is the true optimal path when known; with `truth` also
-/// hazard_errors.png (run_pictures.hpp).
+/// hazard_errors.png (run_pictures.hpp). WriteFinalData then WriteSummary.
 void WriteFinalOutputs(RunFolder& folder, const RunContext& context, const MissionResult& result,
                        const std::optional<RunScore>& score, const mapping::ElevationLayers* truth,
                        const std::optional<planning::Path>& truth_optimum);
+
+/// The end's files but metrics.json and report.html: config, clouds, maps, trajectories,
+/// pictures. Returns the final map's layers, which the summary shows.
+mapping::ElevationLayers WriteFinalData(RunFolder& folder, const RunContext& context,
+                                        const MissionResult& result,
+                                        const mapping::ElevationLayers* truth,
+                                        const std::optional<planning::Path>& truth_optimum);
+
+/// metrics.json and report.html, last: they hold the run's time up to them (context).
+void WriteSummary(RunFolder& folder, const RunContext& context, const MissionResult& result,
+                  const std::optional<RunScore>& score, const mapping::ElevationLayers& layers);
 
 }  // namespace pitchlab::mission

@@ -151,4 +151,9 @@ struct TraversabilityGrid {
 TraversabilityGrid BuildTraversability(const mapping::ElevationLayers& layers,
                                        const PlannerConfig& config);
 
+/// The same into `grid`, reusing its buffers (about 40 bytes a cell): a caller that plans on the
+/// same map at every stop allocates them (and the kernel clears their pages) once.
+void BuildTraversabilityInto(const mapping::ElevationLayers& layers, const PlannerConfig& config,
+                             TraversabilityGrid& grid);
+
 }  // namespace pitchlab::planning

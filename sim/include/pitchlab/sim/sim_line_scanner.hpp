@@ -7,6 +7,7 @@
 #include "pitchlab/sensors/lms200.hpp"
 #include "pitchlab/sensors/ray_caster.hpp"
 #include "pitchlab/sensors/scan_source.hpp"
+#include "pitchlab/sensors/stopwatch.hpp"
 #include "pitchlab/sim/simulation.hpp"
 
 namespace pitchlab::sim {
@@ -22,6 +23,9 @@ class SimLineScanner final : public sensors::LineScanner {
   const sensors::Lms200Model& model() const { return model_; }
   /// Rays reach this far: 5 % beyond the range mode's maximum, so over-range can be flagged [m].
   float cast_range_m() const;
+  /// Time spent so far making lines: casting their rays and turning ranges into readings, i.e.
+  /// all of NextLine but the physics it steps (for a run's stage breakdown).
+  const sensors::Elapsed& line_time() const { return line_time_; }
 
  private:
   void CastAt(const Eigen::Isometry3d& T_world_laser, double offset_rad, std::vector<float>& out,
@@ -33,6 +37,7 @@ class SimLineScanner final : public sensors::LineScanner {
   sensors::Lms200Model model_;
   std::vector<float> origins_, directions_, ranges_, edge_lo_, edge_hi_, along_, across_,
       cos_incidence_;
+  sensors::Elapsed line_time_;
 };
 
 }  // namespace pitchlab::sim
