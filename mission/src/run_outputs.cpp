@@ -1,5 +1,6 @@
 #include "pitchlab/mission/run_outputs.hpp"
 #include "pitchlab/mission/registration_json.hpp"
+#include "pitchlab/mission/trajectory_outputs.hpp"
 #include "run_pictures.hpp"
 #include "run_report.hpp"
 
@@ -171,6 +172,7 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
   for (const StopRecord& s : r.stops) failed += !s.merge.merged && s.index > 0;
   m["registration_failures"] = failed;
   if (!r.stops.empty()) m["final_estimate"] = PoseJson(r.stops.back().T_world_base);
+  m["trajectory_error"] = TrajectoryErrorJson(r);  // the stops' ATE and RPE (null without truth)
   if (score) {
     m["distance_m"] = score->true_distance_m;
     m["final_pose_error"] = {{"translation_m", score->final_translation_error_m},
@@ -228,6 +230,7 @@ void WriteFinalOutputs(RunFolder& folder, const RunContext& c, const MissionResu
                                     folder.File("elevation.asc").string()));
   WriteTrajectoryCsv(folder.File("trajectory_estimated.csv"), r, false);
   WriteTrajectoryCsv(folder.File("trajectory_true.csv"), r, true);
+  WriteStopTrajectories(folder, r);
   if (c.geodetic_origin) {
     WriteTrajectoryGeoJson(folder.File("trajectories.geojson"), r, *c.geodetic_origin);
   }
