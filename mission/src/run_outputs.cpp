@@ -75,6 +75,13 @@ void WriteTrajectoryGeoJson(const std::filesystem::path& file, const MissionResu
                 nlohmann::json{{"type", "FeatureCollection"}, {"features", features}}.dump(1));
 }
 
+// The waypoints a mission drove through before its goal, and how many it reached.
+nlohmann::json RouteJson(const RunContext& c, const MissionResult& r) {
+  nlohmann::json via = nlohmann::json::array();
+  for (const Eigen::Vector2d& p : c.via) via.push_back({{"x_m", p.x()}, {"y_m", p.y()}});
+  return {{"via", via}, {"waypoints_reached", r.waypoints_reached}};
+}
+
 nlohmann::json RegistrationJson(const StopRecord& stop) {
   const mapping::RegistrationResult& reg = stop.merge.registration;
   nlohmann::json matrix = nlohmann::json::array();
@@ -172,6 +179,7 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
   for (const StopRecord& s : r.stops) failed += !s.merge.merged && s.index > 0;
   m["registration_failures"] = failed;
   if (!r.stops.empty()) m["final_estimate"] = PoseJson(r.stops.back().T_world_base);
+  if (!c.via.empty()) m["route"] = RouteJson(c, r);  // run --via, --round-trip
   m["trajectory_error"] = TrajectoryErrorJson(r);  // the stops' ATE and RPE (null without truth)
   if (score) {
     m["distance_m"] = score->true_distance_m;

@@ -23,7 +23,10 @@ namespace pitchlab::mission {
 
 struct MissionConfig {
   Eigen::Vector2d goal_m = Eigen::Vector2d::Zero();  ///< goal in the world frame [m]
-  double goal_tolerance_m = 0.5;                     ///< success within this of the goal [m]
+  /// Waypoints driven through, in order, before the goal (world frame): each is reached like the
+  /// goal, within goal_tolerance_m, and then the robot plans to the next [m].
+  std::vector<Eigen::Vector2d> via_m;
+  double goal_tolerance_m = 0.5;  ///< success within this of the goal (and of a waypoint) [m]
   double drive_per_stop_m = 4.0;                     ///< path length driven between two scans [m]
   int max_stops = 40;                                ///< scans at most [1]
   double time_budget_s = 1800.0;  ///< mission time at most (simulated or real) [s]
@@ -122,7 +125,9 @@ struct StopRecord {
   /// With elevation_from_odometry: the map's unknown cells the scan filled; it leaves the cells
   /// the map has already seen as they are [1].
   std::size_t elevation_cells_filled = 0;
-  double distance_to_goal_m = 0;  ///< from the estimate [m]
+  /// What this stop heads for: via_m[target] while target < via_m.size(), else the goal [1].
+  std::size_t target = 0;
+  double distance_to_goal_m = 0;  ///< from the estimate to the target it heads for [m]
 };
 
 /// A pose of the robot while driving (sampled every control period).
@@ -142,6 +147,7 @@ struct MissionResult {
   double start_s = 0, end_s = 0;        ///< clock at start and end [s]
   double odometry_distance_m = 0;       ///< driven, by odometry [m]
   double max_tilt_rad = 0;              ///< largest tilt seen by the attitude probe [rad]
+  std::size_t waypoints_reached = 0;    ///< of MissionConfig::via_m, in order [1]
 };
 
 /// Called after each stop is planned (for output as it happens) and with progress text.
