@@ -236,6 +236,8 @@ MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
   }
   result_.end_s = probes_.now_s();
   result_.map_cloud_world = mapping::TransformCloud(builder_.MapCloud(), T_world_map_);
+  result_.loop_counts = builder_.loop_closures();
+  result_.loop_closures = builder_.accepted_loops();
   return std::move(result_);
 }
 
@@ -303,8 +305,12 @@ bool Mission::Stop(int k) {
   if (!merge) stop.merge.registration.reason = merge.error().message;
   // A failed registration is never merged: the pose comes from odometry and the map keeps
   // what it had.
-  stop.T_world_base =
-      stop.merge.merged ? T_world_map_ * stop.merge.T_map_base : stop.T_world_base_odom;
+  // With loop closure a loop closed in this merge may have moved the new pose since: the graph's
+  // latest estimate of it is the trajectory's last.
+  const Eigen::Isometry3d T_map_base = config_.registration.loop_closure.enabled && stop.merge.merged
+                                           ? builder_.trajectory().back().T_map_base
+                                           : stop.merge.T_map_base;
+  stop.T_world_base = stop.merge.merged ? T_world_map_ * T_map_base : stop.T_world_base_odom;
   // A scan whose registration failed is never merged into the map cloud; the elevation map
   // still takes it at the odometry pose (said in the stop record), or an unregistrable stretch
   // of terrain would stay unknown and the robot could never plan across it. That pose's height

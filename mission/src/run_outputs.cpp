@@ -1,4 +1,5 @@
 #include "pitchlab/mission/run_outputs.hpp"
+#include "pitchlab/mission/loop_closure_metrics.hpp"
 #include "pitchlab/mission/registration_json.hpp"
 #include "pitchlab/mission/trajectory_outputs.hpp"
 #include "run_pictures.hpp"
@@ -180,6 +181,7 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
   m["registration_failures"] = failed;
   if (!r.stops.empty()) m["final_estimate"] = PoseJson(r.stops.back().T_world_base);
   if (!c.via.empty()) m["route"] = RouteJson(c, r);  // run --via, --round-trip
+  if (c.loop_closure) m["loop_closures"] = LoopClosureJson(r);  // run: {loop_closure: true}
   m["trajectory_error"] = TrajectoryErrorJson(r);  // the stops' ATE and RPE (null without truth)
   if (score) {
     m["distance_m"] = score->true_distance_m;

@@ -149,6 +149,7 @@ RunContext SimContext(const SimMissionSpec& spec, const RunSettings& settings,
   context.config_yaml = AppConfigToYaml(spec.config) + RunSettingsToYaml(settings) + truth.str();
   context.planner = MissionPlanner(settings.mission);
   context.layers = settings.mission.layers;
+  context.loop_closure = settings.mission.registration.loop_closure.enabled;
   return context;
 }
 

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -80,6 +81,27 @@ TEST_F(RouteCli, ARoundTripThroughAWaypointVisitsItThenTheGoalAndComesBack) {
   EXPECT_NEAR(metrics["true_optimal_cost"].get<double>(), kRoute_m, kLegEnds_m);
   // Driven: the route less the goal tolerance at each of its three arrivals, at least.
   EXPECT_GT(metrics["distance_m"].get<double>(), kRoute_m - 3 * kGoalTolerance_m);
+  // Loop closure is off unless the config switches it on: no loop metrics.
+  EXPECT_FALSE(metrics.contains("loop_closures"));
+  EXPECT_NE(Slurp(run / "config.yaml").find("loop_closure: false"), std::string::npos);
+}
+
+TEST_F(RouteCli, WithLoopClosureOnTheRoundTripClosesLoopsAndNoneIsWrong) {
+  const fs::path run = dir_ / "round_trip_loops", config = dir_ / "loops.yaml";
+  std::ofstream(config) << "run: {loop_closure: true}\n";
+  const CliResult r = Exec("run --world office --seed 2 --quiet --via -6.5,0 --goal -4.5,0 "
+                           "--round-trip --config " + config.string() + " --out " + run.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json metrics = nlohmann::json::parse(Slurp(run / "metrics.json"));
+  EXPECT_TRUE(metrics["success"].get<bool>()) << metrics["reason"];
+  const nlohmann::json& loops = metrics["loop_closures"];
+  ASSERT_TRUE(loops.is_object()) << metrics.dump(1);
+  // Stop 3, at the far waypoint, sees the corridor stops 0 and 1 saw, 3.5 m and more back.
+  EXPECT_GE(loops["accepted"].get<int>(), 1);
+  EXPECT_LE(loops["accepted"].get<int>() + loops["rejected"].get<int>(),
+            loops["registered"].get<int>() - loops["registration_failed"].get<int>());
+  EXPECT_EQ(loops["edges"].size(), loops["accepted"].get<std::size_t>());
+  EXPECT_EQ(loops["wrong"].get<int>(), 0) << loops.dump(1);
 }
 
 TEST_F(RouteCli, BadWaypointsExitTwoWithAClearMessageAndNoFolder) {

@@ -148,6 +148,10 @@ struct MissionResult {
   double odometry_distance_m = 0;       ///< driven, by odometry [m]
   double max_tilt_rad = 0;              ///< largest tilt seen by the attitude probe [rad]
   std::size_t waypoints_reached = 0;    ///< of MissionConfig::via_m, in order [1]
+  /// With registration.loop_closure on: MapBuilder's counts over the run and the loop edges it
+  /// accepted (scan indices are MergeStep::scan_index); zero and empty when off.
+  mapping::LoopClosureCounts loop_counts;
+  std::vector<mapping::LoopClosure> loop_closures;
 };
 
 /// Called after each stop is planned (for output as it happens) and with progress text.
