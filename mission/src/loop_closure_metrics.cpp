@@ -35,8 +35,8 @@ nlohmann::json LoopClosureJson(const MissionResult& result) {
   for (const mapping::LoopClosure& loop : result.loop_closures) {
     const StopRecord& from = MergedStop(by_scan, loop.from_scan_index);
     const StopRecord& to = MergedStop(by_scan, loop.to_scan_index);
-    nlohmann::json e = {{"from_stop", from.index}, {"to_stop", to.index},
-                        {"chi2_increase", loop.chi2_increase}};
+    nlohmann::json e = {
+        {"from_stop", from.index}, {"to_stop", to.index}, {"chi2_increase", loop.chi2_increase}};
     if (from.T_world_base_true && to.T_world_base_true) {
       const Eigen::Isometry3d T_true = from.T_world_base_true->inverse() * *to.T_world_base_true;
       const Eigen::Isometry3d d = T_true.inverse() * loop.T_from_to;

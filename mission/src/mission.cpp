@@ -307,9 +307,9 @@ bool Mission::Stop(int k) {
   // what it had.
   // With loop closure a loop closed in this merge may have moved the new pose since: the graph's
   // latest estimate of it is the trajectory's last.
-  const Eigen::Isometry3d T_map_base = config_.registration.loop_closure.enabled && stop.merge.merged
-                                           ? builder_.trajectory().back().T_map_base
-                                           : stop.merge.T_map_base;
+  const bool graph_pose = config_.registration.loop_closure.enabled && stop.merge.merged;
+  const Eigen::Isometry3d T_map_base =
+      graph_pose ? builder_.trajectory().back().T_map_base : stop.merge.T_map_base;
   stop.T_world_base = stop.merge.merged ? T_world_map_ * T_map_base : stop.T_world_base_odom;
   // A scan whose registration failed is never merged into the map cloud; the elevation map
   // still takes it at the odometry pose (said in the stop record), or an unregistrable stretch

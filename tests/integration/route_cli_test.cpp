@@ -51,8 +51,10 @@ std::size_t FirstWithin(const std::vector<mapping::StampedPose>& poses, const Ei
 
 TEST_F(RouteCli, ARoundTripThroughAWaypointVisitsItThenTheGoalAndComesBack) {
   const fs::path run = dir_ / "round_trip";
-  const CliResult r = Exec("run --world office --seed 2 --quiet --via -6.5,0 --goal -4.5,0 "
-                           "--round-trip --out " + run.string());
+  const CliResult r = Exec(
+      "run --world office --seed 2 --quiet --via -6.5,0 --goal -4.5,0 "
+      "--round-trip --out " +
+      run.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json metrics = nlohmann::json::parse(Slurp(run / "metrics.json"));
   EXPECT_TRUE(metrics["success"].get<bool>()) << metrics["reason"];
@@ -89,8 +91,10 @@ TEST_F(RouteCli, ARoundTripThroughAWaypointVisitsItThenTheGoalAndComesBack) {
 TEST_F(RouteCli, WithLoopClosureOnTheRoundTripClosesLoopsAndNoneIsWrong) {
   const fs::path run = dir_ / "round_trip_loops", config = dir_ / "loops.yaml";
   std::ofstream(config) << "run: {loop_closure: true}\n";
-  const CliResult r = Exec("run --world office --seed 2 --quiet --via -6.5,0 --goal -4.5,0 "
-                           "--round-trip --config " + config.string() + " --out " + run.string());
+  const CliResult r = Exec(
+      "run --world office --seed 2 --quiet --via -6.5,0 --goal -4.5,0 "
+      "--round-trip --config " +
+      config.string() + " --out " + run.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json metrics = nlohmann::json::parse(Slurp(run / "metrics.json"));
   EXPECT_TRUE(metrics["success"].get<bool>()) << metrics["reason"];

@@ -11,9 +11,8 @@ namespace {
 
 Eigen::Isometry3d Pose(double x, double y, double yaw_deg) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() =
-      Eigen::AngleAxisd(yaw_deg * 3.14159265358979323846 / 180, Eigen::Vector3d::UnitZ())
-          .toRotationMatrix();
+  T.linear() = Eigen::AngleAxisd(yaw_deg * 3.14159265358979323846 / 180, Eigen::Vector3d::UnitZ())
+                   .toRotationMatrix();
   T.translation() = Eigen::Vector3d(x, y, 0);
   return T;
 }

@@ -24,9 +24,9 @@ namespace fs = std::filesystem;
 constexpr double kRoundTrip = 1e-9;
 
 fs::path Scratch() {
-  const fs::path dir = fs::temp_directory_path() /
-                       ("pitchlab_trajectory_" + std::to_string(::getpid()) + "_" +
-                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  const fs::path dir =
+      fs::temp_directory_path() / ("pitchlab_trajectory_" + std::to_string(::getpid()) + "_" +
+                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -96,10 +96,8 @@ TEST(WriteStopTrajectories, TheTumFilesHoldEachStopAtItsScansTime) {
   WriteStopTrajectories(folder, r);
   folder.Commit();
   for (const bool truth : {false, true}) {
-    const auto poses =
-        mapping::ReadTumTrajectory((dir / "run" / (truth ? "trajectory_true.tum"
-                                                         : "trajectory_estimated.tum"))
-                                       .string());
+    const auto poses = mapping::ReadTumTrajectory(
+        (dir / "run" / (truth ? "trajectory_true.tum" : "trajectory_estimated.tum")).string());
     ASSERT_TRUE(poses) << poses.error().message;
     ASSERT_EQ(poses->size(), r.stops.size());
     for (std::size_t k = 0; k < r.stops.size(); ++k) {
@@ -159,8 +157,7 @@ TEST(RunSimMission, MetricsHoldTheTrajectoryErrorOfItsOwnTumFiles) {
   spec.world_file = dir / "floor.xml";
   const SimMissionOutcome run = RunSimMission(spec, dir / "run");
   ASSERT_TRUE(run.result.success) << run.result.reason;
-  const nlohmann::json metrics =
-      nlohmann::json::parse(ReadBinaryFile(run.folder / "metrics.json"));
+  const nlohmann::json metrics = nlohmann::json::parse(ReadBinaryFile(run.folder / "metrics.json"));
   const nlohmann::json& t = metrics["trajectory_error"];
   const auto est = ReadPoses(run.folder / "trajectory_estimated.tum");
   const auto tru = ReadPoses(run.folder / "trajectory_true.tum");
@@ -172,8 +169,8 @@ TEST(RunSimMission, MetricsHoldTheTrajectoryErrorOfItsOwnTumFiles) {
   const auto per_stop = mapping::RelativePoseErrorPerStop(est, tru);
   ASSERT_TRUE(per_stop) << per_stop.error().message;
   EXPECT_EQ(t["rpe"]["per_stop"]["pairs"].get<int>(), per_stop->pairs);
-  EXPECT_NEAR(t["rpe"]["per_stop"]["translation_rmse_m"].get<double>(),
-              per_stop->translation_rmse, kRoundTrip);
+  EXPECT_NEAR(t["rpe"]["per_stop"]["translation_rmse_m"].get<double>(), per_stop->translation_rmse,
+              kRoundTrip);
   EXPECT_NEAR(t["rpe"]["per_stop"]["rotation_max_deg"].get<double>(), per_stop->rotation_max_deg,
               1e-6);
   const auto per_metre = mapping::RelativePoseErrorPerMetre(est, tru, kRpeSegmentM);
