@@ -429,6 +429,13 @@ json MakeRecord(const SweepSettings& s, const BenchRun& run, std::optional<int> 
   r["odometry_distance_m"] = Field(metrics, "/odometry_distance_m");
   r["final_pose_error_m"] = Field(metrics, "/final_pose_error/translation_m");
   r["final_pose_error_deg"] = Field(metrics, "/final_pose_error/rotation_deg");
+  // The stops' absolute trajectory error (metrics.json "trajectory_error"): unaligned, since the
+  // start is known, and after SE(3) alignment.
+  r["ate_m"] = Field(metrics, "/trajectory_error/ate/unaligned/rmse_m");
+  r["ate_aligned_m"] = Field(metrics, "/trajectory_error/ate/aligned/rmse_m");
+  // With run: {loop_closure: true} only (null otherwise).
+  r["loop_closures_accepted"] = Field(metrics, "/loop_closures/accepted");
+  r["loop_closures_wrong"] = Field(metrics, "/loop_closures/wrong");
   r["final_true_distance_to_goal_m"] = Field(metrics, "/final_true_distance_to_goal_m");
   r["max_registration_error_m"] = Field(metrics, "/max_registration_error/translation_m");
   r["max_registration_error_deg"] = Field(metrics, "/max_registration_error/rotation_deg");
@@ -598,6 +605,14 @@ std::vector<double> FalseHazardPercent(const std::vector<const json*>& records) 
   return v;
 }
 
+// Null when no record has the value (runs without loop closure).
+json Sum(const std::vector<double>& v) {
+  if (v.empty()) return json();
+  double sum = 0;
+  for (double x : v) sum += x;
+  return sum;
+}
+
 json Max(const std::vector<double>& v) {
   if (v.empty()) return json();
   return *std::max_element(v.begin(), v.end());
@@ -624,6 +639,10 @@ json SummaryRow(const std::string& world, const std::vector<const json*>& record
           {"max_wall_time_s", Max(wall)},
           {"median_real_time_factor", Median(Numbers(records, "real_time_factor"))},
           {"median_final_pose_error_m", Median(Numbers(records, "final_pose_error_m"))},
+          {"median_ate_m", Median(Numbers(records, "ate_m"))},
+          {"median_ate_aligned_m", Median(Numbers(records, "ate_aligned_m"))},
+          {"loop_closures_accepted", Sum(Numbers(records, "loop_closures_accepted"))},
+          {"wrong_loop_closures", Sum(Numbers(records, "loop_closures_wrong"))},
           {"max_registration_error_m", Max(Numbers(records, "max_registration_error_m"))},
           {"max_registration_step_m", Max(Numbers(records, "registration_step_max_m"))},
           {"max_registration_step_deg", Max(Numbers(records, "registration_step_max_deg"))},
@@ -665,10 +684,13 @@ std::string Cell(const json& v, const char* format) {
 void PrintTable(const json& summary, std::FILE* out) {
   // "reg max": the worst pose error of a registered stop (with the drift it inherits); "reg step
   // max": the worst error of one registration, the motion since the last merged stop; "false
-  // haz": the final map's false hazard cells per cell compared with the truth, median over runs.
-  std::fprintf(out, "%-14s %5s %5s %8s %18s %8s %14s %13s %20s %13s\n", "world", "runs", "ok",
-               "success", "wall med/max [s]", "RTF med", "pose err [m]", "reg max [m]",
-               "reg step max [m/deg]", "false haz [%]");
+  // haz": the final map's false hazard cells per cell compared with the truth, median over runs;
+  // "ATE med": the stops' absolute trajectory error (RMSE, unaligned), median over runs; "wrong
+  // loops": loop closures more than 0.1 m or 1 deg off the truth, summed ("-": loop closure off).
+  std::fprintf(out, "%-14s %5s %5s %8s %18s %8s %14s %13s %13s %20s %13s %12s\n", "world",
+               "runs", "ok", "success", "wall med/max [s]", "RTF med", "pose err [m]",
+               "ATE med [m]", "reg max [m]", "reg step max [m/deg]", "false haz [%]",
+               "wrong loops");
   std::vector<json> rows(summary["worlds"].begin(), summary["worlds"].end());
   rows.push_back(summary["total"]);
   for (const json& r : rows) {
@@ -676,13 +698,15 @@ void PrintTable(const json& summary, std::FILE* out) {
         Cell(r["median_wall_time_s"], "%.1f") + " / " + Cell(r["max_wall_time_s"], "%.1f");
     const std::string step = Cell(r["max_registration_step_m"], "%.3f") + " / " +
                              Cell(r["max_registration_step_deg"], "%.2f");
-    std::fprintf(out, "%-14s %5zu %5zu %7.1f%% %18s %8s %14s %13s %20s %13s\n",
+    std::fprintf(out, "%-14s %5zu %5zu %7.1f%% %18s %8s %14s %13s %13s %20s %13s %12s\n",
                  r["world"].get<std::string>().c_str(), r["runs"].get<std::size_t>(),
                  r["successes"].get<std::size_t>(), 100.0 * r["success_rate"].get<double>(),
                  wall.c_str(), Cell(r["median_real_time_factor"], "%.1fx").c_str(),
                  Cell(r["median_final_pose_error_m"], "%.3f").c_str(),
+                 Cell(r["median_ate_m"], "%.3f").c_str(),
                  Cell(r["max_registration_error_m"], "%.3f").c_str(), step.c_str(),
-                 Cell(r["median_false_hazard_percent"], "%.2f").c_str());
+                 Cell(r["median_false_hazard_percent"], "%.2f").c_str(),
+                 Cell(r["wrong_loop_closures"], "%.0f").c_str());
   }
   for (const auto& [reason, count] : summary["total"]["failure_reasons"].items()) {
     std::fprintf(out, "  failed %dx: %s\n", count.get<int>(), reason.c_str());

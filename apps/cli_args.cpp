@@ -137,6 +137,42 @@ std::vector<double> CliArgs::GetNumbers(const std::string& name, std::size_t cou
   return numbers;
 }
 
+std::vector<std::pair<double, double>> CliArgs::GetPoints(const std::string& name) const {
+  const std::string text = Get(name);
+  std::vector<std::pair<double, double>> points;
+  std::stringstream ss(text);
+  std::string point;
+  int k = 0;
+  while (std::getline(ss, point, ';')) {
+    ++k;
+    const std::string where = "--" + name + " '" + text + "': point " + std::to_string(k) + " '" +
+                              point + "' ";
+    std::vector<double> xy;
+    std::stringstream ps(point);
+    std::string item;
+    while (std::getline(ps, item, ',')) {
+      std::size_t used = 0;
+      double v = 0;
+      try {
+        v = std::stod(item, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != item.size() || !std::isfinite(v)) {
+        throw CliError(where + "has '" + item + "', not a number");
+      }
+      xy.push_back(v);
+    }
+    if (xy.size() != 2) throw CliError(where + "needs 2 comma-separated numbers (x,y)");
+    points.emplace_back(xy[0], xy[1]);
+  }
+  // getline drops one trailing empty item: "1,2;" would pass as one point without this.
+  if (points.empty() || text.back() == ';') {
+    throw CliError("--" + name + " '" + text + "' needs x,y[;x,y...] (a point after each ';')");
+  }
+  return points;
+}
+
 double CliArgs::GetNumber(const std::string& name, double min, double max) const {
   const std::string text = Get(name);
   double v = 0;

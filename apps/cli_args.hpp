@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pitchlab::apps {
@@ -40,6 +41,9 @@ class CliArgs {
 
   /// "1.5,-2,90" -> {1.5, -2, 90}; exactly `count` finite numbers or CliError naming the option.
   std::vector<double> GetNumbers(const std::string& name, std::size_t count) const;
+  /// "1,2;3.5,-1" -> {{1, 2}, {3.5, -1}}: one or more points of two finite numbers each,
+  /// ';'-separated, else CliError naming the option, the point and what is wrong with it.
+  std::vector<std::pair<double, double>> GetPoints(const std::string& name) const;
   /// One number within [min, max] (max may be infinite: then "inf" is accepted too), else
   /// CliError naming the option, the value and the range.
   double GetNumber(const std::string& name, double min, double max) const;

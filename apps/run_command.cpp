@@ -31,6 +31,11 @@ CliArgs RunArgs() {
               "built-in world (" + BuiltinWorldNames() + ") or any MJCF file", "terrain")
       .Option("start", "x,y,yaw", "start pose: metres, metres, degrees (default: the world's)")
       .Option("goal", "x,y", "goal in metres (default: the world's default goal)")
+      .Option("via", "x,y[;x,y...]",
+              "waypoints in metres to drive through, in order, before the goal")
+      .Flag("round-trip",
+            "to the goal (given or the world's default) and back to the start: success is back "
+            "within the goal tolerance of the start after reaching the goal")
       .Option("robot", "p3at|p3dx", "robot model, overrides the config's robot.model")
       .Option("seed", "N", "seed of every random source, overrides the config's seed")
       .Option("config", "FILE.yaml", "configuration (see README)")
@@ -41,6 +46,25 @@ CliArgs RunArgs() {
       .Flag("json", "print metrics.json on stdout at the end")
       .Flag("quiet", "no progress on stderr");
   return args;
+}
+
+// --via's points, each within the world's bounds (a user's typing mistake: exit 2, before the
+// ground truth is computed).
+std::vector<Eigen::Vector2d> Waypoints(const CliArgs& args, const worlds::WorldMetadata& meta) {
+  std::vector<Eigen::Vector2d> via;
+  const worlds::Bounds2d& b = meta.bounds;
+  for (const auto& [x, y] : args.GetPoints("via")) {
+    if (x < b.x_min_m || x > b.x_max_m || y < b.y_min_m || y > b.y_max_m) {
+      char text[200];
+      std::snprintf(text, sizeof(text),
+                    "--via: waypoint %zu (%g, %g) is off the map: the world spans x %g .. %g, "
+                    "y %g .. %g",
+                    via.size() + 1, x, y, b.x_min_m, b.x_max_m, b.y_min_m, b.y_max_m);
+      throw CliError(text);
+    }
+    via.emplace_back(x, y);
+  }
+  return via;
 }
 
 std::string DefaultOut(const std::string& world, std::uint64_t seed) {
@@ -98,6 +122,8 @@ int RunRun(int argc, char** argv) {
   } else if (!mission::LoadWorldMetadata(world_path).default_goal) {
     throw CliError("world '" + world + "' names no default goal: give --goal x,y");
   }
+  if (args.Has("via")) spec.via_m = Waypoints(args, mission::LoadWorldMetadata(world_path));
+  spec.round_trip = args.Flagged("round-trip");
 
   const mission::SimMissionOutcome run = mission::RunSimMission(
       spec, out, args.Flagged("quiet") ? mission::SimMissionObserver{} : ProgressLines(wall_start));

@@ -109,6 +109,7 @@ RunContext HwContext(const HwMissionSpec& spec, const HwMissionFrame& frame,
       AppConfigToYaml(spec.config) + RunSettingsToYaml(settings) + HwRigConfigToYaml(spec.devices);
   context.planner = MissionPlanner(settings.mission);
   context.layers = settings.mission.layers;
+  context.loop_closure = settings.mission.registration.loop_closure.enabled;
   return context;
 }
 

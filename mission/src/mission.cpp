@@ -196,6 +196,13 @@ class Mission {
     return Propagate(T_world_base_, odo_ref_, odo, Attitude());
   }
   bool OverBudget();
+  // Where the robot heads now: the next waypoint not yet reached, else the goal.
+  const Eigen::Vector2d& Target() const {
+    return target_ < config_.via_m.size() ? config_.via_m[target_] : config_.goal_m;
+  }
+  // The distance from `stop`'s estimate to its target, moving on past every waypoint within the
+  // goal tolerance. True when the goal itself is reached.
+  bool Arrived(StopRecord& stop);
   void Progress(const std::string& text) const {
     if (observer_.on_progress) observer_.on_progress(text);
   }
@@ -210,6 +217,7 @@ class Mission {
   Eigen::Isometry3d T_world_map_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_world_base_ = Eigen::Isometry3d::Identity();  // estimate at odo_ref_
   sensors::Odometry odo_ref_;
+  std::size_t target_ = 0;  // index into config_.via_m; its size: the goal
   // Odometry distance [m] and clock [s] at the last merged scan: the prior's error bound grows
   // from there.
   double merged_distance_m_ = 0, merged_stamp_s_ = 0;
@@ -239,7 +247,7 @@ MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
     odo_ref_ = *odo;
     result_.reason = "stop limit reached (" + std::to_string(config_.max_stops) + " stops)";
     // The laser sees 180 deg ahead: the first scan should look where the robot will go.
-    const Eigen::Vector2d to_goal = config_.goal_m - T_world_start.translation().head<2>();
+    const Eigen::Vector2d to_goal = Target() - T_world_start.translation().head<2>();
     if (TurnTo(std::atan2(to_goal.y(), to_goal.x())) && Rebase()) {
       for (int k = 0; k < config_.max_stops && Stop(k); ++k) {
       }
@@ -247,6 +255,8 @@ MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
   }
   result_.end_s = probes_.now_s();
   result_.map_cloud_world = mapping::TransformCloud(builder_.MapCloud(), T_world_map_);
+  result_.loop_counts = builder_.loop_closures();
+  result_.loop_closures = builder_.accepted_loops();
   return std::move(result_);
 }
 
@@ -329,8 +339,12 @@ bool Mission::Stop(int k) {
   if (!merge) stop.merge.registration.reason = merge.error().message;
   // A failed registration is never merged: the pose comes from odometry and the map keeps
   // what it had.
-  stop.T_world_base =
-      stop.merge.merged ? T_world_map_ * stop.merge.T_map_base : stop.T_world_base_odom;
+  // With loop closure a loop closed in this merge may have moved the new pose since: the graph's
+  // latest estimate of it is the trajectory's last.
+  const bool graph_pose = config_.registration.loop_closure.enabled && stop.merge.merged;
+  const Eigen::Isometry3d T_map_base =
+      graph_pose ? builder_.trajectory().back().T_map_base : stop.merge.T_map_base;
+  stop.T_world_base = stop.merge.merged ? T_world_map_ * T_map_base : stop.T_world_base_odom;
   // A scan whose registration failed is never merged into the map cloud; the elevation map
   // still takes it at the odometry pose (said in the stop record), or an unregistrable stretch
   // of terrain would stay unknown and the robot could never plan across it. That pose's height
@@ -342,15 +356,16 @@ bool Mission::Stop(int k) {
   }
   T_world_base_ = stop.T_world_base;
   odo_ref_ = *odo;
-  stop.distance_to_goal_m = (config_.goal_m - stop.T_world_base.translation().head<2>()).norm();
-  const bool arrived = stop.distance_to_goal_m <= config_.goal_tolerance_m;
+  const bool arrived = Arrived(stop);
   if (!arrived) Plan(stop);
   result_.stops.push_back(std::move(stop));
   const StopRecord& s = result_.stops.back();
   if (observer_.on_stop) observer_.on_stop(s, result_);
   char line[200];
-  std::snprintf(line, sizeof(line), "stop %d: %.1f m to goal, registration %s, %s", k,
-                s.distance_to_goal_m,
+  const std::string target =
+      s.target < config_.via_m.size() ? "waypoint " + std::to_string(s.target + 1) : "goal";
+  std::snprintf(line, sizeof(line), "stop %d: %.1f m to %s, registration %s, %s", k,
+                s.distance_to_goal_m, target.c_str(),
                 s.merge.merged ? mapping::ToString(s.merge.registration.path) : "FAILED",
                 arrived         ? "goal reached"
                 : !s.plan       ? "no path"
@@ -367,6 +382,20 @@ bool Mission::Stop(int k) {
     return false;
   }
   return Drive(s);
+}
+
+bool Mission::Arrived(StopRecord& stop) {
+  const Eigen::Vector2d here = stop.T_world_base.translation().head<2>();
+  for (;;) {
+    stop.target = target_;
+    stop.distance_to_goal_m = (Target() - here).norm();
+    if (stop.distance_to_goal_m > config_.goal_tolerance_m) return false;
+    if (target_ == config_.via_m.size()) return true;
+    Progress("waypoint " + std::to_string(target_ + 1) + " of " +
+             std::to_string(config_.via_m.size()) + " reached at stop " +
+             std::to_string(stop.index));
+    result_.waypoints_reached = ++target_;
+  }
 }
 
 void Mission::UpdateElevation(StopRecord& stop) {
@@ -455,11 +484,11 @@ std::optional<Eigen::Vector2d> EscapeCell(const planning::TraversabilityGrid& gr
 tl::expected<planning::Path, planning::NoPath> Mission::PlanOn(
     const planning::TraversabilityGrid& grid, const Eigen::Vector2d& here) {
   const sensors::ScopedTime timing(result_.stages[Stage::kPlanning]);
-  auto path = planning::PlanPath(grid, here, config_.goal_m, config_.algorithm);
+  auto path = planning::PlanPath(grid, here, Target(), config_.algorithm);
   if (!path && path.error().reason == planning::NoPath::Reason::kStartBlocked) {
     if (const auto escape =
             EscapeCell(grid, here, kEscapeRadius_m, config_.planner.robot.width_m / 2)) {
-      path = planning::PlanPath(grid, *escape, config_.goal_m, config_.algorithm);
+      path = planning::PlanPath(grid, *escape, Target(), config_.algorithm);
       if (path) {  // drive out to the free cell first
         path->waypoints.insert(path->waypoints.begin(),
                                planning::Waypoint{here.x(), here.y(), path->waypoints[0].z_m});
@@ -467,9 +496,9 @@ tl::expected<planning::Path, planning::NoPath> Mission::PlanOn(
     }
   }
   if (!path && path.error().reason == planning::NoPath::Reason::kGoalBlocked) {
-    const bool far = (config_.goal_m - here).norm() > kGoalApproach_m;
+    const bool far = (Target() - here).norm() > kGoalApproach_m;
     const double radius = far ? kGoalApproach_m : config_.goal_tolerance_m;
-    if (const auto near = EscapeCell(grid, config_.goal_m, radius, 0.0)) {
+    if (const auto near = EscapeCell(grid, Target(), radius, 0.0)) {
       auto to_near = planning::PlanPath(grid, here, *near, config_.algorithm);
       if (to_near) path = std::move(to_near);
     }
@@ -528,12 +557,12 @@ void Mission::Plan(StopRecord& stop) {
   }
   // A goal seen from afar on sparse points can look steep or stepped.
   if (!path && path.error().reason == planning::NoPath::Reason::kGoalBlocked &&
-      (config_.goal_m - here).norm() > kGoalApproach_m) {
+      (Target() - here).norm() > kGoalApproach_m) {
     look_closer(
         [&](std::size_t k) {
           if (layers.state[k] == mapping::CellState::kDrop) return true;  // as above, too
           return layers.state[k] != mapping::CellState::kUnknown &&
-                 (layers.geometry.CenterOf(layers.geometry.FromLinear(k)) - config_.goal_m).norm() <
+                 (layers.geometry.CenterOf(layers.geometry.FromLinear(k)) - Target()).norm() <
                      kGoalApproach_m;
         },
         "the inferred drops and the hazards seen around the goal");
@@ -797,6 +826,9 @@ MissionResult RunMission(sensors::ScanSource& source, sensors::MobileBase& base,
   if (!(config.drive_per_stop_m > 0) || config.max_stops < 1 || !(config.goal_tolerance_m > 0)) {
     throw std::invalid_argument(
         "mission: drive_per_stop_m, max_stops, goal_tolerance_m must be > 0");
+  }
+  for (const Eigen::Vector2d& p : config.via_m) {
+    if (!p.allFinite()) throw std::invalid_argument("mission: a waypoint (via_m) is not finite");
   }
   Mission mission(source, base, config, probes, observer);
   return mission.Run(T_world_start);

@@ -106,6 +106,10 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
         }
       } else if (key == "max_stops") {
         m.max_stops = kv.second.as<int>();
+      } else if (key == "loop_closure") {
+        // MapBuilder's loop closure (mapping/README.md); off by default, so every figure measured
+        // without it stays.
+        m.registration.loop_closure.enabled = kv.second.as<bool>();
       } else if (key == "algorithm") {
         m.algorithm = planning::ParseAlgorithm(kv.second.as<std::string>());
       } else if (auto it = numbers.find(key); it != numbers.end()) {
@@ -232,6 +236,7 @@ std::string RunSettingsToYaml(const RunSettings& s) {
      << "  safety_margin_m: " << m.safety_margin_m << "\n"
      << "  unknown_margin_m: " << m.unknown_margin_m << "\n"
      << "  map_range_m: " << m.map_range_m << "\n"
+     << "  loop_closure: " << (m.registration.loop_closure.enabled ? "true" : "false") << "\n"
      << "  odometry_error_m: " << m.odometry_error_m << "\n"
      << "  odometry_error_per_m: " << m.odometry_error_per_m << "\n"
      << "  odometry_error_deg: " << m.odometry_error_deg << "\n"

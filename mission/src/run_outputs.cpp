@@ -1,5 +1,7 @@
 #include "pitchlab/mission/run_outputs.hpp"
+#include "pitchlab/mission/loop_closure_metrics.hpp"
 #include "pitchlab/mission/registration_json.hpp"
+#include "pitchlab/mission/trajectory_outputs.hpp"
 #include "run_pictures.hpp"
 #include "run_report.hpp"
 
@@ -72,6 +74,13 @@ void WriteTrajectoryGeoJson(const std::filesystem::path& file, const MissionResu
   }
   WriteTextFile(file,
                 nlohmann::json{{"type", "FeatureCollection"}, {"features", features}}.dump(1));
+}
+
+// The waypoints a mission drove through before its goal, and how many it reached.
+nlohmann::json RouteJson(const RunContext& c, const MissionResult& r) {
+  nlohmann::json via = nlohmann::json::array();
+  for (const Eigen::Vector2d& p : c.via) via.push_back({{"x_m", p.x()}, {"y_m", p.y()}});
+  return {{"via", via}, {"waypoints_reached", r.waypoints_reached}};
 }
 
 nlohmann::json RegistrationJson(const StopRecord& stop) {
@@ -172,6 +181,9 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
   for (const StopRecord& s : r.stops) failed += !s.merge.merged && s.index > 0;
   m["registration_failures"] = failed;
   if (!r.stops.empty()) m["final_estimate"] = PoseJson(r.stops.back().T_world_base);
+  if (!c.via.empty()) m["route"] = RouteJson(c, r);  // run --via, --round-trip
+  if (c.loop_closure) m["loop_closures"] = LoopClosureJson(r);  // run: {loop_closure: true}
+  m["trajectory_error"] = TrajectoryErrorJson(r);  // the stops' ATE and RPE (null without truth)
   if (score) {
     m["distance_m"] = score->true_distance_m;
     m["final_pose_error"] = {{"translation_m", score->final_translation_error_m},
@@ -236,6 +248,7 @@ mapping::ElevationLayers WriteFinalData(RunFolder& folder, const RunContext& c,
                                     folder.File("elevation.asc").string()));
   WriteTrajectoryCsv(folder.File("trajectory_estimated.csv"), r, false);
   WriteTrajectoryCsv(folder.File("trajectory_true.csv"), r, true);
+  WriteStopTrajectories(folder, r);
   if (c.geodetic_origin) {
     WriteTrajectoryGeoJson(folder.File("trajectories.geojson"), r, *c.geodetic_origin);
   }

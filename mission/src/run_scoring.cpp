@@ -1,4 +1,5 @@
 #include "pitchlab/mission/run_scoring.hpp"
+#include "pitchlab/mission/waypoint_route.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -86,7 +87,7 @@ HazardVerdict CompareHazard(const planning::TraversabilityGrid& estimated,
 RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGrid& truth,
                   const planning::TraversabilityGrid& estimated,
                   const Eigen::Vector2d& start_m, const Eigen::Vector2d& goal_m,
-                  planning::Algorithm algorithm) {
+                  planning::Algorithm algorithm, const std::vector<Eigen::Vector2d>& via_m) {
   RunScore s;
   std::vector<Eigen::Vector2d> xy{start_m};
   Eigen::Isometry3d last_true = Eigen::Isometry3d::Identity();
@@ -144,7 +145,7 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
     s.hazard_cells_crossed += b == planning::Blocked::kStep || b == planning::Blocked::kDrop ||
                               b == planning::Blocked::kTooSteep;
   }
-  auto optimum = planning::PlanPath(truth, start_m, goal_m, algorithm);
+  auto optimum = PlanRoute(truth, start_m, via_m, goal_m, algorithm);
   if (optimum) {
     s.true_optimal_cost = optimum->cost;
     if (optimum->cost > 0) s.cost_ratio = on_truth.cost / optimum->cost;

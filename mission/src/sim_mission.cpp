@@ -12,6 +12,7 @@
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/elevation_truth.hpp"
 #include "pitchlab/mission/run_folder.hpp"
+#include "pitchlab/mission/waypoint_route.hpp"
 #include "pitchlab/planning/planner.hpp"
 #include "pitchlab/planning/traversability.hpp"
 #include "pitchlab/sensors/stopwatch.hpp"
@@ -31,9 +32,19 @@ constexpr double kAttitudeSigma_rad = 0.2 * kDegToRad;
 constexpr double kAttitudeBiasSigma_rad = 0.1 * kDegToRad;
 constexpr std::uint64_t kAttitudeSeedSalt = 0x6174746974756465;  // "attitude": its own stream
 
-// The run's start (given or the world's) and goal (given or the world's), checked on its map.
+void CheckOnMap(const std::string& what, const Eigen::Vector2d& p, const worlds::Bounds2d& b) {
+  if (p.x() < b.x_min_m || p.x() > b.x_max_m || p.y() < b.y_min_m || p.y() > b.y_max_m) {
+    throw std::runtime_error(what + " (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) +
+                             ") is off the map: the world spans x " + std::to_string(b.x_min_m) +
+                             " .. " + std::to_string(b.x_max_m) + ", y " +
+                             std::to_string(b.y_min_m) + " .. " + std::to_string(b.y_max_m));
+  }
+}
+
+// The run's start (given or the world's), waypoints and goal (given or the world's), checked on
+// its map; a round trip makes the goal its last waypoint and the start its goal.
 void ResolveEnds(const SimMissionSpec& spec, const worlds::WorldMetadata& meta,
-                 Eigen::Vector3d& start, Eigen::Vector2d& goal) {
+                 Eigen::Vector3d& start, std::vector<Eigen::Vector2d>& via, Eigen::Vector2d& goal) {
   start = spec.start.value_or(
       Eigen::Vector3d(meta.default_start.x_m, meta.default_start.y_m, meta.default_start.yaw_rad));
   if (spec.goal_m) {
@@ -44,13 +55,17 @@ void ResolveEnds(const SimMissionSpec& spec, const worlds::WorldMetadata& meta,
     throw std::invalid_argument("world '" + spec.world_file.string() +
                                 "' names no default goal: give one");
   }
-  const worlds::Bounds2d& b = meta.bounds;
-  if (goal.x() < b.x_min_m || goal.x() > b.x_max_m || goal.y() < b.y_min_m ||
-      goal.y() > b.y_max_m) {
-    throw std::runtime_error("goal (" + std::to_string(goal.x()) + ", " + std::to_string(goal.y()) +
-                             ") is off the map: the world spans x " + std::to_string(b.x_min_m) +
-                             " .. " + std::to_string(b.x_max_m) + ", y " +
-                             std::to_string(b.y_min_m) + " .. " + std::to_string(b.y_max_m));
+  via = spec.via_m;
+  for (std::size_t k = 0; k < via.size(); ++k) {
+    if (!via[k].allFinite()) {
+      throw std::invalid_argument("waypoint " + std::to_string(k + 1) + " is not a finite point");
+    }
+    CheckOnMap("waypoint " + std::to_string(k + 1), via[k], meta.bounds);
+  }
+  CheckOnMap("goal", goal, meta.bounds);
+  if (spec.round_trip) {
+    via.push_back(goal);
+    goal = start.head<2>();
   }
 }
 
@@ -71,9 +86,10 @@ Truth ComputeTruth(sim::SimRig& rig, const MissionConfig& mission, const Eigen::
   truth.layers = mapping::ComputeLayers(map, mission.layers);
   truth.grid = planning::BuildTraversability(truth.layers, mission.planner);
   if (observer.on_setup) observer.on_setup("ground truth: the best path on the true map");
-  auto optimum = planning::PlanPath(truth.grid, start, mission.goal_m, mission.algorithm);
+  auto optimum = PlanRoute(truth.grid, start, mission.via_m, mission.goal_m, mission.algorithm);
   if (!optimum) {
-    throw std::runtime_error("the goal is unreachable on the true map: " + optimum.error().message);
+    throw std::runtime_error(std::string(mission.via_m.empty() ? "the goal" : "the route") +
+                             " is unreachable on the true map: " + optimum.error().message);
   }
   truth.optimum = std::move(*optimum);
   return truth;
@@ -125,6 +141,7 @@ RunContext SimContext(const SimMissionSpec& spec, const RunSettings& settings,
   context.seed = spec.config.seed;
   context.start = start;
   context.goal = settings.mission.goal_m;
+  context.via = settings.mission.via_m;
   context.geodetic_origin = origin;
   const Eigen::Vector3d mount_error_deg = rig.mount_error_rpy_rad() * 180.0 / kPi;
   std::ostringstream truth;
@@ -135,6 +152,7 @@ RunContext SimContext(const SimMissionSpec& spec, const RunSettings& settings,
   context.config_yaml = AppConfigToYaml(spec.config) + RunSettingsToYaml(settings) + truth.str();
   context.planner = MissionPlanner(settings.mission);
   context.layers = settings.mission.layers;
+  context.loop_closure = settings.mission.registration.loop_closure.enabled;
   return context;
 }
 
@@ -178,8 +196,9 @@ SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesyste
   if (spec.world_file.empty()) throw std::invalid_argument("mission: no world file given");
   const worlds::WorldMetadata meta = LoadWorldMetadata(spec.world_file);
   Eigen::Vector3d start;
+  std::vector<Eigen::Vector2d> via;
   Eigen::Vector2d goal;
-  ResolveEnds(spec, meta, start, goal);
+  ResolveEnds(spec, meta, start, via, goal);
   const std::string world_stem = spec.world_file.stem().string();
 
   RunFolder folder(out);
@@ -190,6 +209,7 @@ SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesyste
   RunSettings settings = spec.settings;
   MissionConfig& mission = settings.mission;
   mission.goal_m = goal;
+  mission.via_m = via;
   mission.mount = spec.config.rig.robot.mount;
   const worlds::Bounds2d& b = meta.bounds;
   mission.map_area = mapping::GridGeometry::Covering(Eigen::Vector2d(b.x_min_m, b.y_min_m),
@@ -231,7 +251,7 @@ SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesyste
     const planning::TraversabilityGrid final_grid = planning::BuildTraversability(
         mapping::ComputeLayers(run.result.elevation, mission.layers), mission.planner);
     run.score =
-        ScoreRun(run.result, truth.grid, final_grid, start.head<2>(), goal, mission.algorithm);
+        ScoreRun(run.result, truth.grid, final_grid, start.head<2>(), goal, mission.algorithm, via);
   }
 
   run.context = SimContext(spec, settings, start, origin, rig);

@@ -146,6 +146,24 @@ TEST(RunSettings, TheTiltToleranceIsReadAndAnImpossibleOneNamed) {
   }
 }
 
+TEST(RunSettings, LoopClosureIsOffUnlessTheRunSectionSwitchesItOn) {
+  EXPECT_FALSE(ParseRunSettings("", "f.yaml", sim::P3Model::kP3DX)
+                   .mission.registration.loop_closure.enabled);
+  const RunSettings on =
+      ParseRunSettings("run: {loop_closure: true}\n", "f.yaml", sim::P3Model::kP3DX);
+  EXPECT_TRUE(on.mission.registration.loop_closure.enabled);
+  EXPECT_TRUE(ParseRunSettings(RunSettingsToYaml(on), "back", sim::P3Model::kP3DX)
+                  .mission.registration.loop_closure.enabled);
+  try {
+    ParseRunSettings("run: {loop_closure: sometimes}\n", "f.yaml", sim::P3Model::kP3DX);
+    FAIL() << "accepted a loop_closure that is no boolean";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("f.yaml: run.loop_closure has the wrong type"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(RunSettings, WrittenYamlReadsBackTheSame) {
   const RunSettings s = ParseRunSettings(
       "run: {goal_tolerance_m: 0.3, odometry_error_m: 0.2, tilt_tolerance_deg: 0.8}\n"

@@ -24,7 +24,10 @@ namespace pitchlab::mission {
 
 struct MissionConfig {
   Eigen::Vector2d goal_m = Eigen::Vector2d::Zero();  ///< goal in the world frame [m]
-  double goal_tolerance_m = 0.5;                     ///< success within this of the goal [m]
+  /// Waypoints driven through, in order, before the goal (world frame): each is reached like the
+  /// goal, within goal_tolerance_m, and then the robot plans to the next [m].
+  std::vector<Eigen::Vector2d> via_m;
+  double goal_tolerance_m = 0.5;  ///< success within this of the goal (and of a waypoint) [m]
   double drive_per_stop_m = 4.0;                     ///< path length driven between two scans [m]
   int max_stops = 40;                                ///< scans at most [1]
   double time_budget_s = 1800.0;  ///< mission time at most (simulated or real) [s]
@@ -127,7 +130,9 @@ struct StopRecord {
   /// With elevation_from_odometry: the map's unknown cells the scan filled; it leaves the cells
   /// the map has already seen as they are [1].
   std::size_t elevation_cells_filled = 0;
-  double distance_to_goal_m = 0;  ///< from the estimate [m]
+  /// What this stop heads for: via_m[target] while target < via_m.size(), else the goal [1].
+  std::size_t target = 0;
+  double distance_to_goal_m = 0;  ///< from the estimate to the target it heads for [m]
 };
 
 /// A pose of the robot while driving (sampled every control period).
@@ -150,6 +155,11 @@ struct MissionResult {
   /// Time spent in the loop's stages (stage_times.hpp); those of a whole run (ground truth,
   /// outputs, scoring) are the caller's to add.
   StageTimes stages;
+  std::size_t waypoints_reached = 0;    ///< of MissionConfig::via_m, in order [1]
+  /// With registration.loop_closure on: MapBuilder's counts over the run and the loop edges it
+  /// accepted (scan indices are MergeStep::scan_index); zero and empty when off.
+  mapping::LoopClosureCounts loop_counts;
+  std::vector<mapping::LoopClosure> loop_closures;
 };
 
 /// Called after each stop is planned (for output as it happens) and with progress text.

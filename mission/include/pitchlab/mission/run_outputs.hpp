@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -23,6 +24,8 @@ struct RunContext {
   std::uint64_t seed = 0;
   Eigen::Vector3d start{0, 0, 0};  ///< x [m], y [m], yaw [rad]
   Eigen::Vector2d goal{0, 0};      ///< [m]
+  std::vector<Eigen::Vector2d> via;  ///< waypoints before the goal, in order [m]
+  bool loop_closure = false;  ///< the mission closed loops (run: {loop_closure: true})
   std::optional<mapping::GeodeticOrigin> geodetic_origin;
   std::string config_yaml;  ///< the configuration as used
   /// The planner as the mission used it (robot width including the safety margin).

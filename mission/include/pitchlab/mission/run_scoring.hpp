@@ -56,10 +56,11 @@ HazardVerdict CompareHazard(const planning::TraversabilityGrid& estimated,
                             const planning::TraversabilityGrid& truth, std::size_t k);
 
 /// `truth` is the true traversability over the mission's map area, `estimated` the final map's on
-/// the same grid; `start_m`/`goal_m` world [m].
+/// the same grid; `start_m`/`goal_m` world [m]; `via_m` the waypoints the mission drove through
+/// (the true optimum goes through them too: PlanRoute).
 RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGrid& truth,
                   const planning::TraversabilityGrid& estimated,
                   const Eigen::Vector2d& start_m, const Eigen::Vector2d& goal_m,
-                  planning::Algorithm algorithm);
+                  planning::Algorithm algorithm, const std::vector<Eigen::Vector2d>& via_m = {});
 
 }  // namespace pitchlab::mission

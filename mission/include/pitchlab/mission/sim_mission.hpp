@@ -14,6 +14,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
@@ -33,6 +34,11 @@ struct SimMissionSpec {
   std::string world_name;            ///< how the outputs name the world; empty: the file's stem
   std::optional<Eigen::Vector3d> start;   ///< x [m], y [m], yaw [rad]; empty: the world's default
   std::optional<Eigen::Vector2d> goal_m;  ///< [m]; empty: the world's default goal
+  /// Waypoints driven through, in order, before the goal [m] (MissionConfig::via_m).
+  std::vector<Eigen::Vector2d> via_m;
+  /// Through via_m to the goal (given or the world's), then back to the start: the mission's goal
+  /// becomes the start, and the goal the last waypoint.
+  bool round_trip = false;
   AppConfig config;                       ///< sensors, simulated rig, seed
   /// Mission, planner, registration; the run sets the goal, map area and mount.
   RunSettings settings;
@@ -70,7 +76,8 @@ struct SimMissionOutcome {
 /// failed run leaves no folder. A mission that ends without reaching the goal is a result
 /// (`result.success` false), not an error. Throws std::invalid_argument on a bad spec (no goal
 /// given and none in the world, bad configuration) and std::runtime_error when `out` exists, the
-/// goal is off the world's map or unreachable on its true map, or a file cannot be written.
+/// goal or a waypoint is off the world's map or unreachable on its true map, or a file cannot be
+/// written.
 SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesystem::path& out,
                                 const SimMissionObserver& observer = {});
 
