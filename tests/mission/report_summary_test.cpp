@@ -100,6 +100,23 @@ TEST(KeyMetrics, ShowsUnitsAndLeavesOutWhatIsUnknown) {
   EXPECT_EQ(false_hazards->value, "31");
   EXPECT_NE(false_hazards->note.find("of 10205 cells compared"), std::string::npos);
   EXPECT_EQ(find("wall time"), nullptr);
+  // The trajectory error (issue 20's standard metric) from metrics.json's nested keys; a
+  // hardware run's null leaves it out.
+  EXPECT_EQ(find("absolute trajectory error (RMSE)"), nullptr);
+  m["trajectory_error"] = {{"ate", {{"unaligned", {{"rmse_m", 0.10922}}},
+                                    {"aligned", {{"rmse_m", 0.075184}}}}}};
+  const std::vector<MetricRow> with_ate = KeyMetrics(m);
+  auto ate = [&](const std::string& label) {
+    const auto it = std::find_if(with_ate.begin(), with_ate.end(),
+                                 [&](const MetricRow& r) { return r.label == label; });
+    return it == with_ate.end() ? std::string("missing") : it->value + " " + it->unit;
+  };
+  EXPECT_EQ(ate("absolute trajectory error (RMSE)"), "0.109 m");
+  EXPECT_EQ(ate("absolute trajectory error, aligned"), "0.0752 m");
+  m["trajectory_error"] = nullptr;
+  for (const MetricRow& r : KeyMetrics(m)) {
+    EXPECT_EQ(r.label.find("trajectory error"), std::string::npos) << r.label;
+  }
 }
 
 }  // namespace
