@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
@@ -124,6 +125,25 @@ TEST_F(RunCli, AMissionAroundABlockReachesTheGoalAndWritesEveryOutput) {
 struct BadRun {
   std::string args, message;
 };
+
+// The README's main job runs `pitchlab run` with no --out in a fresh clone: the default
+// runs/<world>-s<seed>-<time> is created with its missing runs/ folder (it once was refused).
+TEST_F(RunCli, WithoutOutTheRunGoesToANewRunsFolderInTheWorkingFolder) {
+  const fs::path cwd = dir_ / "ok_default_out";
+  fs::create_directories(cwd);
+  const std::string command = "cd " + cwd.string() + " && " + std::string(PITCHLAB_CLI) +
+                              " run --world " + kYard.string() + " --seed 3 --quiet >" +
+                              (dir_ / "default_out.txt").string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  ASSERT_EQ(WEXITSTATUS(status), 0) << Slurp(dir_ / "default_out.txt");
+  std::vector<fs::path> runs;
+  for (const auto& e : fs::directory_iterator(cwd / "runs")) runs.push_back(e.path());
+  ASSERT_EQ(runs.size(), 1u);
+  EXPECT_EQ(runs[0].filename().string().rfind("yard-s3-", 0), 0u) << runs[0];
+  EXPECT_TRUE(fs::exists(runs[0] / "metrics.json"));
+  EXPECT_TRUE(fs::exists(runs[0] / "report.html"));
+}
 
 TEST_F(RunCli, BadInputGivesAClearErrorAndLeavesNoRunFolder) {
   std::ofstream(dir_ / "bad.yaml") << "run: {drive_per_stop_m: -1}\n";
