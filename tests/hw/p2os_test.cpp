@@ -80,6 +80,12 @@ TEST_F(P2osDriverTest, HandshakeOpensAndEnablesTheMotors) {
   P2osDriver driver(Config());
   EXPECT_EQ(driver.robot(), "pitchlab Pioneer p3at-sh");
   EXPECT_TRUE(emulator_.connected());
+  // ENABLE has no reply in P2OS: the emulator's thread applies it when it reads it, which on a
+  // loaded machine can be after the constructor returns (seen once under a parallel build).
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+  while (!emulator_.motors_enabled() && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
   EXPECT_TRUE(emulator_.motors_enabled());
 }
 
