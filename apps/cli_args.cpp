@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 namespace pitchlab::apps {
@@ -112,23 +113,32 @@ std::string CliArgs::Get(const std::string& name) const {
 
 bool CliArgs::Flagged(const std::string& name) const { return values_.count(name) > 0; }
 
+namespace {
+
+// `item` whole as a finite number, else nothing ("1.5x", "", "nan", "inf" are not).
+std::optional<double> FiniteNumber(const std::string& item) {
+  std::size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(item, &used);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  if (used == 0 || used != item.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+}  // namespace
+
 std::vector<double> CliArgs::GetNumbers(const std::string& name, std::size_t count) const {
   const std::string text = Get(name);
   std::vector<double> numbers;
   std::stringstream ss(text);
   std::string item;
   while (std::getline(ss, item, ',')) {
-    std::size_t used = 0;
-    double v = 0;
-    try {
-      v = std::stod(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != item.size() || !std::isfinite(v)) {
-      throw CliError("--" + name + " '" + text + "': '" + item + "' is not a number");
-    }
-    numbers.push_back(v);
+    const std::optional<double> v = FiniteNumber(item);
+    if (!v) throw CliError("--" + name + " '" + text + "': '" + item + "' is not a number");
+    numbers.push_back(*v);
   }
   if (numbers.size() != count) {
     throw CliError("--" + name + " '" + text + "' needs " + std::to_string(count) +
@@ -151,17 +161,9 @@ std::vector<std::pair<double, double>> CliArgs::GetPoints(const std::string& nam
     std::stringstream ps(point);
     std::string item;
     while (std::getline(ps, item, ',')) {
-      std::size_t used = 0;
-      double v = 0;
-      try {
-        v = std::stod(item, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != item.size() || !std::isfinite(v)) {
-        throw CliError(where + "has '" + item + "', not a number");
-      }
-      xy.push_back(v);
+      const std::optional<double> v = FiniteNumber(item);
+      if (!v) throw CliError(where + "has '" + item + "', not a number");
+      xy.push_back(*v);
     }
     if (xy.size() != 2) throw CliError(where + "needs 2 comma-separated numbers (x,y)");
     points.emplace_back(xy[0], xy[1]);

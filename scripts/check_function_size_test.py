@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Tests of check_function_size.py on tests/data/function_size/sample.cpp, whose functions carry
+"""Tests of check_function_size.py on tests/data/function_size/sample_functions.txt, whose functions carry
 their length in a '// N lines' comment on their opening brace's line (hand-counted, confirmed by
 clang-tidy's readability-function-size)."""
 
@@ -14,7 +14,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import check_function_size  # noqa: E402
 
 SAMPLE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "data",
-                      "function_size", "sample.cpp")
+                      "function_size", "sample_functions.txt")
 
 
 def expected_lengths(text):
