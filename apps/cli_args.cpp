@@ -1,117 +1,186 @@
 #include "cli_args.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <limits>
 #include <iostream>
 #include <optional>
+#include <set>
 #include <sstream>
+
+#include <CLI/CLI.hpp>
 
 namespace pitchlab::apps {
 
+namespace {
+
+// --help laid out for long option descriptions: each option's names and value on one line, its
+// description indented below (CLI11's default puts them in two columns, which long sentences
+// overflow), then "(default: ...)" where pitchlab supplies one.
+class HelpLayout : public CLI::Formatter {
+ public:
+  std::string make_help(const CLI::App* app, std::string, CLI::AppFormatMode) const override {
+    std::ostringstream os;
+    const std::vector<const CLI::Option*> options =
+        app->get_options([](const CLI::Option*) { return true; });
+    std::string positional;
+    for (const CLI::Option* o : options) {
+      if (o->get_positional()) positional = " " + o->get_type_name();
+    }
+    os << "usage: " << app->get_name() << positional << " [options]\n\n"
+       << app->get_description() << "\n\n";
+    const CLI::Option* help = app->get_help_ptr();
+    for (const CLI::Option* o : options) {
+      if (o == help) continue;  // last, below
+      if (o->get_positional()) {
+        os << "  " << o->get_type_name();
+      } else {
+        os << "  " << o->get_name(false, true);
+        if (!o->get_type_name().empty()) os << " " << o->get_type_name();
+      }
+      os << "\n      " << o->get_description() << "\n";
+    }
+    os << "  " << help->get_name(false, true) << "\n      " << help->get_description() << "\n";
+    return os.str();
+  }
+};
+
+}  // namespace
+
+struct CliArgs::Declared {
+  CLI::App app;
+  std::map<std::string, CLI::Option*> options;
+  std::map<std::string, std::string> defaults;
+  std::set<std::string> flags;
+  std::string positional_name;
+  int positional_min = 0, positional_max = 0;
+};
+
 CliArgs::CliArgs(std::string command, std::string summary)
-    : command_(std::move(command)), summary_(std::move(summary)) {}
+    : declared_(std::make_unique<Declared>()) {
+  CLI::App& app = declared_->app;
+  app.name("pitchlab " + command);
+  app.description(std::move(summary));
+  app.formatter(std::make_shared<HelpLayout>());
+  app.set_help_flag("-h,--help", "show this help");
+  // Leftovers (unknown options, surplus positionals) are collected and worded in Parse.
+  app.allow_extras();
+}
+
+CliArgs::CliArgs(CliArgs&&) noexcept = default;
+CliArgs& CliArgs::operator=(CliArgs&&) noexcept = default;
+CliArgs::~CliArgs() = default;
 
 CliArgs& CliArgs::Option(const std::string& name, const std::string& metavar,
                          const std::string& help, std::optional<std::string> default_value) {
-  order_.push_back(name);
-  specs_[name] = Spec{metavar, help, std::move(default_value), false};
+  std::string shown = help;
+  if (default_value) {
+    shown += " (default: " + *default_value + ")";
+    declared_->defaults[name] = *default_value;
+  }
+  // Every occurrence is kept so Parse can name an option given twice.
+  declared_->options[name] = declared_->app.add_option("--" + name)
+                                 ->description(shown)
+                                 ->type_name(metavar)
+                                 ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   return *this;
 }
 
 CliArgs& CliArgs::Flag(const std::string& name, const std::string& help) {
-  order_.push_back(name);
-  specs_[name] = Spec{"", help, std::nullopt, true};
+  declared_->flags.insert(name);
+  declared_->options[name] = declared_->app.add_flag("--" + name, help)
+                                 ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   return *this;
 }
 
 CliArgs& CliArgs::Positionals(const std::string& name, const std::string& help, int min,
                               int max) {
-  positional_name_ = name;
-  positional_help_ = help;
-  positional_min_ = min;
-  positional_max_ = max;
+  declared_->positional_name = name;
+  declared_->positional_min = min;
+  declared_->positional_max = max;
+  // CLI11 names a positional with one word; the user sees `name` (e.g. "SOURCE TARGET").
+  // It takes any number: Parse counts them and says what the command needs.
+  declared_->app.add_option("positionals", positionals_, help)->type_name(name);
   return *this;
 }
 
 bool CliArgs::Parse(int argc, char** argv) {
-  for (int i = 0; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      std::cout << Usage();
-      return false;
+  CLI::App& app = declared_->app;
+  // CLI11 takes the arguments last first.
+  std::vector<std::string> args(argv, argv + argc);
+  const std::string command = app.get_name().substr(std::string("pitchlab ").size());
+  for (const std::string& arg : args) {
+    if (arg == "--") break;
+    // CLI11 reads `--flag=false` as "not given"; pitchlab's switches take no value at all.
+    const auto eq = arg.find('=');
+    if (arg.rfind("--", 0) == 0 && eq != std::string::npos &&
+        declared_->flags.count(arg.substr(2, eq - 2)) > 0) {
+      throw CliError(arg.substr(0, eq) + " takes no value");
     }
-    if (arg.rfind("--", 0) == 0) {
-      std::string name = arg.substr(2), value;
-      const auto eq = name.find('=');
-      const bool inline_value = eq != std::string::npos;
-      if (inline_value) {
-        value = name.substr(eq + 1);
-        name = name.substr(0, eq);
-      }
-      auto it = specs_.find(name);
-      if (it == specs_.end()) {
-        throw CliError("unknown option '--" + name + "' for '" + command_ + "' (see --help)");
-      }
-      if (it->second.is_flag) {
-        if (inline_value) throw CliError("--" + name + " takes no value");
-        values_[name] = "true";
-        continue;
-      }
-      if (!inline_value) {
-        if (i + 1 >= argc) throw CliError("--" + name + " needs a value (" +
-                                          it->second.metavar + ")");
-        value = argv[++i];
-      }
-      values_[name] = value;
+  }
+  std::reverse(args.begin(), args.end());
+  try {
+    app.parse(args);
+  } catch (const CLI::CallForHelp&) {
+    std::cout << Usage();
+    return false;
+  } catch (const CLI::ParseError& e) {
+    throw CliError(e.what());
+  }
+  for (const auto& [name, option] : declared_->options) {
+    if (option->count() > 1) {
+      throw CliError("--" + name + " given " + std::to_string(option->count()) +
+                     " times: give it once");
+    }
+  }
+  bool after_marker = false;  // after "--" everything is a positional
+  int surplus = 0;            // positionals beyond what the command takes
+  for (const std::string& extra : app.remaining()) {
+    if (extra == "--" && !after_marker) {
+      after_marker = true;
       continue;
     }
-    positionals_.push_back(arg);
+    ++surplus;
+    if (!after_marker && extra.rfind("-", 0) == 0 && extra.size() > 1) {
+      const std::string name = extra.substr(0, extra.find('='));
+      throw CliError("unknown option '" + name + "' for '" + command + "' (see --help)");
+    }
+    if (declared_->positional_max == 0) throw CliError("unexpected argument '" + extra + "'");
   }
-  const int n = static_cast<int>(positionals_.size());
-  if (n < positional_min_ || n > positional_max_) {
-    if (positional_max_ == 0) throw CliError("unexpected argument '" + positionals_.front() + "'");
-    throw CliError("'" + command_ + "' needs " +
-                   (positional_min_ == positional_max_ ? std::to_string(positional_min_)
-                                                       : std::to_string(positional_min_) + ".." +
-                                                             std::to_string(positional_max_)) +
-                   " " + positional_name_ + " argument(s), got " + std::to_string(n));
+  const int n = static_cast<int>(positionals_.size()) + surplus;
+  const int min = declared_->positional_min, max = declared_->positional_max;
+  if (n < min || n > max) {
+    throw CliError("'" + command + "' needs " +
+                   (min == max ? std::to_string(min)
+                               : std::to_string(min) + ".." + std::to_string(max)) +
+                   " " + declared_->positional_name + " argument(s), got " + std::to_string(n));
   }
   return true;
 }
 
-std::string CliArgs::Usage() const {
-  std::ostringstream os;
-  os << "usage: pitchlab " << command_;
-  if (!positional_name_.empty()) os << " " << positional_name_;
-  os << " [options]\n\n" << summary_ << "\n\n";
-  if (!positional_name_.empty()) os << "  " << positional_name_ << "\n      " << positional_help_
-                                    << "\n";
-  for (const std::string& name : order_) {
-    const Spec& s = specs_.at(name);
-    os << "  --" << name;
-    if (!s.is_flag) os << " " << s.metavar;
-    os << "\n      " << s.help;
-    if (s.default_value) os << " (default: " << *s.default_value << ")";
-    os << "\n";
-  }
-  os << "  --help\n      show this help\n";
-  return os.str();
-}
+std::string CliArgs::Usage() const { return declared_->app.help(); }
 
 bool CliArgs::Has(const std::string& name) const {
-  return values_.count(name) > 0 || (specs_.count(name) && specs_.at(name).default_value);
+  return Flagged(name) || declared_->defaults.count(name) > 0;
 }
 
 std::string CliArgs::Get(const std::string& name) const {
-  if (auto it = values_.find(name); it != values_.end()) return it->second;
-  if (auto it = specs_.find(name); it != specs_.end() && it->second.default_value) {
-    return *it->second.default_value;
+  const auto it = declared_->options.find(name);
+  if (it != declared_->options.end() && it->second->count() > 0) {
+    return it->second->results().front();
   }
-  throw CliError("'" + command_ + "' needs --" + name + " (see --help)");
+  if (const auto d = declared_->defaults.find(name); d != declared_->defaults.end()) {
+    return d->second;
+  }
+  const std::string command = declared_->app.get_name().substr(std::string("pitchlab ").size());
+  throw CliError("'" + command + "' needs --" + name + " (see --help)");
 }
 
-bool CliArgs::Flagged(const std::string& name) const { return values_.count(name) > 0; }
+bool CliArgs::Flagged(const std::string& name) const {
+  const auto it = declared_->options.find(name);
+  return it != declared_->options.end() && it->second->count() > 0;
+}
 
 namespace {
 
@@ -142,7 +211,7 @@ std::vector<double> CliArgs::GetNumbers(const std::string& name, std::size_t cou
   }
   if (numbers.size() != count) {
     throw CliError("--" + name + " '" + text + "' needs " + std::to_string(count) +
-                   " comma-separated numbers (" + specs_.at(name).metavar + ")");
+                   " comma-separated numbers (" + declared_->options.at(name)->get_type_name() + ")");
   }
   return numbers;
 }

@@ -1,9 +1,12 @@
 #pragma once
-// A small command-line parser for pitchlab's subcommands: `--name value`, `--flag`, positionals,
-// and a generated --help. Errors throw CliError with a message for the user.
+// pitchlab's subcommand options: `--name value` / `--name=value`, `--flag`, positionals, `--` before
+// positionals that look like options, and a generated --help, parsed by CLI11 (cli_args.cpp keeps
+// its header out of every other file). Errors throw CliError with a message for the user; the typed
+// getters check numbers (finite, in range, whole) and name the option and the value.
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -21,6 +24,9 @@ struct CliError : std::runtime_error {
 class CliArgs {
  public:
   CliArgs(std::string command, std::string summary);
+  CliArgs(CliArgs&&) noexcept;
+  CliArgs& operator=(CliArgs&&) noexcept;
+  ~CliArgs();
 
   /// An option taking a value; `metavar` is shown in --help (e.g. "x,y,yaw").
   CliArgs& Option(const std::string& name, const std::string& metavar, const std::string& help,
@@ -31,6 +37,8 @@ class CliArgs {
   CliArgs& Positionals(const std::string& name, const std::string& help, int min, int max);
 
   /// Parses argv (after the subcommand). Returns false when --help was asked (usage printed).
+  /// An option given twice, an unknown option, a missing value or a value given to a flag is a
+  /// CliError.
   bool Parse(int argc, char** argv);
 
   std::string Usage() const;
@@ -51,17 +59,8 @@ class CliArgs {
   std::uint64_t GetWholeNumber(const std::string& name) const;
 
  private:
-  struct Spec {
-    std::string metavar, help;
-    std::optional<std::string> default_value;
-    bool is_flag = false;
-  };
-  std::string command_, summary_;
-  std::vector<std::string> order_;
-  std::map<std::string, Spec> specs_;
-  std::map<std::string, std::string> values_;
-  std::string positional_name_, positional_help_;
-  int positional_min_ = 0, positional_max_ = 0;
+  struct Declared;  // the CLI11 app and what was declared on it (cli_args.cpp)
+  std::unique_ptr<Declared> declared_;
   std::vector<std::string> positionals_;
 };
 

@@ -7,6 +7,7 @@ packages=(
   libeigen3-dev libmujoco-dev libembree-dev libpcl-dev libgeographiclib-dev
   libyaml-cpp-dev libexpected-dev libpng-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libboost-graph-dev
+  libcli11-dev  # the pitchlab command's option parsing (apps/cli_args.cpp)
   libceres-dev  # the pose graph (mapping/src/pose_graph.cpp)
   libjs-three chromium  # the report's 3D view; its headless-browser test
   slurmctld slurmd slurm-client munge  # scripts/test-slurm.sh
