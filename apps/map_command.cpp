@@ -388,6 +388,7 @@ int RunMap(int argc, char** argv) {
       {"insert_time_s", insert_s},
       {"robot", robot.name},
       {"lethal_cells", lethal},
+      {"bridged_gap_cells", traversability.bridged_cells},
       {"files",
        {"map.plem", "elevation.asc", "elevation.prj", "inclination.asc", "inclination.prj",
         "roughness.asc", "roughness.prj", "traversability.yaml", "traversability.pgm",

@@ -43,20 +43,22 @@ planning::PlannerConfig ReadPlannerConfig(const std::string& path) {
 // The planner's defaults as --help states them, from the library's own values.
 std::string PlannerDefaults() {
   const planning::PlannerConfig c;
-  char text[900];
+  char text[1200];
   std::snprintf(
       text, sizeof(text),
       "Defaults (a --config file may set any of them; --robot and --unknown override it):\n"
-      "  robot %s: step %g m, inclination %.1f deg, %g m wide, %g m long\n"
+      "  robot %s: step %g m, inclination %.1f deg, %g m wide, %g m long, wheel radius %g m\n"
       "  weights: roughness %g, length %g, inclination_x %g, inclination_y %g\n"
       "  unknown: forbid (unknown_penalty %g when penalise); `pitchlab run` plans with\n"
       "    penalise: a map from scans has unknown cells under and around the robot (the laser\n"
-      "    does not see its own footprint), so give --unknown penalise on such maps\n"
+      "    does not see its own footprint), so give --unknown penalise on such maps;\n"
+      "    unknown cells in a gap between scan lines (at most %.2f m across for this robot's\n"
+      "    wheels, rays crossed them within a step of the ground on both sides) are ground\n"
       "  clearance_m %g, clearance_cost %g (off); algorithm astar (exact, as dijkstra)\n",
       c.robot.name.c_str(), c.robot.step_max_m, c.robot.max_inclination_rad * kRadToDeg,
-      c.robot.width_m, c.robot.length_m, c.weights.roughness, c.weights.length,
-      c.weights.inclination_x, c.weights.inclination_y, c.unknown_penalty, c.clearance_m,
-      c.clearance_cost);
+      c.robot.width_m, c.robot.length_m, c.robot.wheel_radius_m, c.weights.roughness,
+      c.weights.length, c.weights.inclination_x, c.weights.inclination_y, c.unknown_penalty,
+      planning::MaxBridgedGap(c.robot), c.clearance_m, c.clearance_cost);
   return text;
 }
 
@@ -205,6 +207,8 @@ int RunPlan(int argc, char** argv) {
     summary["start_map_m"] = {start_m.x(), start_m.y()};
     summary["goal_map_m"] = {goal_m.x(), goal_m.y()};
   }
+  // Unknown cells planned as ground: gaps between scan lines the wheels roll over.
+  summary["bridged_gap_cells"] = in.grid.bridged_cells;
   summary["traversability_time_s"] = std::chrono::duration<double>(t1 - t0).count();
   summary["search_time_s"] = std::chrono::duration<double>(t2 - t1).count();
   summary["warnings"] = nlohmann::json::array();

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "finish_traversability.hpp"
+#include "scan_gaps.hpp"
 #include "move_cost.hpp"
 
 namespace pitchlab::planning {
@@ -260,8 +261,12 @@ float MoveCostOf(const TraversabilityGrid& T, std::size_t k, int b) {
   return MoveCostAt(T, c.i, c.j, b);
 }
 
-RobotLimits RobotLimits::P3AT() { return {"p3at", 0.089, std::atan(0.35), 0.497, 0.508}; }
-RobotLimits RobotLimits::P3DX() { return {"p3dx", 0.025, std::atan(0.25), 0.381, 0.455}; }
+RobotLimits RobotLimits::P3AT() {
+  return {"p3at", 0.089, std::atan(0.35), 0.497, 0.508, 0.1075};
+}
+RobotLimits RobotLimits::P3DX() {
+  return {"p3dx", 0.025, std::atan(0.25), 0.381, 0.455, 0.04};
+}
 RobotLimits RobotLimits::Preset(const std::string& name) {
   if (name == "p3at") return P3AT();
   if (name == "p3dx") return P3DX();
@@ -283,6 +288,7 @@ void PlannerConfig::Validate() const {
         robot.max_inclination_rad);
   check(robot.width_m >= 0, "width_m", robot.width_m);
   check(robot.length_m > 0, "length_m", robot.length_m);
+  check(robot.wheel_radius_m > 0, "wheel_radius_m", robot.wheel_radius_m);
   check(unknown_penalty >= 0, "unknown_penalty", unknown_penalty);
   check(clearance_m >= 0 && clearance_m <= 10, "clearance_m", clearance_m);
   check(clearance_cost >= 0, "clearance_cost", clearance_cost);
@@ -311,6 +317,7 @@ PlannerConfig ParsePlannerConfig(const std::string& yaml_text, const std::string
   c.robot.max_inclination_rad = incl_deg * kDegToRad;
   Read(root, "width_m", source, &c.robot.width_m);
   Read(root, "length_m", source, &c.robot.length_m);
+  Read(root, "wheel_radius_m", source, &c.robot.wheel_radius_m);
   if (const YAML::Node w = root["weights"]) {
     Read(w, "roughness", source, &c.weights.roughness);
     Read(w, "length", source, &c.weights.length);
@@ -414,6 +421,7 @@ void BuildTraversabilityInto(const ElevationLayers& L, const PlannerConfig& conf
         T.enter_cost[k] += static_cast<float>(config.unknown_penalty);
       }
     }
+  T.bridged_cells = BridgeScanGaps(L, T);
   FinishTraversability(T);
 }
 
@@ -433,6 +441,11 @@ void FinishTraversability(TraversabilityGrid& T) {
 bool IsFootprintHazard(Blocked b) {
   return b == Blocked::kDrop || b == Blocked::kStep || b == Blocked::kTooSteep ||
          b == Blocked::kOccupied;
+}
+
+double MaxBridgedGap(const RobotLimits& robot) {
+  const double r = robot.wheel_radius_m, sink = std::min(robot.step_max_m, r);
+  return 2.0 * std::sqrt(r * r - (r - sink) * (r - sink));
 }
 
 bool CoarserThanRobot(const GridGeometry& geometry, const RobotLimits& robot) {

@@ -29,10 +29,14 @@ struct RobotLimits {
   /// Footprint length [m]. With the width, what makes a grid coarser than the robot
   /// (CoarserThanRobot).
   double length_m = 0.508;
+  /// Radius of the smallest wheel the robot stands on (a caster's, if it has one) [m]: how wide
+  /// an unseen gap it rolls over without sinking more than step_max_m (MaxBridgedGap).
+  double wheel_radius_m = 0.1075;
 
-  /// Pioneer 3-AT (datasheet: 8.9 cm step, 35 % grade, 50.8 x 49.7 cm).
+  /// Pioneer 3-AT (datasheet: 8.9 cm step, 35 % grade, 50.8 x 49.7 cm, 21.5 cm tyres).
   static RobotLimits P3AT();
-  /// Pioneer 3-DX (datasheet: 2.5 cm step, 25 % grade, 45.5 x 38.1 cm).
+  /// Pioneer 3-DX (datasheet: 2.5 cm step, 25 % grade, 45.5 x 38.1 cm; its rear caster's 8 cm
+  /// wheel is the smallest).
   static RobotLimits P3DX();
   /// "p3at" or "p3dx"; throws std::invalid_argument naming the known presets otherwise.
   static RobotLimits Preset(const std::string& name);
@@ -66,6 +70,7 @@ struct PlannerConfig {
 ///   max_inclination_deg: 19.3
 ///   width_m: 0.497
 ///   length_m: 0.508
+///   wheel_radius_m: 0.1075
 ///   weights: {roughness: 10, length: 1, inclination_x: 1, inclination_y: 1}
 ///   unknown: forbid              # forbid | penalise
 ///   unknown_penalty: 1.0
@@ -82,6 +87,11 @@ PlannerConfig ParsePlannerConfig(const std::string& yaml_text, const std::string
 /// not as a step (a 0.5 m rise between 3 m cells is a 9.5 deg slope). Finer grids keep the step
 /// rule: the robot spans several cells and meets a rise between two at once.
 bool CoarserThanRobot(const mapping::GridGeometry& geometry, const RobotLimits& robot);
+
+/// The widest gap in the ground a wheel of `robot.wheel_radius_m` rolls over sinking no more than
+/// `robot.step_max_m`: the chord 2 sqrt(r^2 - (r - step)^2) [m]. P3-AT 0.21 m; P3-DX (caster)
+/// 0.07 m.
+double MaxBridgedGap(const RobotLimits& robot);
 /// What a user should know about planning on `geometry` with `robot`: empty for a grid finer than
 /// the robot, else a warning that says what the planner does and what the map cannot show.
 std::string CoarseGridWarning(const mapping::GridGeometry& geometry, const RobotLimits& robot);
@@ -142,6 +152,9 @@ struct TraversabilityGrid {
   double min_diagonal_cost = 0;  ///< cheapest diagonal move, +inf if none [1]
   double max_edge_cost = 0;      ///< dearest allowed move, 0 if none [1]
   float min_enter_cost = 0;      ///< cheapest entry cost of a free cell [1]
+  /// Unknown cells read as ground because they are a gap between scan lines the robot's wheels
+  /// roll over (BuildTraversability, "Gaps between scan lines") [1].
+  std::size_t bridged_cells = 0;
 
   bool Free(std::size_t k) const { return blocked[k] == Blocked::kFree; }
 };
