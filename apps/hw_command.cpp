@@ -224,7 +224,9 @@ int RunLms200(int argc, char** argv) {
       .Flag("once", "one scan, then exit (the only mode so far)")
       .Flag("json", "print the scan as JSON");
   if (!args.Parse(argc, argv)) return 0;
-  if (!args.Flagged("once")) throw CliError("only --once is supported");
+  if (!args.Flagged("once")) {
+    throw CliError("lms200 needs --once (one scan, then exit: the only mode so far)");
+  }
   hw::Lms200DriverConfig config;
   config.device = args.Get("device");
   config.lms.baud = ParseBaud(args.Get("baud"));
