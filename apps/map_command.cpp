@@ -22,6 +22,7 @@
 #include "pitchlab/mapping/elevation_map.hpp"
 #include "pitchlab/mapping/elevation_truth.hpp"
 #include "pitchlab/mapping/ground_level.hpp"
+#include "pitchlab/mission/map_figure.hpp"
 #include "pitchlab/planning/occupancy_grid.hpp"
 #include "pitchlab/planning/traversability.hpp"
 #include "pitchlab/sensors/ray_caster.hpp"
@@ -356,8 +357,15 @@ int RunMap(int argc, char** argv) {
                                      folder.File("traversability.yaml").string()));
   std::size_t lethal = 0;
   for (planning::Blocked b : traversability.blocked) lethal += planning::IsFootprintHazard(b);
-  check(mapping::WritePng(mapping::RenderElevationImage(layers),
-                          folder.File("elevation.png").string()));
+  {  // cropped to the known cells, axes in metres, a scale bar and the heights' colour bar
+    const mission::MapWindow window = mission::ExploredWindow(layers, {});
+    mapping::ImageOptions options;
+    options.pixels_per_cell = mission::FigurePixelsPerCell(layers.geometry, window);
+    check(mapping::WritePng(
+        mission::ComposeMapFigure(mapping::RenderElevationImage(layers, options), layers.geometry,
+                                  window, {std::nullopt, std::nullopt, mission::HeightBar(layers)}),
+        folder.File("elevation.png").string()));
+  }
 
   std::size_t known = 0, drops = 0;
   for (mapping::CellState s : layers.state) {

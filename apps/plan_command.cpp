@@ -16,6 +16,7 @@
 #include "interrupt.hpp"
 #include "output_paths.hpp"
 #include "pitchlab/mapping/elevation_io.hpp"
+#include "pitchlab/mission/map_figure.hpp"
 #include "pitchlab/planning/occupancy_grid.hpp"
 #include "pitchlab/planning/path_io.hpp"
 #include "pitchlab/planning/planner.hpp"
@@ -139,27 +140,44 @@ planning::PlannerConfig PlanConfig(const CliArgs& args) {
 }
 
 // The pictures of the map and of what the planner may enter, with or without a path: they show
-// why the path went where it did, or why there is none. Returns the files written.
+// why the path went where it did, or why there is none. Each is cropped to what the map knows
+// (and the start and goal), with axes in metres, a scale bar, the start (S) and goal (G) and, for
+// heights, a colour bar. Returns the files written.
 std::vector<std::string> WritePictures(const PlanInput& in, const planning::Path* path,
-                                       const RunFolder& folder) {
-  const auto check = [](Result<void> r) {
-    if (!r) throw std::runtime_error(r.error().message);
+                                       const RunFolder& folder, const Eigen::Vector2d& start_m,
+                                       const Eigen::Vector2d& goal_m) {
+  const auto write = [&](const mapping::RgbImage& image, const std::string& name) {
+    if (const Result<void> r = mapping::WritePng(image, folder.File(name).string()); !r) {
+      throw std::runtime_error(r.error().message);
+    }
   };
+  const mapping::GridGeometry& g = in.grid.geometry;
+  const mission::MapWindow window =
+      in.layers ? mission::ExploredWindow(*in.layers, {start_m, goal_m})
+                : mission::MapWindow{{g.x_min_m, g.y_min_m}, {g.x_max_m(), g.y_max_m()}};
+  mapping::ImageOptions options;
+  options.pixels_per_cell = mission::FigurePixelsPerCell(g, window);
+  const mission::FigureMarks marks{start_m, goal_m, std::nullopt};
+  mission::FigureMarks height_marks = marks;
+  if (in.layers) height_marks.colour_bar = mission::HeightBar(*in.layers);
+
   std::vector<std::string> files;
-  mapping::RgbImage traversability = RenderTraversability(in.grid);
-  if (path) planning::DrawPath(*path, in.grid.geometry, traversability);
-  check(mapping::WritePng(traversability, folder.File("traversability.png").string()));
+  mapping::RgbImage traversability = RenderTraversability(in.grid, options);
+  if (path) planning::DrawPath(*path, g, traversability);
+  write(mission::ComposeMapFigure(traversability, g, window, marks), "traversability.png");
   files.push_back("traversability.png");
   if (in.layers) {
-    check(mapping::WritePng(mapping::RenderElevationImage(*in.layers),
-                            folder.File("elevation.png").string()));
+    write(mission::ComposeMapFigure(mapping::RenderElevationImage(*in.layers, options), g, window,
+                                    height_marks),
+          "elevation.png");
     files.push_back("elevation.png");
   }
   if (path) {  // the path on the elevation picture, or on the traversability one without heights
-    mapping::RgbImage image =
-        in.layers ? mapping::RenderElevationImage(*in.layers) : RenderTraversability(in.grid);
-    planning::DrawPath(*path, in.grid.geometry, image);
-    check(mapping::WritePng(image, folder.File("path.png").string()));
+    mapping::RgbImage image = in.layers ? mapping::RenderElevationImage(*in.layers, options)
+                                        : RenderTraversability(in.grid, options);
+    planning::DrawPath(*path, g, image);
+    write(mission::ComposeMapFigure(image, g, window, in.layers ? height_marks : marks),
+          "path.png");
     files.push_back("path.png");
   }
   return files;
@@ -231,7 +249,7 @@ int RunPlan(int argc, char** argv) {
     std::vector<std::string> files;
     if (on_map) {
       RunFolder folder(out);
-      files = WritePictures(in, nullptr, folder);
+      files = WritePictures(in, nullptr, folder, start_m, goal_m);
       files.push_back("plan.json");
       summary["files"] = files;
       WriteTextFile(folder.File("plan.json"), summary.dump(2) + "\n");
@@ -266,7 +284,9 @@ int RunPlan(int argc, char** argv) {
         "skipped: the map is not georeferenced (a .plem mapped without --world, "
         "a DEM without a .prj, an occupancy grid)";
   }
-  for (const std::string& f : WritePictures(in, &*result, folder)) files.push_back(f);
+  for (const std::string& f : WritePictures(in, &*result, folder, start_m, goal_m)) {
+    files.push_back(f);
+  }
   files.push_back("plan.json");
   summary["files"] = files;
   WriteTextFile(folder.File("plan.json"), summary.dump(2) + "\n");

@@ -1,4 +1,4 @@
-#include "map_figure.hpp"
+#include "pitchlab/mission/map_figure.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -184,6 +184,11 @@ void DrawAxes(mapping::RgbImage& out, const MapWindow& w, const Frame& f) {
 }
 
 }  // namespace
+
+ColourBar HeightBar(const mapping::ElevationLayers& layers) {
+  const auto [lo, hi] = mapping::ElevationRampRange(layers);
+  return {lo, hi, mapping::ElevationRamp};
+}
 
 MapWindow ExploredWindow(const mapping::ElevationLayers& layers,
                          const std::vector<Eigen::Vector2d>& points_m) {

@@ -10,7 +10,7 @@
 
 #include <Eigen/Core>
 
-#include "map_figure.hpp"
+#include "pitchlab/mission/map_figure.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/point_cloud.hpp"
 #include "pitchlab/planning/traversability.hpp"

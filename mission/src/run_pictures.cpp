@@ -2,7 +2,7 @@
 
 #include <stdexcept>
 
-#include "map_figure.hpp"
+#include "pitchlab/mission/map_figure.hpp"
 #include "pitchlab/planning/path_io.hpp"
 #include "pitchlab/mission/traversability_image.hpp"
 
@@ -31,11 +31,6 @@ void DrawPolyline(mapping::RgbImage& image, const mapping::GridGeometry& g,
           image.Set(static_cast<int>(p.x()) + dx, static_cast<int>(p.y()) + dy, r, gr, b);
     }
   }
-}
-
-ColourBar HeightBar(const mapping::ElevationLayers& layers) {
-  const auto [lo, hi] = mapping::ElevationRampRange(layers);
-  return {lo, hi, mapping::ElevationRamp};
 }
 
 }  // namespace

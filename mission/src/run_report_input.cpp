@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <iostream>
 
-#include "map_figure.hpp"
+#include "pitchlab/mission/map_figure.hpp"
 #include "report_scene.hpp"
 #include "run_pictures.hpp"
 #include "run_report.hpp"

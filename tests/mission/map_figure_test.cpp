@@ -1,4 +1,4 @@
-#include "map_figure.hpp"
+#include "pitchlab/mission/map_figure.hpp"
 #include "run_pictures.hpp"
 
 #include <array>

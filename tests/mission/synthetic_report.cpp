@@ -5,7 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "map_figure.hpp"
+#include "pitchlab/mission/map_figure.hpp"
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "report_scene.hpp"
 

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 
 #include "pitchlab/mapping/elevation_io.hpp"
+#include "pitchlab/mapping/elevation_layers.hpp"
 
 namespace pitchlab::mission {
 
@@ -34,6 +35,9 @@ struct ColourBar {
   double lo_m = 0, hi_m = 1;
   std::function<std::array<double, 3>(double)> colour;
 };
+
+/// The elevation colour bar of `layers`: its heights' ramp range and mapping::ElevationRamp.
+ColourBar HeightBar(const mapping::ElevationLayers& layers);
 
 /// What a figure marks besides the axes and the scale bar.
 struct FigureMarks {
