@@ -183,7 +183,10 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
   if (!r.stops.empty()) m["final_estimate"] = PoseJson(r.stops.back().T_world_base);
   if (!c.via.empty()) m["route"] = RouteJson(c, r);  // run --via, --round-trip
   if (c.loop_closure) m["loop_closures"] = LoopClosureJson(r);  // run: {loop_closure: true}
-  m["trajectory_error"] = TrajectoryErrorJson(r);  // the stops' ATE and RPE (null without truth)
+  // The stops' ATE and RPE at their final poses (null without truth); with loop closure also as
+  // they were registered, before later loops moved them.
+  m["trajectory_error"] = TrajectoryErrorJson(r, StopPoses::kFinal);
+  if (c.loop_closure) m["trajectory_error_live"] = TrajectoryErrorJson(r, StopPoses::kLive);
   if (score) {
     m["distance_m"] = score->true_distance_m;
     m["final_pose_error"] = {{"translation_m", score->final_translation_error_m},
@@ -248,7 +251,7 @@ mapping::ElevationLayers WriteFinalData(RunFolder& folder, const RunContext& c,
                                     folder.File("elevation.asc").string()));
   WriteTrajectoryCsv(folder.File("trajectory_estimated.csv"), r, false);
   WriteTrajectoryCsv(folder.File("trajectory_true.csv"), r, true);
-  WriteStopTrajectories(folder, r);
+  WriteStopTrajectories(folder, r, c.loop_closure);
   if (c.geodetic_origin) {
     WriteTrajectoryGeoJson(folder.File("trajectories.geojson"), r, *c.geodetic_origin);
   }
