@@ -127,6 +127,24 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
           {"rotation_deg", Eigen::AngleAxisd(m.linear()).angle() * kRadToDeg}};
     }
   }
+  // Loop closure on: each earlier scan registered against this one, and the pose graph's verdict.
+  if (!stop.merge.loop_attempts.empty()) {
+    nlohmann::json loops = nlohmann::json::array();
+    for (const mapping::LoopAttempt& a : stop.merge.loop_attempts) {
+      loops.push_back({{"target_scan_index", a.target_scan_index},
+                       {"graph_distance_m", a.candidate.distance_m},
+                       {"graph_uncertainty_m", a.candidate.uncertainty_m},
+                       {"success", a.registration.success},
+                       {"path", mapping::ToString(a.registration.path)},
+                       {"inlier_ratio", a.registration.inlier_ratio},
+                       {"reason", a.registration.reason},
+                       {"tested", a.tested},
+                       {"accepted", a.tested && a.decision.accepted},
+                       {"chi2_increase", a.tested ? nlohmann::json(a.decision.chi2_increase)
+                                                  : nlohmann::json()}});
+    }
+    j["loops"] = loops;
+  }
   // The plan of this stop: how it was found, or why there was none.
   j["plan"] = {{"found", stop.plan.has_value()},
                {"known_m", stop.plan_known_m},
