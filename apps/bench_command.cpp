@@ -81,6 +81,11 @@ struct SweepSettings {
   std::optional<fs::path> config;
   /// ConfigHash of the config's bytes, recorded per run: a resumed sweep must use the same one.
   std::string config_hash;
+  /// What every run drives (RouteArgs): `pitchlab run`'s --via and --round-trip, passed on.
+  std::vector<std::string> route_args;
+  /// The route as runs.jsonl records it ("goal", "round-trip", "via X,Y;...", ...): a resumed
+  /// sweep must drive the same.
+  std::string route;
 };
 
 /// A child process running one `pitchlab run`.
@@ -113,6 +118,11 @@ CliArgs BenchArgs() {
       .Option("timeout-s", "S", "wall time per run before it is killed and recorded as failed",
               "600")
       .Option("config", "FILE.yaml", "configuration passed to every run (see README)")
+      .Option("via", "x,y[;x,y...]",
+              "waypoints every run drives through before the goal (as `pitchlab run --via`; "
+              "a waypoint off a world's map fails that world's runs)")
+      .Flag("round-trip",
+            "every run drives to its world's default goal (through --via) and back to the start")
       .Flag("summarize", "merge the runs.jsonl of the given folders into one summary; no runs")
       .Flag("merge", "same as --summarize")
       .Flag("json", "print the summary as JSON on stdout (the table goes to stderr)")
@@ -232,6 +242,17 @@ SweepSettings ParseSweepSettings(const CliArgs& args) {
   if (!(s.timeout_s > 0)) throw CliError("--timeout-s must be positive");
   if (args.Has("config")) s.config = CheckConfig(args.Get("config"));
   s.config_hash = ConfigHash(s.config ? mission::ReadBinaryFile(*s.config) : std::string());
+  std::vector<std::string> route;
+  if (args.Has("via")) {
+    (void)args.GetPoints("via");  // the format now (exit 2 before any run); the bounds per world, by run
+    s.route_args = {"--via", args.Get("via")};
+    route.push_back("via " + args.Get("via"));
+  }
+  if (args.Flagged("round-trip")) {
+    s.route_args.push_back("--round-trip");
+    route.push_back("round-trip");
+  }
+  s.route = route.empty() ? "goal" : route.size() == 1 ? route[0] : route[0] + ", " + route[1];
   return s;
 }
 
@@ -335,6 +356,7 @@ pid_t StartRun(const SweepSettings& s, const BenchRun& run) {
                                     "--out",    RunDir(s.out, run).string(),
                                     "--json"};
   if (s.config) words.insert(words.end(), {"--config", s.config->string()});
+  words.insert(words.end(), s.route_args.begin(), s.route_args.end());
   std::vector<char*> argv;
   for (std::string& w : words) argv.push_back(w.data());
   argv.push_back(nullptr);
@@ -400,6 +422,7 @@ json MakeRecord(const SweepSettings& s, const BenchRun& run, std::optional<int> 
             {"index", run.index},
             {"shard", s.shard.Text()},
             {"config_hash", s.config_hash},
+            {"route", s.route},
             {"exit_code", exit_code ? json(*exit_code) : json()},
             {"signal", signal ? json(*signal) : json()},
             {"wall_time_s", wall_s},
@@ -433,8 +456,11 @@ json MakeRecord(const SweepSettings& s, const BenchRun& run, std::optional<int> 
   // start is known, and after SE(3) alignment.
   r["ate_m"] = Field(metrics, "/trajectory_error/ate/unaligned/rmse_m");
   r["ate_aligned_m"] = Field(metrics, "/trajectory_error/ate/aligned/rmse_m");
-  // With run: {loop_closure: true} only (null otherwise).
+  // With run: {loop_closure: true} only (null otherwise): the ATE of the stops as they were
+  // registered (the one above is after the last optimisation) and the loop edges' verdicts.
+  r["ate_live_m"] = Field(metrics, "/trajectory_error_live/ate/unaligned/rmse_m");
   r["loop_closures_accepted"] = Field(metrics, "/loop_closures/accepted");
+  r["loop_closures_rejected"] = Field(metrics, "/loop_closures/rejected");
   r["loop_closures_wrong"] = Field(metrics, "/loop_closures/wrong");
   r["final_true_distance_to_goal_m"] = Field(metrics, "/final_true_distance_to_goal_m");
   r["max_registration_error_m"] = Field(metrics, "/max_registration_error/translation_m");
@@ -641,7 +667,9 @@ json SummaryRow(const std::string& world, const std::vector<const json*>& record
           {"median_final_pose_error_m", Median(Numbers(records, "final_pose_error_m"))},
           {"median_ate_m", Median(Numbers(records, "ate_m"))},
           {"median_ate_aligned_m", Median(Numbers(records, "ate_aligned_m"))},
+          {"median_ate_live_m", Median(Numbers(records, "ate_live_m"))},
           {"loop_closures_accepted", Sum(Numbers(records, "loop_closures_accepted"))},
+          {"loop_closures_rejected", Sum(Numbers(records, "loop_closures_rejected"))},
           {"wrong_loop_closures", Sum(Numbers(records, "loop_closures_wrong"))},
           {"max_registration_error_m", Max(Numbers(records, "max_registration_error_m"))},
           {"max_registration_step_m", Max(Numbers(records, "registration_step_max_m"))},
@@ -685,12 +713,13 @@ void PrintTable(const json& summary, std::FILE* out) {
   // "reg max": the worst pose error of a registered stop (with the drift it inherits); "reg step
   // max": the worst error of one registration, the motion since the last merged stop; "false
   // haz": the final map's false hazard cells per cell compared with the truth, median over runs;
-  // "ATE med": the stops' absolute trajectory error (RMSE, unaligned), median over runs; "wrong
-  // loops": loop closures more than 0.1 m or 1 deg off the truth, summed ("-": loop closure off).
-  std::fprintf(out, "%-14s %5s %5s %8s %18s %8s %14s %13s %13s %20s %13s %12s\n", "world",
+  // "ATE med": the stops' absolute trajectory error (RMSE, unaligned, at the final poses), median
+  // over runs; "loops acc/rej/wrong": loop edges accepted and refused by the pose graph's test,
+  // and accepted ones more than 0.1 m or 1 deg off the truth, summed ("-": loop closure off).
+  std::fprintf(out, "%-14s %5s %5s %8s %18s %8s %14s %13s %13s %20s %13s %20s\n", "world",
                "runs", "ok", "success", "wall med/max [s]", "RTF med", "pose err [m]",
                "ATE med [m]", "reg max [m]", "reg step max [m/deg]", "false haz [%]",
-               "wrong loops");
+               "loops acc/rej/wrong");
   std::vector<json> rows(summary["worlds"].begin(), summary["worlds"].end());
   rows.push_back(summary["total"]);
   for (const json& r : rows) {
@@ -698,15 +727,17 @@ void PrintTable(const json& summary, std::FILE* out) {
         Cell(r["median_wall_time_s"], "%.1f") + " / " + Cell(r["max_wall_time_s"], "%.1f");
     const std::string step = Cell(r["max_registration_step_m"], "%.3f") + " / " +
                              Cell(r["max_registration_step_deg"], "%.2f");
-    std::fprintf(out, "%-14s %5zu %5zu %7.1f%% %18s %8s %14s %13s %13s %20s %13s %12s\n",
+    const std::string loops = Cell(r["loop_closures_accepted"], "%.0f") + " / " +
+                              Cell(r["loop_closures_rejected"], "%.0f") + " / " +
+                              Cell(r["wrong_loop_closures"], "%.0f");
+    std::fprintf(out, "%-14s %5zu %5zu %7.1f%% %18s %8s %14s %13s %13s %20s %13s %20s\n",
                  r["world"].get<std::string>().c_str(), r["runs"].get<std::size_t>(),
                  r["successes"].get<std::size_t>(), 100.0 * r["success_rate"].get<double>(),
                  wall.c_str(), Cell(r["median_real_time_factor"], "%.1fx").c_str(),
                  Cell(r["median_final_pose_error_m"], "%.3f").c_str(),
                  Cell(r["median_ate_m"], "%.3f").c_str(),
                  Cell(r["max_registration_error_m"], "%.3f").c_str(), step.c_str(),
-                 Cell(r["median_false_hazard_percent"], "%.2f").c_str(),
-                 Cell(r["wrong_loop_closures"], "%.0f").c_str());
+                 Cell(r["median_false_hazard_percent"], "%.2f").c_str(), loops.c_str());
   }
   for (const auto& [reason, count] : summary["total"]["failure_reasons"].items()) {
     std::fprintf(out, "  failed %dx: %s\n", count.get<int>(), reason.c_str());
@@ -752,24 +783,38 @@ int SummarizeFolders(const CliArgs& args) {
   return 0;
 }
 
-/// A resumed sweep reuses the runs already recorded: they must have been made with this config.
-/// Records from before config_hash was recorded say nothing and are taken as they are.
-void CheckSameConfig(const SweepSettings& s, const std::vector<json>& records) {
-  std::map<std::string, std::vector<std::string>> other;  // hash -> run ids
+/// A resumed sweep reuses the runs already recorded: they must have been made with this config
+/// and driven this route. Records from before config_hash (route) was recorded say nothing and
+/// are taken as they are.
+void CheckSameSweep(const SweepSettings& s, const std::vector<json>& records) {
+  std::map<std::string, std::vector<std::string>> other_config, other_route;  // value -> run ids
   for (const json& r : records) {
     const std::string hash = r.value("config_hash", std::string());
-    if (!hash.empty() && hash != s.config_hash) other[hash].push_back(RecordKey(r));
+    if (!hash.empty() && hash != s.config_hash) other_config[hash].push_back(RecordKey(r));
+    const std::string route = r.value("route", std::string());
+    if (!route.empty() && route != s.route) other_route[route].push_back(RecordKey(r));
   }
-  if (other.empty()) return;
-  std::string made_with;
-  for (const auto& [hash, ids] : other) {
-    made_with += (made_with.empty() ? "" : "; ") + hash + ": " + ids.front() +
-                 (ids.size() > 1 ? " and " + std::to_string(ids.size() - 1) + " more" : "");
+  const auto made_with = [](const std::map<std::string, std::vector<std::string>>& other) {
+    std::string text;
+    for (const auto& [value, ids] : other) {
+      text += (text.empty() ? "" : "; ") + value + ": " + ids.front() +
+              (ids.size() > 1 ? " and " + std::to_string(ids.size() - 1) + " more" : "");
+    }
+    return text;
+  };
+  if (!other_config.empty()) {
+    throw CliError("bench folder '" + s.out.string() + "' holds runs made with another config (" +
+                   made_with(other_config) + "); this sweep's is " + s.config_hash + " (" +
+                   (s.config ? "--config " + s.config->string() : std::string("no --config")) +
+                   "): resuming would mix them; give a new --out, or the config they were made "
+                   "with");
   }
-  throw CliError("bench folder '" + s.out.string() + "' holds runs made with another config (" +
-                 made_with + "); this sweep's is " + s.config_hash + " (" +
-                 (s.config ? "--config " + s.config->string() : std::string("no --config")) +
-                 "): resuming would mix them; give a new --out, or the config they were made with");
+  if (!other_route.empty()) {
+    throw CliError("bench folder '" + s.out.string() + "' holds runs that drove another route (" +
+                   made_with(other_route) + "); this sweep's is '" + s.route +
+                   "': resuming would mix them; give a new --out, or the same --via / "
+                   "--round-trip");
+  }
 }
 
 int Sweep(const CliArgs& args) {
@@ -789,7 +834,7 @@ int Sweep(const CliArgs& args) {
   const fs::path jsonl = s.out / "runs.jsonl";
   std::set<std::string> recorded;
   const std::vector<json> records = ReadRecords(jsonl);
-  CheckSameConfig(s, records);
+  CheckSameSweep(s, records);
   for (const json& r : records) recorded.insert(RecordKey(r));
   std::vector<BenchRun> pending;
   for (const BenchRun& run : shard) {

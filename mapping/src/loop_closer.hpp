@@ -24,6 +24,12 @@ namespace pitchlab::mapping {
 [[nodiscard]] Result<Matrix6d> EdgeInformation(const RegistrationResult& registration,
                                                double scale);
 
+/// The settings a loop registration runs with: `sequential`'s, but no direction the scans leave
+/// free is kept at the guess (carry_max_m = carry_max_deg = 0): the guess is the graph's own
+/// relative pose, and a loop edge must measure it independently; and min_inlier_ratio no lower
+/// than the pairwise default (loop_closer.cpp says why).
+RegistrationConfig LoopRegistrationConfig(RegistrationConfig sequential);
+
 class LoopCloser {
  public:
   /// `config` validated by the caller; `sensor_base`: where the laser sits in each base_link.

@@ -56,12 +56,15 @@ PerScanElevationMap::Contribution PerScanElevationMap::Contribute(const Scan& sc
   std::vector<Eigen::Vector3f> points;
   points.reserve(scan.points_base.size());
   for (const Eigen::Vector3f& p : scan.points_base) points.push_back(T * p);
+  const std::size_t scan_points = points.size();
+  for (const Eigen::Vector3f& p : scan.ground_base) points.push_back(T * p);
   const Eigen::Vector3f sensor = T * scan.sensor_base;
   Contribution out;
   const std::optional<GridGeometry> local = ExtentOn(geometry_, points, sensor);
   if (!local) return out;
   ElevationMap view(*local);
-  (void)view.InsertScan(points.data(), points.size(), sensor, config_);
+  (void)view.InsertScan(points.data(), scan_points, sensor, config_);
+  (void)view.InsertPoints(points.data() + scan_points, points.size() - scan_points, config_);
   const long di = std::lround((local->x_min_m - geometry_.x_min_m) / geometry_.cell_m);
   const long dj = std::lround((local->y_min_m - geometry_.y_min_m) / geometry_.cell_m);
   for (std::size_t k = 0; k < view.cells().size(); ++k) {
@@ -116,13 +119,14 @@ void PerScanElevationMap::Combine() {
 
 Result<void> PerScanElevationMap::Insert(std::size_t id, std::vector<Eigen::Vector3f> points_base,
                                          const Eigen::Vector3f& sensor_base,
-                                         const Eigen::Isometry3d& T_map_base) {
+                                         const Eigen::Isometry3d& T_map_base,
+                                         std::vector<Eigen::Vector3f> ground_base) {
   if (scans_.count(id)) {
     return Fail(Error::Code::kInvalidArgument,
                 "per-scan elevation map: scan " + std::to_string(id) + " is already in the map");
   }
   if (auto ok = CheckPose(T_map_base, id); !ok) return ok;
-  Scan scan{std::move(points_base), sensor_base, T_map_base, {}};
+  Scan scan{std::move(points_base), std::move(ground_base), sensor_base, T_map_base, {}};
   scan.contribution = Contribute(scan);
   scans_.emplace(id, std::move(scan));
   Combine();

@@ -5,18 +5,21 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/point_cloud.hpp"
+#include "pitchlab/mission/elevation_scan.hpp"
 #include "pitchlab/mission/slope_guard.hpp"
+
+#include "optimised_elevation.hpp"
 
 namespace pitchlab::mission {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kMinProgress_m = 0.05;   // less than this over stuck_timeout_s is no progress
-constexpr double kFootprintHalf_m = 0.2;  // ground known under the robot: it stands on it
 constexpr double kStopTime_s = 0.5;       // braking before a scan
 constexpr double kEscapeRadius_m = 1.0;   // how far a start inside a hazard margin looks out
 constexpr double kGoalApproach_m = 2.0;   // a blocked goal farther than this: approach it
@@ -90,26 +93,15 @@ std::vector<Eigen::Vector2d> PathPrefix(const planning::Path& path, double lengt
 }
 
 // Inserts the scan (map frame, rays from `laser`) into the cells of `map` that have no point yet;
-// the others stay as they are, clearance included. Returns the cells it filled.
-std::size_t FillUnknown(mapping::ElevationMap& map, const std::vector<Eigen::Vector3f>& points,
-                        const Eigen::Vector3f& laser) {
-  // A scratch grid over the scan's extent (rays included), aligned to the map's cells.
+// the others stay as they are, clearance included. Returns the view and the cells it filled.
+std::pair<mapping::ElevationMap, std::size_t> FillUnknown(
+    mapping::ElevationMap& map, const std::vector<Eigen::Vector3f>& points,
+    const Eigen::Vector3f& laser) {
+  mapping::ElevationMap view = ViewOver(map.geometry(), points, laser);
   const mapping::GridGeometry& g = map.geometry();
-  Eigen::Vector2f lo = laser.head<2>(), hi = laser.head<2>();
-  for (const Eigen::Vector3f& p : points) {
-    lo = lo.cwiseMin(p.head<2>());
-    hi = hi.cwiseMax(p.head<2>());
-  }
-  const mapping::CellIndex a = g.IndexOf(lo.x(), lo.y()), b = g.IndexOf(hi.x(), hi.y());
-  const int i0 = std::clamp(a.i, 0, g.size_x - 1), j0 = std::clamp(a.j, 0, g.size_y - 1);
-  const int i1 = std::clamp(b.i, 0, g.size_x - 1), j1 = std::clamp(b.j, 0, g.size_y - 1);
-  mapping::GridGeometry local = g;
-  local.x_min_m = g.x_min_m + i0 * g.cell_m;
-  local.y_min_m = g.y_min_m + j0 * g.cell_m;
-  local.size_x = i1 - i0 + 1;
-  local.size_y = j1 - j0 + 1;
-  mapping::ElevationMap view(local);
-  view.InsertScan(points.data(), points.size(), laser);
+  const mapping::GridGeometry& local = view.geometry();
+  const int i0 = static_cast<int>(std::lround((local.x_min_m - g.x_min_m) / g.cell_m));
+  const int j0 = static_cast<int>(std::lround((local.y_min_m - g.y_min_m) / g.cell_m));
   std::size_t filled = 0;
   for (int j = 0; j < local.size_y; ++j) {
     for (int i = 0; i < local.size_x; ++i) {
@@ -118,7 +110,7 @@ std::size_t FillUnknown(mapping::ElevationMap& map, const std::vector<Eigen::Vec
   }
   const auto merged = map.Merge(view, mapping::ElevationMap::MergeCells::kUnknown);
   if (!merged) throw std::logic_error("mission: " + merged.error().message);  // same alignment
-  return filled;
+  return {std::move(view), filled};
 }
 
 // The scan-to-map settings with the laser where the mount puts it (its mirror at zero pitch).
@@ -146,6 +138,11 @@ class Mission {
   // failed) the pose's height is first taken from the map's ground (FitHeightOffset), and the scan
   // fills only the cells the map has not seen (FillUnknown).
   void UpdateElevation(StopRecord& stop);
+  // Loop closure on: a registered stop's scan joins the per-scan map at the graph's pose, and
+  // when this merge's optimisation moved poses every kept scan follows.
+  void UpdateOptimisedElevation(const StopRecord& stop, const ElevationScan& scan);
+  // Every stop's StopRecord::T_world_base_final, from the pose graph's last optimum.
+  void SetFinalPoses();
   void Plan(StopRecord& stop);
   // planning::BuildTraversabilityInto `grid` (one of the members below, reused every stop).
   void Traversability(const mapping::ElevationLayers& layers,
@@ -213,6 +210,9 @@ class Mission {
   const MissionProbes& probes_;
   const MissionObserver& observer_;
   mapping::MapBuilder builder_;
+  // With loop closure: the registered scans kept one by one, so the map the robot plans on
+  // follows the pose graph's optimised poses (result_.elevation is its combination).
+  std::optional<OptimisedElevation> optimised_;
   MissionResult result_;
   Eigen::Isometry3d T_world_map_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_world_base_ = Eigen::Isometry3d::Identity();  // estimate at odo_ref_
@@ -238,6 +238,7 @@ class Mission {
 MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
   result_.start_s = probes_.now_s();
   result_.elevation = mapping::ElevationMap(config_.map_area);
+  if (config_.registration.loop_closure.enabled) optimised_.emplace(config_.map_area);
   nearest_view_m_.assign(config_.map_area.cell_count(), std::numeric_limits<float>::infinity());
   T_world_map_ = T_world_base_ = T_world_start;
   Result<sensors::Odometry> odo = base_.ReadOdometry();
@@ -257,6 +258,7 @@ MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
   result_.map_cloud_world = mapping::TransformCloud(builder_.MapCloud(), T_world_map_);
   result_.loop_counts = builder_.loop_closures();
   result_.loop_closures = builder_.accepted_loops();
+  SetFinalPoses();
   return std::move(result_);
 }
 
@@ -400,15 +402,17 @@ bool Mission::Arrived(StopRecord& stop) {
 
 void Mission::UpdateElevation(StopRecord& stop) {
   const Eigen::Isometry3f T = stop.T_world_base.cast<float>();
+  const ElevationScan scan = ElevationScanOf(stop.scan, config_.map_range_m, config_.mount);
   std::vector<Eigen::Vector3f> near;  // map frame, within map_range_m of the laser
-  near.reserve(stop.scan.points.size());
-  const mapping::GridGeometry& g = config_.map_area;
-  for (const sensors::ScanPoint& p : stop.scan.points) {
-    if (p.range_m > config_.map_range_m) continue;
-    near.push_back(T * Eigen::Vector3f(p.x, p.y, p.z));
-    if (stop.elevation_from_odometry) continue;  // a registered view only
-    const mapping::CellIndex c = g.IndexOf(near.back().x(), near.back().y());
-    if (g.Contains(c)) {
+  near.reserve(scan.points_base.size());
+  for (const Eigen::Vector3f& p : scan.points_base) near.push_back(T * p);
+  if (!stop.elevation_from_odometry) {  // a registered view only
+    const mapping::GridGeometry& g = config_.map_area;
+    for (const sensors::ScanPoint& p : stop.scan.points) {
+      if (p.range_m > config_.map_range_m) continue;
+      const Eigen::Vector3f at = T * Eigen::Vector3f(p.x, p.y, p.z);
+      const mapping::CellIndex c = g.IndexOf(at.x(), at.y());
+      if (!g.Contains(c)) continue;
       float& nearest = nearest_view_m_[g.Linear(c)];
       nearest = std::min(nearest, p.range_m);
     }
@@ -419,7 +423,10 @@ void Mission::UpdateElevation(StopRecord& stop) {
     const std::optional<HeightOffset> fit = FitHeightOffset(result_.elevation, near);
     if (fit && std::abs(fit->dz_m) <= kMaxShift_m) {
       stop.T_world_base.translation().z() -= fit->dz_m;
-      for (Eigen::Vector3f& p : near) p.z() -= static_cast<float>(fit->dz_m);
+      // The points at the pose as corrected, as anyone rebuilding the map from the stop computes
+      // them (a shift in float would differ from that in the last bit).
+      const Eigen::Isometry3f T_fitted = stop.T_world_base.cast<float>();
+      for (std::size_t i = 0; i < near.size(); ++i) near[i] = T_fitted * scan.points_base[i];
       stop.height_fit = fit;
     }
   }
@@ -429,7 +436,13 @@ void Mission::UpdateElevation(StopRecord& stop) {
     // Odometry slips by up to a metre on rugged ground: the scan only fills the map's unknown
     // cells. Blended into the ground the map has seen, a shifted view of it makes steps and
     // drops all over the overlap (the fake hazards that sealed the terrain runs' way).
-    stop.elevation_cells_filled = FillUnknown(result_.elevation, near, laser);
+    auto [view, filled] = FillUnknown(result_.elevation, near, laser);
+    stop.elevation_cells_filled = filled;
+    if (optimised_) optimised_->AddOdometryView(std::move(view));
+    return;
+  }
+  if (optimised_) {
+    UpdateOptimisedElevation(stop, scan);
     return;
   }
   result_.elevation.InsertScan(near.data(), near.size(), laser);
@@ -437,12 +450,40 @@ void Mission::UpdateElevation(StopRecord& stop) {
   // pose knows its height well enough (odometry's z drifts, and a wrong one makes a step around
   // the robot that traps it).
   std::vector<Eigen::Vector3f> ground;
-  for (double x = -kFootprintHalf_m; x <= kFootprintHalf_m + 1e-9; x += 0.1) {
-    for (double y = -kFootprintHalf_m; y <= kFootprintHalf_m + 1e-9; y += 0.1) {
-      ground.push_back(T * Eigen::Vector3f(float(x), float(y), 0.0f));
-    }
-  }
+  for (const Eigen::Vector3f& p : scan.ground_base) ground.push_back(T * p);
   result_.elevation.InsertPoints(ground.data(), ground.size());
+}
+
+void Mission::UpdateOptimisedElevation(const StopRecord& stop, const ElevationScan& scan) {
+  // The graph's poses are rigid and every merged scan is inserted once: a failure is a bug.
+  const auto bug = [](const Error& e) { throw std::logic_error("mission: " + e.message); };
+  if (auto inserted = optimised_->Insert(stop.merge.scan_index, scan, stop.T_world_base);
+      !inserted) {
+    bug(inserted.error());
+  }
+  if (stop.merge.reposed) {
+    std::vector<std::pair<std::size_t, Eigen::Isometry3d>> poses;
+    for (const mapping::TrajectoryPose& p : builder_.trajectory()) {
+      poses.emplace_back(p.scan_index, T_world_map_ * p.T_map_base);
+    }
+    if (auto moved = optimised_->Repose(poses); !moved) bug(moved.error());
+  }
+  result_.elevation = optimised_->Map();
+}
+
+void Mission::SetFinalPoses() {
+  std::map<std::size_t, Eigen::Isometry3d> optimum;  // scan index -> T_world_base
+  for (const mapping::TrajectoryPose& p : builder_.trajectory()) {
+    optimum[p.scan_index] = T_world_map_ * p.T_map_base;
+  }
+  // A stop that did not register is no graph node: it moves with the last registered stop
+  // before it (its odometry pose was propagated from that one).
+  Eigen::Isometry3d correction = Eigen::Isometry3d::Identity();
+  for (StopRecord& stop : result_.stops) {
+    const auto it = stop.merge.merged ? optimum.find(stop.merge.scan_index) : optimum.end();
+    if (it != optimum.end()) correction = it->second * stop.T_world_base.inverse();
+    stop.T_world_base_final = it != optimum.end() ? it->second : correction * stop.T_world_base;
+  }
 }
 
 // The robot may stand where the footprint rule forbids a path to go (a hazard seen late, drift):

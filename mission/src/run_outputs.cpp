@@ -127,6 +127,24 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
           {"rotation_deg", Eigen::AngleAxisd(m.linear()).angle() * kRadToDeg}};
     }
   }
+  // Loop closure on: each earlier scan registered against this one, and the pose graph's verdict.
+  if (!stop.merge.loop_attempts.empty()) {
+    nlohmann::json loops = nlohmann::json::array();
+    for (const mapping::LoopAttempt& a : stop.merge.loop_attempts) {
+      loops.push_back({{"target_scan_index", a.target_scan_index},
+                       {"graph_distance_m", a.candidate.distance_m},
+                       {"graph_uncertainty_m", a.candidate.uncertainty_m},
+                       {"success", a.registration.success},
+                       {"path", mapping::ToString(a.registration.path)},
+                       {"inlier_ratio", a.registration.inlier_ratio},
+                       {"reason", a.registration.reason},
+                       {"tested", a.tested},
+                       {"accepted", a.tested && a.decision.accepted},
+                       {"chi2_increase", a.tested ? nlohmann::json(a.decision.chi2_increase)
+                                                  : nlohmann::json()}});
+    }
+    j["loops"] = loops;
+  }
   // The plan of this stop: how it was found, or why there was none.
   j["plan"] = {{"found", stop.plan.has_value()},
                {"known_m", stop.plan_known_m},
@@ -183,7 +201,10 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
   if (!r.stops.empty()) m["final_estimate"] = PoseJson(r.stops.back().T_world_base);
   if (!c.via.empty()) m["route"] = RouteJson(c, r);  // run --via, --round-trip
   if (c.loop_closure) m["loop_closures"] = LoopClosureJson(r);  // run: {loop_closure: true}
-  m["trajectory_error"] = TrajectoryErrorJson(r);  // the stops' ATE and RPE (null without truth)
+  // The stops' ATE and RPE at their final poses (null without truth); with loop closure also as
+  // they were registered, before later loops moved them.
+  m["trajectory_error"] = TrajectoryErrorJson(r, StopPoses::kFinal);
+  if (c.loop_closure) m["trajectory_error_live"] = TrajectoryErrorJson(r, StopPoses::kLive);
   if (score) {
     m["distance_m"] = score->true_distance_m;
     m["final_pose_error"] = {{"translation_m", score->final_translation_error_m},
@@ -248,7 +269,7 @@ mapping::ElevationLayers WriteFinalData(RunFolder& folder, const RunContext& c,
                                     folder.File("elevation.asc").string()));
   WriteTrajectoryCsv(folder.File("trajectory_estimated.csv"), r, false);
   WriteTrajectoryCsv(folder.File("trajectory_true.csv"), r, true);
-  WriteStopTrajectories(folder, r);
+  WriteStopTrajectories(folder, r, c.loop_closure);
   if (c.geodetic_origin) {
     WriteTrajectoryGeoJson(folder.File("trajectories.geojson"), r, *c.geodetic_origin);
   }

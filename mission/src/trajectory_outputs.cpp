@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "pitchlab/mapping/trajectory_metrics.hpp"
 
@@ -41,19 +42,29 @@ void Put(nlohmann::json& j, const std::string& key, const Result<T>& value, ToJs
 
 }  // namespace
 
-std::vector<mapping::StampedPose> StopTrajectory(const MissionResult& result, bool truth) {
+std::vector<mapping::StampedPose> StopTrajectory(const MissionResult& result, StopPoses which) {
   std::vector<mapping::StampedPose> poses;
   for (const StopRecord& s : result.stops) {
-    if (truth && !s.T_world_base_true) return {};
-    poses.push_back({s.stamp_s, truth ? *s.T_world_base_true : s.T_world_base});
+    switch (which) {
+      case StopPoses::kFinal:
+        poses.push_back({s.stamp_s, s.T_world_base_final});
+        break;
+      case StopPoses::kLive:
+        poses.push_back({s.stamp_s, s.T_world_base});
+        break;
+      case StopPoses::kTrue:
+        if (!s.T_world_base_true) return {};
+        poses.push_back({s.stamp_s, *s.T_world_base_true});
+        break;
+    }
   }
   return poses;
 }
 
-nlohmann::json TrajectoryErrorJson(const MissionResult& result) {
-  const std::vector<mapping::StampedPose> truth = StopTrajectory(result, true);
+nlohmann::json TrajectoryErrorJson(const MissionResult& result, StopPoses estimate) {
+  const std::vector<mapping::StampedPose> truth = StopTrajectory(result, StopPoses::kTrue);
   if (truth.empty()) return nullptr;
-  const std::vector<Eigen::Isometry3d> est = Poses(StopTrajectory(result, false));
+  const std::vector<Eigen::Isometry3d> est = Poses(StopTrajectory(result, estimate));
   const std::vector<Eigen::Isometry3d> tru = Poses(truth);
   nlohmann::json ate, rpe;
   Put(ate, "unaligned", mapping::AbsoluteTrajectoryErrorUnaligned(est, tru), AteJson);
@@ -69,13 +80,17 @@ nlohmann::json TrajectoryErrorJson(const MissionResult& result) {
   return {{"poses", tru.size()}, {"ate", ate}, {"rpe", rpe}};
 }
 
-void WriteStopTrajectories(RunFolder& folder, const MissionResult& result) {
-  for (const bool truth : {false, true}) {
-    const std::vector<mapping::StampedPose> poses = StopTrajectory(result, truth);
-    if (truth && poses.empty()) continue;  // no truth (hardware)
-    const std::string name = truth ? "trajectory_true.tum" : "trajectory_estimated.tum";
+void WriteStopTrajectories(RunFolder& folder, const MissionResult& result, bool live) {
+  const std::pair<StopPoses, const char*> files[] = {
+      {StopPoses::kFinal, "trajectory_estimated.tum"},
+      {StopPoses::kLive, "trajectory_estimated_live.tum"},
+      {StopPoses::kTrue, "trajectory_true.tum"}};
+  for (const auto& [which, name] : files) {
+    if (which == StopPoses::kLive && !live) continue;
+    const std::vector<mapping::StampedPose> poses = StopTrajectory(result, which);
+    if (which == StopPoses::kTrue && poses.empty()) continue;  // no truth (hardware)
     const Result<std::string> text = mapping::FormatTumTrajectory(poses);
-    if (!text) throw std::runtime_error(name + ": " + text.error().message);
+    if (!text) throw std::runtime_error(std::string(name) + ": " + text.error().message);
     WriteTextFile(folder.File(name), *text);
   }
 }

@@ -164,6 +164,33 @@ TEST_F(BenchCli, FailingRunsAreRecordedWithTheirReasonAndTheOthersFinish) {
   EXPECT_TRUE(fs::is_empty(dir_ / "slow/runs"));
 }
 
+TEST_F(BenchCli, ARoundTripSweepDrivesEveryRunToTheGoalAndBackAndResumesOnlyTheSameRoute) {
+  const fs::path out = dir_ / "round_trip";
+  const std::string sweep = "--quiet --worlds " + kYard.string() + " --out " + out.string();
+  const CliResult r = Exec(sweep + " --seeds 1 --round-trip");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json record = Records(out).at(0);
+  EXPECT_EQ(record["route"], "round-trip");
+  EXPECT_TRUE(record["success"].get<bool>()) << record;
+  const json metrics =
+      json::parse(Slurp(out / record["run_dir"].get<std::string>() / "metrics.json"));
+  // The yard's default start (-5.5, 0) is the goal of a round trip; its default goal (5.5, 0)
+  // the one waypoint, reached.
+  EXPECT_DOUBLE_EQ(metrics["goal"]["x_m"].get<double>(), -5.5);
+  ASSERT_EQ(metrics["route"]["via"].size(), 1u);
+  EXPECT_DOUBLE_EQ(metrics["route"]["via"][0]["x_m"].get<double>(), 5.5);
+  EXPECT_EQ(metrics["route"]["waypoints_reached"].get<int>(), 1);
+  // There and back: at least twice the 11 m between start and goal, less the goal tolerance
+  // (0.5 m) at each end.
+  EXPECT_GT(record["distance_m"].get<double>(), 2 * 11.0 - 2 * 0.5);
+  // Resuming the folder with another route would mix the runs: refused, nothing run.
+  const CliResult plain = Exec(sweep + " --seeds 1,2");
+  EXPECT_EQ(plain.exit_code, 2);
+  EXPECT_NE(plain.err.find("drove another route (round-trip: yard-s1)"), std::string::npos)
+      << plain.err;
+  EXPECT_EQ(Records(out).size(), 1u);
+}
+
 struct BadBench {
   std::string args, message;
 };
@@ -181,6 +208,8 @@ TEST_F(BenchCli, BadInputGivesAClearErrorBeforeAnyRunStarts) {
       {" --worlds " + kYard.string() + ",atlantis --seeds 1", "unknown world 'atlantis'"},
       {yard + " --seeds 1 --jobs 0", "--jobs"},
       {yard + " --seeds 1 --config " + (dir_ / "bad.yaml").string(), "drive_per_stop_m"},
+      {yard + " --seeds 1 --via 1,x", "'x', not a number"},
+      {yard + " --seeds 1 --via 1", "needs 2 comma-separated numbers"},
   };
   for (const BadBench& c : cases) {
     const CliResult r = Exec(c.args + " --out " + (dir_ / "never").string());

@@ -47,3 +47,26 @@ TEST(EdgeInformation, ARegistrationWithoutACovarianceIsAnError) {
 
 }  // namespace
 }  // namespace pitchlab::mapping
+
+namespace pitchlab::mapping {
+namespace {
+
+// A loop edge needs the pairwise inlier share even when scan-to-map runs looser (the mission's
+// 15 %: office loops at 15-18 % inliers were 1.6-2.4 deg off), and keeps no direction at the
+// graph's guess; a stricter caller's share stays.
+TEST(LoopRegistrationConfig, NeedsThePairwiseInlierShareAndCarriesNothingFromTheGuess) {
+  RegistrationConfig mission;
+  mission.min_inlier_ratio = 0.15;
+  mission.carry_max_m = 2.0;
+  mission.carry_max_deg = 10.0;
+  const RegistrationConfig loop = LoopRegistrationConfig(mission);
+  EXPECT_DOUBLE_EQ(loop.min_inlier_ratio, RegistrationConfig{}.min_inlier_ratio);
+  EXPECT_EQ(loop.carry_max_m, 0.0);
+  EXPECT_EQ(loop.carry_max_deg, 0.0);
+  RegistrationConfig strict;
+  strict.min_inlier_ratio = 0.5;
+  EXPECT_DOUBLE_EQ(LoopRegistrationConfig(strict).min_inlier_ratio, 0.5);
+}
+
+}  // namespace
+}  // namespace pitchlab::mapping

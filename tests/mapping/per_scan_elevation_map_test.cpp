@@ -74,6 +74,21 @@ void ExpectSameCells(const ElevationMap& a, const ElevationMap& b) {
   EXPECT_EQ(differing, 0u);
 }
 
+// Same known cells, heights within `rounding_m` (the per-scan grid's origin is whole cells away,
+// so cell offsets round differently).
+void ExpectSameCellsToRounding(const ElevationMap& a, const ElevationMap& b, float rounding_m) {
+  ASSERT_EQ(a.cells().size(), b.cells().size());
+  for (std::size_t k = 0; k < a.cells().size(); ++k) {
+    const CellStats& x = a.at(k);
+    const CellStats& y = b.at(k);
+    ASSERT_EQ(x.count, y.count) << "cell " << k;
+    if (!x.known()) continue;
+    EXPECT_NEAR(x.mean_z, y.mean_z, rounding_m) << "cell " << k;
+    EXPECT_NEAR(x.min_z, y.min_z, rounding_m) << "cell " << k;
+    EXPECT_NEAR(x.max_z, y.max_z, rounding_m) << "cell " << k;
+  }
+}
+
 std::size_t KnownCells(const ElevationMap& m) {
   std::size_t n = 0;
   for (const CellStats& c : m.cells()) n += c.known();
@@ -142,15 +157,31 @@ TEST(PerScanElevationMap, OneScanGivesInsertScansMapToFloatRounding) {
   for (const Eigen::Vector3f& p : scan) in_map.push_back(at.cast<float>() * p);
   (void)plain.InsertScan(in_map.data(), in_map.size(), at.cast<float>() * kSensorBase);
   ASSERT_GT(KnownCells(plain), 500u);
-  for (std::size_t k = 0; k < plain.cells().size(); ++k) {
-    const CellStats& x = plain.at(k);
-    const CellStats& y = per_scan.map().at(k);
-    ASSERT_EQ(x.count, y.count) << "cell " << k;
-    if (!x.known()) continue;
-    EXPECT_NEAR(x.mean_z, y.mean_z, kRoundingM) << "cell " << k;
-    EXPECT_NEAR(x.min_z, y.min_z, kRoundingM) << "cell " << k;
-    EXPECT_NEAR(x.max_z, y.max_z, kRoundingM) << "cell " << k;
+  ExpectSameCellsToRounding(plain, per_scan.map(), kRoundingM);
+}
+
+// The ground under the robot (inside the laser's blind zone, so no ray reaches it) goes in
+// without a ray, after the scan: as InsertScan followed by InsertPoints on one map.
+TEST(PerScanElevationMap, GroundPointsGoInAfterTheScanWithoutRays) {
+  constexpr float kRoundingM = 1e-5f;  // as above
+  const Eigen::Isometry3d at = Stop(2);
+  const std::vector<Eigen::Vector3f> scan = Scan(at);
+  std::vector<Eigen::Vector3f> ground;  // a 0.4 m square footprint at 0.1 m, on the floor
+  for (int i = -2; i <= 2; ++i) {
+    for (int j = -2; j <= 2; ++j) ground.emplace_back(0.1f * i, 0.1f * j, 0.0f);
   }
+  PerScanElevationMap per_scan(Area());
+  ASSERT_TRUE(per_scan.Insert(0, scan, kSensorBase, at, ground));
+  ElevationMap plain(Area());
+  std::vector<Eigen::Vector3f> in_map, ground_map;
+  for (const Eigen::Vector3f& p : scan) in_map.push_back(at.cast<float>() * p);
+  for (const Eigen::Vector3f& p : ground) ground_map.push_back(at.cast<float>() * p);
+  (void)plain.InsertScan(in_map.data(), in_map.size(), at.cast<float>() * kSensorBase);
+  ElevationMap scan_only = plain;
+  (void)plain.InsertPoints(ground_map.data(), ground_map.size());
+  ExpectSameCellsToRounding(plain, per_scan.map(), kRoundingM);
+  // Not vacuous: the footprint's cells, unseen by the scan, are known now.
+  EXPECT_GE(KnownCells(plain), KnownCells(scan_only) + 9u);
 }
 
 // Scan "under" stands at the origin and sees the floor out to 6 m; its rays to the far floor pass

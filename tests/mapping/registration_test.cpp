@@ -8,6 +8,7 @@
 
 #include "pitchlab/mapping/registration.hpp"
 #include "pitchlab/sensors/scan3d.hpp"
+#include "loop_closer.hpp"
 #include "sim_scans.hpp"
 
 namespace pitchlab::mapping {
@@ -267,6 +268,30 @@ TEST(Register, TheCorridorTakesItsAxisFromAnOdometryGuessTrustedToAFewCentimetre
   const double sd_along = std::sqrt(along.dot(r->covariance.bottomRightCorner<3, 3>() * along));
   EXPECT_NEAR(sd_along, 0.03, 0.01);
   EXPECT_LT(std::sqrt(r->covariance(5, 5)), 0.005);  // up: the floor and ceiling fix it
+}
+
+// A loop registration's guess is the pose graph's relative pose: when the graph is wrong along the
+// corridor's axis (here 1 m, where it claims 3 cm), keeping the axis at the guess would give a
+// loop edge that repeats the graph's error and passes its consistency test. Loop registrations
+// keep no direction from the guess: the corridor is then not determined, a failure.
+TEST(Register, ALoopRegistrationTakesNoFreeDirectionFromTheGraphsGuess) {
+  const ScanPair corridor = CorridorPair();
+  constexpr double kGraphOffAlong_m = 1.0;
+  RegistrationPrior prior;
+  prior.odometry = Eigen::Translation3d(kGraphOffAlong_m, 0, 0) * corridor.truth;
+  prior.odometry_uncertainty = GuessUncertainty{0.03, 0.3};
+  const RegistrationConfig sequential;
+  Result<RegistrationResult> kept =
+      RegisterScans(corridor.target, corridor.source, prior, sequential);
+  ASSERT_TRUE(kept) << kept.error().message;
+  // What a loop edge would have been with the sequential settings: the graph's error, repeated.
+  ASSERT_TRUE(kept->success) << kept->reason;
+  EXPECT_GT(ComparePoses(kept->T_target_source, corridor.truth).translation_m,
+            kGraphOffAlong_m - 0.1);
+  Result<RegistrationResult> loop = RegisterScans(corridor.target, corridor.source, prior,
+                                                  LoopRegistrationConfig(sequential));
+  ASSERT_TRUE(loop) << loop.error().message;
+  EXPECT_FALSE(loop->success) << loop->reason;
 }
 
 TEST(Register, AMotionModelNeverOverrulesTheRobotsOdometry) {

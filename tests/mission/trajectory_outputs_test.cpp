@@ -8,6 +8,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -47,7 +49,7 @@ MissionResult ShiftedRun() {
     s.index = k;
     s.stamp_s = 10.0 * k + 0.5;
     s.T_world_base_true = Pose(2.0 * k, 0.0, 0.0);
-    s.T_world_base = Pose(2.0 * k, 0.1, 0.0);
+    s.T_world_base = s.T_world_base_final = Pose(2.0 * k, 0.1, 0.0);
     r.stops.push_back(s);
   }
   return r;
@@ -68,10 +70,21 @@ TEST(TrajectoryErrorJson, AConstantOffsetIsAllAbsoluteAndNoneRelativeOrAligned) 
 
 TEST(TrajectoryErrorJson, ARelativeErrorIsDividedByTheTruePathLength) {
   MissionResult r = ShiftedRun();
-  r.stops[3].T_world_base = Pose(6.0 + 0.2, 0.1, 0.0);  // the last step 0.2 m too long
+  r.stops[3].T_world_base_final = Pose(6.0 + 0.2, 0.1, 0.0);  // the last step 0.2 m too long
   const nlohmann::json j = TrajectoryErrorJson(r);
   EXPECT_NEAR(j["rpe"]["per_stop"]["translation_max_m"].get<double>(), 0.2, 1e-12);
   EXPECT_NEAR(j["rpe"]["per_metre"]["translation_max_m_per_m"].get<double>(), 0.2 / 2.0, 1e-12);
+}
+
+// A loop closed late moved the stops' final poses onto the truth; as registered they were 0.1 m
+// off. The default scores the final poses, the live ones on request.
+TEST(TrajectoryErrorJson, TheFinalPosesAreScoredAndTheLiveOnesOnRequest) {
+  MissionResult r = ShiftedRun();
+  for (StopRecord& s : r.stops) s.T_world_base_final = *s.T_world_base_true;
+  EXPECT_NEAR(TrajectoryErrorJson(r)["ate"]["unaligned"]["rmse_m"].get<double>(), 0.0, 1e-12);
+  EXPECT_NEAR(
+      TrajectoryErrorJson(r, StopPoses::kLive)["ate"]["unaligned"]["rmse_m"].get<double>(), 0.1,
+      1e-12);
 }
 
 TEST(TrajectoryErrorJson, OneStopHasNoRelativeErrorAndSaysWhy) {
@@ -91,20 +104,23 @@ TEST(TrajectoryErrorJson, NoTruthIsNull) {
 
 TEST(WriteStopTrajectories, TheTumFilesHoldEachStopAtItsScansTime) {
   const fs::path dir = Scratch();
-  const MissionResult r = ShiftedRun();
+  MissionResult r = ShiftedRun();
+  for (StopRecord& s : r.stops) s.T_world_base_final = *s.T_world_base_true;  // a loop closed
   RunFolder folder(dir / "run");
-  WriteStopTrajectories(folder, r);
+  WriteStopTrajectories(folder, r, /*live=*/true);
   folder.Commit();
-  for (const bool truth : {false, true}) {
-    const auto poses = mapping::ReadTumTrajectory(
-        (dir / "run" / (truth ? "trajectory_true.tum" : "trajectory_estimated.tum")).string());
-    ASSERT_TRUE(poses) << poses.error().message;
+  const std::pair<const char*, std::function<Eigen::Isometry3d(const StopRecord&)>> files[] = {
+      {"trajectory_estimated.tum", [](const StopRecord& s) { return s.T_world_base_final; }},
+      {"trajectory_estimated_live.tum", [](const StopRecord& s) { return s.T_world_base; }},
+      {"trajectory_true.tum", [](const StopRecord& s) { return *s.T_world_base_true; }}};
+  for (const auto& [name, pose] : files) {
+    const auto poses = mapping::ReadTumTrajectory((dir / "run" / name).string());
+    ASSERT_TRUE(poses) << name << ": " << poses.error().message;
     ASSERT_EQ(poses->size(), r.stops.size());
     for (std::size_t k = 0; k < r.stops.size(); ++k) {
       const StopRecord& s = r.stops[k];
       EXPECT_DOUBLE_EQ((*poses)[k].stamp_s, s.stamp_s);
-      EXPECT_TRUE((*poses)[k].T_map_base.isApprox(truth ? *s.T_world_base_true : s.T_world_base,
-                                                  kRoundTrip));
+      EXPECT_TRUE((*poses)[k].T_map_base.isApprox(pose(s), kRoundTrip)) << name << " stop " << k;
     }
   }
 }
@@ -114,9 +130,10 @@ TEST(WriteStopTrajectories, WithoutTruthOnlyTheEstimateIsWritten) {
   MissionResult r = ShiftedRun();
   for (StopRecord& s : r.stops) s.T_world_base_true.reset();
   RunFolder folder(dir / "run");
-  WriteStopTrajectories(folder, r);
+  WriteStopTrajectories(folder, r, /*live=*/false);
   folder.Commit();
   EXPECT_TRUE(fs::exists(dir / "run/trajectory_estimated.tum"));
+  EXPECT_FALSE(fs::exists(dir / "run/trajectory_estimated_live.tum"));  // loop closure off
   EXPECT_FALSE(fs::exists(dir / "run/trajectory_true.tum"));
 }
 

@@ -33,12 +33,15 @@ class PerScanElevationMap {
   explicit PerScanElevationMap(const GridGeometry& geometry, const InsertConfig& config = {});
 
   /// Inserts scan `id` (any number; the map combines scans in increasing id): its points in its
-  /// base_link [m], where its laser sits in base_link [m], and its pose. Errors (the map left as
-  /// it was): `id` already present, a non-finite or non-rigid pose. Non-finite points are skipped
-  /// as InsertScan skips them.
+  /// base_link [m], where its laser sits in base_link [m], and its pose. `ground_base`: points
+  /// known without a ray (the ground under the robot, which the laser cannot see but the robot
+  /// stands on) [m], in base_link, added after the scan as InsertPoints adds them. Errors (the
+  /// map left as it was): `id` already present, a non-finite or non-rigid pose. Non-finite
+  /// points are skipped as InsertScan skips them.
   [[nodiscard]] Result<void> Insert(std::size_t id, std::vector<Eigen::Vector3f> points_base,
                                     const Eigen::Vector3f& sensor_base,
-                                    const Eigen::Isometry3d& T_map_base);
+                                    const Eigen::Isometry3d& T_map_base,
+                                    std::vector<Eigen::Vector3f> ground_base = {});
   /// Takes scan `id`'s contribution out. Error: no scan `id`.
   [[nodiscard]] Result<void> Remove(std::size_t id);
   /// Moves scans to new poses (id, T_map_base) and re-inserts those whose pose changed (any bit);
@@ -64,6 +67,7 @@ class PerScanElevationMap {
   };
   struct Scan {
     std::vector<Eigen::Vector3f> points_base;
+    std::vector<Eigen::Vector3f> ground_base;
     Eigen::Vector3f sensor_base;
     Eigen::Isometry3d T_map_base;
     Contribution contribution;

@@ -112,6 +112,10 @@ struct StopRecord {
   mapping::MergeStep merge;  ///< registration against the map
   Eigen::Isometry3d T_world_base_odom = Eigen::Isometry3d::Identity();  ///< odometry's pose
   Eigen::Isometry3d T_world_base = Eigen::Isometry3d::Identity();       ///< the estimate used
+  /// The pose after the run's last pose-graph optimisation (registration.loop_closure on): a
+  /// registered stop's node; a stop that did not register moves with the last registered stop
+  /// before it. Equals T_world_base with loop closure off. Set when the mission ends.
+  Eigen::Isometry3d T_world_base_final = Eigen::Isometry3d::Identity();
   std::optional<Eigen::Isometry3d> T_world_base_true;                   ///< simulation only
   std::optional<planning::Path> plan;  ///< to the goal, world frame
   std::string plan_error;              ///< why there was no plan

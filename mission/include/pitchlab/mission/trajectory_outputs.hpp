@@ -4,6 +4,10 @@
 // of each stop's scan) and metrics.json's "trajectory_error": absolute trajectory error without
 // and after SE(3) alignment, relative pose error per stop and per metre (mapping's
 // trajectory_metrics.hpp). Kept apart from the rest of metrics.json so it merges on its own.
+// The estimate scored and written is the final one (StopRecord::T_world_base_final: the pose
+// graph's last optimum with loop closure); with loop closure the live one (each stop as it was
+// registered, what the robot acted on) is kept beside it: trajectory_estimated_live.tum and
+// "trajectory_error_live".
 
 #include <vector>
 
@@ -21,20 +25,29 @@ namespace pitchlab::mission {
 /// is never divided by a near-zero length.
 inline constexpr double kRpeSegmentM = 1.0;
 
-/// The stops' poses stamped with their scans' time: the estimates used (`truth` false) or the
-/// true ones; empty when some stop has no truth (hardware runs).
-std::vector<mapping::StampedPose> StopTrajectory(const MissionResult& result, bool truth);
+/// Which of a stop's poses.
+enum class StopPoses {
+  kFinal,  ///< StopRecord::T_world_base_final: after the run's last optimisation
+  kLive,   ///< StopRecord::T_world_base: as the stop was registered (what the robot acted on)
+  kTrue,   ///< StopRecord::T_world_base_true
+};
 
-/// metrics.json's "trajectory_error" over StopTrajectory's estimate vs truth: {poses,
+/// The stops' poses stamped with their scans' time; with kTrue empty when some stop has no truth
+/// (hardware runs).
+std::vector<mapping::StampedPose> StopTrajectory(const MissionResult& result, StopPoses which);
+
+/// metrics.json's "trajectory_error" over StopTrajectory's `estimate` vs truth: {poses,
 /// ate: {unaligned, aligned}: {rmse_m, max_m, rotation_rmse_deg}, rpe: {per_stop: {pairs,
 /// translation_rmse_m, translation_max_m, rotation_rmse_deg, rotation_max_deg}, per_metre: {the
 /// same per metre, segment_m}}}. A metric that cannot be computed (one stop, a path shorter than
 /// kRpeSegmentM) is null with "<name>_note" saying why. Null when the run has no truth.
-nlohmann::json TrajectoryErrorJson(const MissionResult& result);
+nlohmann::json TrajectoryErrorJson(const MissionResult& result,
+                                   StopPoses estimate = StopPoses::kFinal);
 
-/// Writes trajectory_estimated.tum and, with truth, trajectory_true.tum. Throws
+/// Writes trajectory_estimated.tum (final poses), with `live` also trajectory_estimated_live.tum
+/// (live poses), and with truth trajectory_true.tum. Throws
 /// std::runtime_error naming the file on a bad trajectory (stamps not increasing) or a write
 /// failure.
-void WriteStopTrajectories(RunFolder& folder, const MissionResult& result);
+void WriteStopTrajectories(RunFolder& folder, const MissionResult& result, bool live);
 
 }  // namespace pitchlab::mission

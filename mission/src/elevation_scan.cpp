@@ -1,0 +1,46 @@
+#include "pitchlab/mission/elevation_scan.hpp"
+
+#include <algorithm>
+
+namespace pitchlab::mission {
+
+ElevationScan ElevationScanOf(const sensors::Scan3D& scan, double map_range_m,
+                              const sensors::MountConfig& mount) {
+  // The ground known under the robot: half its 0.4 m footprint each way, at the map's 0.1 m cell.
+  constexpr double kFootprintHalf_m = 0.2, kStep_m = 0.1;
+  ElevationScan out;
+  out.points_base.reserve(scan.points.size());
+  for (const sensors::ScanPoint& p : scan.points) {
+    if (p.range_m <= map_range_m) out.points_base.emplace_back(p.x, p.y, p.z);
+  }
+  out.sensor_base = mount.BaseToLaser(0.0).translation().cast<float>();
+  for (double x = -kFootprintHalf_m; x <= kFootprintHalf_m + 1e-9; x += kStep_m) {
+    for (double y = -kFootprintHalf_m; y <= kFootprintHalf_m + 1e-9; y += kStep_m) {
+      out.ground_base.emplace_back(float(x), float(y), 0.0f);
+    }
+  }
+  return out;
+}
+
+mapping::ElevationMap ViewOver(const mapping::GridGeometry& area,
+                               const std::vector<Eigen::Vector3f>& points,
+                               const Eigen::Vector3f& laser) {
+  Eigen::Vector2f lo = laser.head<2>(), hi = laser.head<2>();
+  for (const Eigen::Vector3f& p : points) {
+    lo = lo.cwiseMin(p.head<2>());
+    hi = hi.cwiseMax(p.head<2>());
+  }
+  const mapping::CellIndex a = area.IndexOf(lo.x(), lo.y()), b = area.IndexOf(hi.x(), hi.y());
+  const int i0 = std::clamp(a.i, 0, area.size_x - 1), j0 = std::clamp(a.j, 0, area.size_y - 1);
+  const int i1 = std::clamp(b.i, 0, area.size_x - 1), j1 = std::clamp(b.j, 0, area.size_y - 1);
+  mapping::GridGeometry local = area;
+  local.x_min_m = area.x_min_m + i0 * area.cell_m;
+  local.y_min_m = area.y_min_m + j0 * area.cell_m;
+  local.size_x = i1 - i0 + 1;
+  local.size_y = j1 - j0 + 1;
+  mapping::ElevationMap view(local);
+  view.InsertScan(points.data(), points.size(), laser);
+  return view;
+}
+
+}  // namespace pitchlab::mission
