@@ -115,16 +115,6 @@ Eigen::Quaterniond OnPlane(const Eigen::Vector3d& coeffs, double yaw_rad) {
 Result<Eigen::Isometry3d> Simulation::PlaceRobot(double x_m, double y_m, double yaw_rad,
                                                  const PlacementConfig& config) {
   Impl& s = *impl_;
-  // The drop and the settling are solved in full: the state is never held while placing.
-  struct PlacingGuard {
-    Impl& s;
-    explicit PlacingGuard(Impl& impl) : s(impl) {
-      s.held = false;
-      s.placing = true;
-      s.monitor.Reset();
-    }
-    ~PlacingGuard() { s.placing = false; }
-  } placing(s);
   const P3Params& p = params();
   if (world_.bounds) {
     const Eigen::Vector4d& b = *world_.bounds;

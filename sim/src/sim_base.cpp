@@ -11,8 +11,8 @@ namespace {
 constexpr double kWheelKi_per_s = 10.0;    // firmware PI: integral gain on wheel speed error
 constexpr double kMaxIntegral_rps = 5.0;   // integral clamp [rad/s]
 constexpr double kStillSpeed_mps = 0.005;  // Stop(): still below this [m/s]
-constexpr double kStillRate_rps = 0.01;   // ... and this [rad/s]
-constexpr double kHoldGain_per_s = 5.0;   // parked: wheel speed per radian off the held angle
+constexpr double kStillRate_rps = 0.01;
+constexpr double kHoldGain_per_s = 5.0;   // parked: wheel speed per radian off the held angle    // ... and this [rad/s]
 
 double Ramp(double from, double to, double max_delta) {
   return from + std::clamp(to - from, -max_delta, max_delta);
@@ -58,10 +58,7 @@ SimBase::SimBase(Simulation& sim, const OdometryConfig& odometry)
   hooks_ = sim_.AddStepHooks([this] { BeforeStep(); }, [this] { AfterStep(); });
 }
 
-SimBase::~SimBase() {
-  sim_.RemoveHooks(hooks_);
-  sim_.PermitRest(false);  // no controller holds the wheels any more
-}
+SimBase::~SimBase() { sim_.RemoveHooks(hooks_); }
 
 double SimBase::effective_track_m() const {
   return sim_.params().track_m * sim_.params().track_factor;
@@ -133,10 +130,6 @@ void SimBase::BeforeStep() {
   // Parked, the firmware holds the wheels where they stopped (a position loop), so the robot
   // does not roll down a slope while it scans.
   const bool parked = command_.isZero() && target_.isZero();
-  // The simulation may hold a parked robot's state at rest; held, the servo's inputs do not
-  // change and its output is held with them (integrating a frozen residual would only wind up).
-  sim_.PermitRest(parked);
-  if (sim_.resting()) return;
   if (parked && !holding_) hold_angles_ = sim_.WheelAngles();
   holding_ = parked;
   if (parked) ref_rps = kHoldGain_per_s * (hold_angles_ - sim_.WheelAngles());

@@ -30,7 +30,6 @@ std::unique_ptr<SimRig> SimRig::FromString(const std::string& world_xml,
 
 SimRig::SimRig(std::unique_ptr<Simulation> sim, const SimRigConfig& config)
     : config_(config), sim_(std::move(sim)) {
-  sim_->set_rest_config(config_.rest);
   const std::array<double, 3> e = sensors::DrawMountErrorRpyRad(config_.lms200);
   mount_error_rpy_rad_ = Eigen::Vector3d(e[0], e[1], e[2]);
   sensors::RayCasterOptions options;

@@ -138,7 +138,6 @@ Simulation::Simulation(const std::string& world_xml, const std::string& base_dir
   s.pitch_qpos = s.m->jnt_qposadr[pitch];
   s.pitch_dof = s.m->jnt_dofadr[pitch];
   s.pitch_act = IdOrThrow(s.m, mjOBJ_ACTUATOR, kPitchActuator);
-  s.pitch_joint = pitch;
   for (const WheelSpec& w : Wheels(params())) {
     const int j = IdOrThrow(s.m, mjOBJ_JOINT, w.joint.c_str());
     const int a = IdOrThrow(s.m, mjOBJ_ACTUATOR, (w.joint + "_motor").c_str());
@@ -155,7 +154,6 @@ Simulation::Simulation(const std::string& world_xml, const std::string& base_dir
                              std::to_string(robot_.pitch_servo.kv_nms_per_rad) +
                              " (kv * timestep / inertia = " + std::to_string(courant) + " > 1.5)");
   }
-  s.monitor = RestMonitor(rest_);
   mj_forward(s.m, s.d);
 }
 
@@ -166,35 +164,24 @@ const mjData_* Simulation::data() const { return impl_->d; }
 double Simulation::time_s() const { return impl_->d->time; }
 double Simulation::timestep_s() const { return impl_->m->opt.timestep; }
 
-// PD servo with bias (gravity) and rate feed-forward: torque = kp (q_sp - q) + kv (rate_sp -
-// qdot) + bias, so q tracks a slewing setpoint and sits exactly on a fixed one.
-double Simulation::PitchServoCtrl(double bias_nm, double passive_nm) const {
-  const PitchServoConfig& servo = robot_.pitch_servo;
-  return pitch_setpoint_rad_ +
-         (bias_nm - passive_nm + servo.kv_nms_per_rad * pitch_setpoint_rate_rps_) /
-             servo.kp_nm_per_rad;
-}
-
 void Simulation::Step(int n) {
   Impl& s = *impl_;
   for (int i = 0; i < n; ++i) {
-    const bool was_held = s.held;
-    if (!was_held) mj_step1(s.m, s.d);
+    mj_step1(s.m, s.d);
     for (auto& [id, hook] : s.hooks) {
       if (hook.first) hook.first();
     }
-    if (s.held) {
-      StepPitchOnly();
-    } else {
-      if (was_held) mj_step1(s.m, s.d);  // a hook released the held state: solve this step
-      s.d->ctrl[s.pitch_act] =
-          PitchServoCtrl(s.d->qfrc_bias[s.pitch_dof], s.d->qfrc_passive[s.pitch_dof]);
-      mj_step2(s.m, s.d);
-    }
+    // PD servo with bias (gravity) and rate feed-forward: torque = kp (q_sp - q) + kv (rate_sp -
+    // qdot) + bias, so q tracks a slewing setpoint and sits exactly on a fixed one.
+    const PitchServoConfig& servo = robot_.pitch_servo;
+    s.d->ctrl[s.pitch_act] =
+        pitch_setpoint_rad_ + (s.d->qfrc_bias[s.pitch_dof] - s.d->qfrc_passive[s.pitch_dof] +
+                               servo.kv_nms_per_rad * pitch_setpoint_rate_rps_) /
+                                  servo.kp_nm_per_rad;
+    mj_step2(s.m, s.d);
     for (auto& [id, hook] : s.hooks) {
       if (hook.second) hook.second();
     }
-    UpdateRest();
   }
   mj_kinematics(s.m, s.d);  // fresh xpos/site/geom poses for ground truth and the ray casters
 }

@@ -9,7 +9,6 @@
 #include <mujoco/mujoco.h>
 
 #include "pitchlab/sim/simulation.hpp"
-#include "rest_monitor.hpp"
 
 namespace pitchlab::sim {
 
@@ -18,7 +17,7 @@ struct Simulation::Impl {
   mjData* d = nullptr;
   int robot_body = -1, root_qpos = -1, root_dof = -1;
   int base_site = -1, laser_site = -1;
-  int pitch_qpos = -1, pitch_dof = -1, pitch_act = -1, pitch_joint = -1;
+  int pitch_qpos = -1, pitch_dof = -1, pitch_act = -1;
   struct Wheel {
     int qpos, dof, act;
     bool left;
@@ -26,13 +25,6 @@ struct Simulation::Impl {
   std::vector<Wheel> wheels;
   std::map<int, std::pair<StepHook, StepHook>> hooks;
   int next_hook = 0;
-  // Rest hold (RestConfig): the state is held while `held`; `permitted` is the base's word that
-  // it is parked, `placing` keeps PlaceRobot's settling fully simulated.
-  RestMonitor monitor{RestConfig{}};
-  bool permitted = false, held = false, placing = false;
-  double held_from_pitch_rad = 0.0;  // pitch when the state was held (recheck_pitch_rad)
-  double pitch_inertia = 0.0;        // about the pitch axis, with armature, from qM [kg m^2]
-  double held_s = 0.0;               // simulated time held [s]
 
   ~Impl() {
     if (d) mj_deleteData(d);

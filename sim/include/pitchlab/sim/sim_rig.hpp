@@ -32,7 +32,6 @@ struct SimRigConfig {
   OdometryConfig odometry;
   ImuConfig imu;  ///< deskews scans when imu.deskew
   PlacementConfig placement;
-  RestConfig rest;  ///< when the parked robot's state is held while it scans
   CasterKind caster = CasterKind::kEmbree;
 };
 

@@ -2,7 +2,6 @@
 // One MuJoCo world with the P3 robot: owns mjModel/mjData, steps physics, runs the robot's
 // low-level servos (pitch gravity feed-forward, hooks for the base controller), gives ground truth.
 
-#include <cmath>
 #include <functional>
 #include <memory>
 #include <string>
@@ -30,35 +29,6 @@ struct PlacementConfig {
   double settle_rate_rps = 0.05;   ///< settled: angular speed below [rad/s]
   double settle_hold_s = 0.1;      ///< ... for this long [s]
   double max_settle_s = 3.0;       ///< give up after [s]
-};
-
-/// When a parked robot counts as at rest. At rest the Simulation holds the MuJoCo state and
-/// advances only time and the laser's pitch joint (a one-joint model on the held base) instead of
-/// solving the whole robot and its contacts every step: 62 % of a mission's simulated time is
-/// spent standing to scan. Thresholds are for the seed scan (17 s of sweep, see below).
-struct RestConfig {
-  bool enabled = true;  ///< false: every step solves the whole robot
-  /// The base's mean pose is compared over consecutive windows this long [s]: each pitch step
-  /// (25 lines/s) rings the tyre contacts at 1-15 mm/s and 1-100 mrad/s with micrometre
-  /// amplitudes; five line periods average that out, leaving the drift.
-  double window_s = 0.2;
-  /// Mean drift below this is rest [m/s]: 1 mm over a 17 s sweep, less than an encoder tick
-  /// (1.35 mm) and a fifth of the LMS200's range sigma (5 mm). A 10 deg slope's creep under
-  /// the wheel hold (0.4 mm/s) is 6x above it and stays fully simulated.
-  double max_speed_mps = 6e-5;
-  /// Mean turn rate below this is rest [rad/s]: a fifth of the gyro's angle random walk over a
-  /// 17 s sweep (0.02 deg/s/sqrt(Hz): 1.4 mrad), i.e. 0.3 mrad, 3 mm at 10 m.
-  double max_rate_rps = 1.7e-5;
-  /// ... and the base still by SimBase::Stop()'s standard at that instant [m/s], [rad/s].
-  double still_speed_mps = 0.005;
-  double still_rate_rps = 0.01;
-  /// The held state is checked again by the whole model once the laser has pitched this far
-  /// [rad]: 20 deg moves the LMS200's centre of mass (5 cm off the axis) by 1.7 cm and the
-  /// robot's by 3 mm, 2.5 % of the load between front and rear tyres, enough to change a creep.
-  double recheck_pitch_rad = 20.0 * M_PI / 180.0;
-
-  /// Throws std::invalid_argument naming the field and value.
-  void Validate() const;
 };
 
 /// MuJoCo world + robot. Not copyable; one thread at a time.
@@ -108,17 +78,6 @@ class Simulation {
   /// Linear [m/s] and angular [rad/s] speed of the robot's root body.
   Eigen::Vector2d BaseSpeeds() const;
 
-  /// Sets when the robot counts as at rest (validates; throws std::invalid_argument).
-  void set_rest_config(const RestConfig& config);
-  const RestConfig& rest_config() const { return rest_; }
-  /// The base controller's word that the wheels are commanded zero (parked); the state is only
-  /// held while it stands. Called before each step by SimBase; false releases a held state now.
-  void PermitRest(bool parked);
-  /// True while the state is held (only time and the pitch joint advance).
-  bool resting() const;
-  /// Simulated time spent with the state held since construction [s].
-  double rest_time_s() const;
-
   /// Puts base_link at (x, y) with heading `yaw_rad` on the ground and lets it settle. Fails
   /// (kInvalidArgument) outside pitchlab:bounds, off the world (no ground under the footprint),
   /// inside or under an obstacle; (kFailed) when it does not settle or ends tilted.
@@ -143,12 +102,7 @@ class Simulation {
   std::string composed_xml_;
   double pitch_setpoint_rad_ = 0.0;
   double pitch_setpoint_rate_rps_ = 0.0;
-  RestConfig rest_;
   std::unique_ptr<Impl> impl_;
-
-  double PitchServoCtrl(double bias_nm, double passive_nm) const;
-  void StepPitchOnly();
-  void UpdateRest();
 };
 
 }  // namespace pitchlab::sim
