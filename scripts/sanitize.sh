@@ -25,8 +25,28 @@ cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 cmake --build "$build_dir" -j"$(nproc)" ${TARGETS:+--target $TARGETS}
 # Leaks: the libraries' process-lifetime singletons (TBB's, VTK's through PCL) are listed in
 # scripts/lsan.supp, each with why; anything else is ours and fails.
-export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:abort_on_error=0:strict_string_checks=1"
+# Many tests run `pitchlab` as a child and expect it to fail (exit 1 or 2 on bad input): a report
+# in such a child, exiting 1 as ASan does by default, would pass for the expected failure. So
+# ASan's and LSan's reports go to files in $reports, from every process, and any file there fails
+# the run; and both sanitizers exit 86, a code no pitchlab command uses (0, 1, 2, 130, 143).
+# GCC's libubsan writes its diagnostics to stderr whatever log_path says (measured with gcc 12),
+# so a UB report is caught by its exit code alone.
+reports=$PWD/$build_dir/sanitizer-reports
+rm -rf "$reports"
+mkdir -p "$reports"
+export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:abort_on_error=0:strict_string_checks=1:exitcode=86:log_path=$reports/asan"
 export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp:print_suppressions=0"
-export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:exitcode=86"
 # The fuzz label is clang's own sanitizer build (tests/hw/fuzz): not this one's business.
-ctest --test-dir "$build_dir" --output-on-failure -j"$(nproc)" -LE fuzz --timeout 1800 "$@"
+status=0
+ctest --test-dir "$build_dir" --output-on-failure -j"$(nproc)" -LE fuzz --timeout 1800 "$@" ||
+  status=$?
+if [ -n "$(ls -A "$reports")" ]; then
+  for f in "$reports"/*; do
+    echo "sanitize: report of process ${f##*.} ($f):"
+    cat "$f"
+  done
+  echo "sanitize: FAIL: $(ls "$reports" | wc -l) sanitizer report(s) in $reports" >&2
+  exit 1
+fi
+exit "$status"
