@@ -1,4 +1,5 @@
 # Run as: cmake -DBUILD_DIR=... -DEXAMPLE_DIR=... -DWORK_DIR=... -DBUILD_TREE_WORLDS=... -P this
+#   [-DTREE_CXX_FLAGS=... -DTREE_EXE_LINKER_FLAGS=...: the flags the installed tree was built with]
 cmake_minimum_required(VERSION 3.22)
 
 function(run what)
@@ -46,9 +47,14 @@ run("installed pitchlab worlds" "${prefix}/bin/pitchlab" worlds --json)
 string(FIND "${last_output}" "${prefix}/share/pitchlab/worlds" at)
 expect("NOT;at;EQUAL;-1" "installed `pitchlab worlds` does not read ${prefix}/share/pitchlab/worlds:\n${last_output}")
 
-# A user's project: configure and build examples/ against the prefix only.
+# A user's project: configure and build examples/ against the prefix only. It is built with the
+# flags the installed libraries were built with, as a user of such a package must: the libraries
+# are static, so an instrumented tree (scripts/sanitize.sh) installs objects that call ASan's
+# runtime (__asan_init) and link only with -fsanitize, and Eigen's allocator must agree on
+# EIGEN_MALLOC_ALREADY_ALIGNED across the library and the program that frees its matrices.
 run("configure examples/" ${CMAKE_COMMAND} -S "${EXAMPLE_DIR}" -B "${WORK_DIR}/example"
-    -DCMAKE_BUILD_TYPE=Release "-DCMAKE_PREFIX_PATH=${prefix}")
+    -DCMAKE_BUILD_TYPE=Release "-DCMAKE_PREFIX_PATH=${prefix}"
+    "-DCMAKE_CXX_FLAGS=${TREE_CXX_FLAGS}" "-DCMAKE_EXE_LINKER_FLAGS=${TREE_EXE_LINKER_FLAGS}")
 run("build examples/" ${CMAKE_COMMAND} --build "${WORK_DIR}/example")
 
 # A goal that is no number is the user's mistake: exit 2 with the usage, before any work.
