@@ -49,6 +49,7 @@ class HelpLayout : public CLI::Formatter {
 }  // namespace
 
 struct CliArgs::Declared {
+  std::string command;  ///< as in messages: "register", "hw emulate"
   CLI::App app;
   std::map<std::string, CLI::Option*> options;
   std::map<std::string, std::string> defaults;
@@ -59,6 +60,7 @@ struct CliArgs::Declared {
 
 CliArgs::CliArgs(std::string command, std::string summary)
     : declared_(std::make_unique<Declared>()) {
+  declared_->command = command;
   CLI::App& app = declared_->app;
   app.name("pitchlab " + command);
   app.description(std::move(summary));
@@ -109,7 +111,7 @@ bool CliArgs::Parse(int argc, char** argv) {
   CLI::App& app = declared_->app;
   // CLI11 takes the arguments last first.
   std::vector<std::string> args(argv, argv + argc);
-  const std::string command = app.get_name().substr(std::string("pitchlab ").size());
+  const std::string& command = declared_->command;
   for (const std::string& arg : args) {
     if (arg == "--") break;
     // CLI11 reads `--flag=false` as "not given"; pitchlab's switches take no value at all.
@@ -173,8 +175,7 @@ std::string CliArgs::Get(const std::string& name) const {
   if (const auto d = declared_->defaults.find(name); d != declared_->defaults.end()) {
     return d->second;
   }
-  const std::string command = declared_->app.get_name().substr(std::string("pitchlab ").size());
-  throw CliError("'" + command + "' needs --" + name + " (see --help)");
+  throw CliError("'" + declared_->command + "' needs --" + name + " (see --help)");
 }
 
 bool CliArgs::Flagged(const std::string& name) const {

@@ -38,16 +38,9 @@ TraversabilityGrid BuildTraversability(const OccupancyGrid& grid, const PlannerC
   config.Validate();
   const std::size_t n = grid.geometry.cell_count();
   TraversabilityGrid T;
-  T.geometry = grid.geometry;
-  T.config = config;
   // No heights: the ground is flat at z = 0 where it is known (Eq. 4's P the flat distance), and
   // no roughness or inclination is known.
-  T.z_m.assign(n, std::numeric_limits<float>::quiet_NaN());
-  T.enter_cost.assign(n, 0.0f);
-  T.roughness_m.assign(n, 0.0f);
-  T.phi_x_rad.assign(n, 0.0f);
-  T.phi_y_rad.assign(n, 0.0f);
-  T.blocked.assign(n, Blocked::kFree);
+  StartTraversability(grid.geometry, config, T);
   T.occupancy_cost.assign(n, 0.0f);
   const double full = FullScaleCost(config);
   for (std::size_t k = 0; k < n; ++k) {

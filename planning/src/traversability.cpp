@@ -375,16 +375,7 @@ void BuildTraversabilityInto(const ElevationLayers& L, const PlannerConfig& conf
                              TraversabilityGrid& T) {
   config.Validate();
   const GridGeometry& g = L.geometry;
-  const std::size_t n = g.cell_count();
-  T.geometry = g;
-  T.config = config;
-  T.occupancy_cost.clear();  // an elevation map's grid has none
-  T.z_m.assign(n, std::numeric_limits<float>::quiet_NaN());
-  T.enter_cost.assign(n, 0.0f);
-  T.roughness_m.assign(n, 0.0f);
-  T.phi_x_rad.assign(n, 0.0f);
-  T.phi_y_rad.assign(n, 0.0f);
-  T.blocked.assign(n, Blocked::kFree);
+  StartTraversability(g, config, T);
   const CostWeights& w = config.weights;
   for (int j = 0; j < g.size_y; ++j)
     for (int i = 0; i < g.size_x; ++i) {
@@ -423,6 +414,20 @@ void BuildTraversabilityInto(const ElevationLayers& L, const PlannerConfig& conf
     }
   T.bridged_cells = BridgeScanGaps(L, T);
   FinishTraversability(T);
+}
+
+void StartTraversability(const GridGeometry& g, const PlannerConfig& config,
+                         TraversabilityGrid& T) {
+  const std::size_t n = g.cell_count();
+  T.geometry = g;
+  T.config = config;
+  T.occupancy_cost.clear();
+  T.z_m.assign(n, std::numeric_limits<float>::quiet_NaN());
+  T.enter_cost.assign(n, 0.0f);
+  T.roughness_m.assign(n, 0.0f);
+  T.phi_x_rad.assign(n, 0.0f);
+  T.phi_y_rad.assign(n, 0.0f);
+  T.blocked.assign(n, Blocked::kFree);
 }
 
 void FinishTraversability(TraversabilityGrid& T) {
