@@ -76,6 +76,11 @@ void Inclination(const ElevationMap& map, int ci, int cj, const LayerConfig& con
   Moments points, centres;
   const float z_c = map.at({ci, cj}).mean_z;
   const int r = config.inclination_radius_cells;
+  // A neighbour whose own points rise more than a max_fit_slope surface across a cell's diagonal
+  // holds a step's foot (a wall or a door jamb and the floor before it), not slope: with its mean
+  // still near the floor's, its wall points tilted the fits of the floor cells beside it (office
+  // doors closed by "too steep" floor cells at the jambs under the measured LMS200 model).
+  const double max_own_rise = config.max_fit_slope * std::sqrt(2.0) * g.cell_m;
   for (int dj = -r; dj <= r; ++dj) {
     for (int di = -r; di <= r; ++di) {
       const CellIndex nb{ci + di, cj + dj};
@@ -84,6 +89,7 @@ void Inclination(const ElevationMap& map, int ci, int cj, const LayerConfig& con
       if (c.count == 0) continue;
       const double ox = di * g.cell_m, oy = dj * g.cell_m;
       if (std::abs(c.mean_z - z_c) > config.max_fit_slope * std::hypot(ox, oy)) continue;
+      if ((di != 0 || dj != 0) && c.max_z - c.min_z > max_own_rise) continue;
       points.Add(c.count, c.mean_x + ox, c.mean_y + oy, c.mean_z, c.c_xx, c.c_xy, c.c_xz, c.c_yy,
                  c.c_yz);
       centres.Add(1, ox, oy, c.mean_z, 0, 0, 0, 0, 0);

@@ -5,15 +5,26 @@
 namespace pitchlab::mission {
 
 ElevationScan ElevationScanOf(const sensors::Scan3D& scan, double map_range_m,
-                              const sensors::MountConfig& mount) {
+                              const sensors::MountConfig& mount, double beam_divergence_rad,
+                              double cell_m) {
   // The ground known under the robot: half its 0.4 m footprint each way, at the map's 0.1 m cell.
   constexpr double kFootprintHalf_m = 0.2, kStep_m = 0.1;
   ElevationScan out;
   out.points_base.reserve(scan.points.size());
-  for (const sensors::ScanPoint& p : scan.points) {
-    if (p.range_m <= map_range_m) out.points_base.emplace_back(p.x, p.y, p.z);
-  }
   out.sensor_base = mount.BaseToLaser(0.0).translation().cast<float>();
+  sensors::GrazingConfig grazing;
+  grazing.beam_divergence_rad = beam_divergence_rad;
+  grazing.max_spread_m = cell_m;
+  const std::vector<bool> grazed = sensors::GrazedReturns(scan, mount, grazing);
+  for (std::size_t i = 0; i < scan.points.size(); ++i) {
+    const sensors::ScanPoint& p = scan.points[i];
+    if (p.range_m > map_range_m) continue;
+    if (grazed[i]) {
+      ++out.grazed;
+      continue;
+    }
+    out.points_base.emplace_back(p.x, p.y, p.z);
+  }
   for (double x = -kFootprintHalf_m; x <= kFootprintHalf_m + 1e-9; x += kStep_m) {
     for (double y = -kFootprintHalf_m; y <= kFootprintHalf_m + 1e-9; y += kStep_m) {
       out.ground_base.emplace_back(float(x), float(y), 0.0f);

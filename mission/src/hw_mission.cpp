@@ -1,6 +1,7 @@
 #include "pitchlab/mission/hw_mission.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <set>
 #include <sstream>
@@ -280,6 +281,7 @@ HwMissionOutcome RunHwMission(const HwMissionSpec& spec, const std::filesystem::
   MissionConfig& mission = settings.mission;
   mission.goal_m = frame.goal;
   mission.mount = spec.config.rig.robot.mount;
+  mission.beam_divergence_rad = spec.config.rig.lms200.beam_divergence_deg * M_PI / 180.0;
   mission.map_area = frame.map_area;
 
   HwMissionOutcome run;

@@ -402,7 +402,8 @@ bool Mission::Arrived(StopRecord& stop) {
 
 void Mission::UpdateElevation(StopRecord& stop) {
   const Eigen::Isometry3f T = stop.T_world_base.cast<float>();
-  const ElevationScan scan = ElevationScanOf(stop.scan, config_.map_range_m, config_.mount);
+  const ElevationScan scan = ElevationScanOf(stop.scan, config_.map_range_m, config_.mount,
+                                              config_.beam_divergence_rad, config_.map_area.cell_m);
   std::vector<Eigen::Vector3f> near;  // map frame, within map_range_m of the laser
   near.reserve(scan.points_base.size());
   for (const Eigen::Vector3f& p : scan.points_base) near.push_back(T * p);

@@ -211,6 +211,7 @@ SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesyste
   mission.goal_m = goal;
   mission.via_m = via;
   mission.mount = spec.config.rig.robot.mount;
+  mission.beam_divergence_rad = spec.config.rig.lms200.beam_divergence_deg * M_PI / 180.0;
   const worlds::Bounds2d& b = meta.bounds;
   mission.map_area = mapping::GridGeometry::Covering(Eigen::Vector2d(b.x_min_m, b.y_min_m),
                                                      Eigen::Vector2d(b.x_max_m, b.y_max_m),

@@ -5,6 +5,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -40,7 +41,9 @@ std::size_t DifferingCells(const mapping::ElevationMap& a, const mapping::Elevat
 mapping::ElevationMap Rebuilt(const SimMissionSpec& spec, const MissionResult& r, bool final) {
   const sensors::MountConfig& mount = spec.config.rig.robot.mount;
   const auto input = [&](const StopRecord& s) {
-    return ElevationScanOf(s.scan, spec.settings.mission.map_range_m, mount);
+    return ElevationScanOf(s.scan, spec.settings.mission.map_range_m, mount,
+                           spec.config.rig.lms200.beam_divergence_deg * M_PI / 180.0,
+                           r.elevation.geometry().cell_m);
   };
   mapping::PerScanElevationMap scans(r.elevation.geometry());
   for (const StopRecord& s : r.stops) {

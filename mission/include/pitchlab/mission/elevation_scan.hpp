@@ -11,13 +11,17 @@
 #include <Eigen/Core>
 
 #include "pitchlab/mapping/elevation_map.hpp"
+#include "pitchlab/sensors/grazing_returns.hpp"
 #include "pitchlab/sensors/scan3d.hpp"
 
 namespace pitchlab::mission {
 
 /// A stop's scan as the elevation map takes it, base_link [m].
 struct ElevationScan {
-  std::vector<Eigen::Vector3f> points_base;  ///< returns within the map range
+  std::vector<Eigen::Vector3f> points_base;  ///< returns within the map range, none grazed
+  /// Returns within the map range left out as grazed (sensors/grazing_returns.hpp): on a steep
+  /// surface, so obliquely that the footprint spreads over more than a map cell along the beam.
+  std::size_t grazed = 0;
   Eigen::Vector3f sensor_base = Eigen::Vector3f::Zero();  ///< the laser, mirror at zero pitch
   /// The ground the robot stands on: the laser cannot see under the robot, but a registered pose
   /// knows that ground's height (a 0.4 m square at 0.1 m spacing, base_link's z = 0).
@@ -25,9 +29,12 @@ struct ElevationScan {
 };
 
 /// The returns of `scan` no farther than `map_range_m` from the laser (MissionConfig's
-/// map_range_m), the laser's place from `mount`, the footprint's ground.
+/// map_range_m) except the grazed ones (a beam of `beam_divergence_rad` spreading over more than
+/// `cell_m`, the map's cell, on a steep surface), the laser's place from `mount`, the footprint's
+/// ground.
 ElevationScan ElevationScanOf(const sensors::Scan3D& scan, double map_range_m,
-                              const sensors::MountConfig& mount);
+                              const sensors::MountConfig& mount, double beam_divergence_rad,
+                              double cell_m);
 
 /// `points` (world frame [m], rays from `laser`) inserted alone into a grid over their extent,
 /// aligned to `area`'s cells: the view of a stop that did not register, which fills only the

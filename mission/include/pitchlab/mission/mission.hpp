@@ -81,6 +81,10 @@ struct MissionConfig {
   mapping::MapConfig registration;  ///< scan-to-map merging
   mapping::GridGeometry map_area;   ///< the elevation map's grid, world frame
   sensors::MountConfig mount;       ///< for the laser origin of clearance rays
+  /// The laser's full beam width (Lms200Config::beam_divergence_deg, 0.25 deg): a return on a
+  /// steep surface whose footprint spreads over more than a map cell along the beam stays out of
+  /// the elevation map (sensors/grazing_returns.hpp) [rad].
+  double beam_divergence_rad = 0.25 * 3.14159265358979323846 / 180.0;
 };
 
 /// What the loop reads besides the seam interfaces. `now_s` is required; the others may be empty.
