@@ -26,6 +26,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pitchlab/sensors/cloud_file.hpp"
+#include "pitchlab/sensors/grazing_returns.hpp"
 #include "pitchlab/sensors/sensor_config.hpp"
 #include "pitchlab/sim/sim_rig.hpp"
 
@@ -218,6 +219,9 @@ struct Accumulator {
   // Floor.
   std::vector<double> floor_tilt_deg, floor_roll_deg, floor_pitch_deg, floor_sigma_m, floor_rms_m;
   std::vector<double> floor_points;
+  // Grazed returns (sensors::GrazedReturns, with the elevation map's 0.1 m cell) within the
+  // mission's 10 m map range.
+  double grazed = 0, within_map_range = 0;
 };
 
 struct PatchFit {
@@ -424,7 +428,42 @@ void FloorStats(const RangeGrid& g, const std::vector<PatchFit>& fits, Accumulat
   acc.floor_points.push_back(static_cast<double>(resid.size()));
 }
 
+// What the mission would leave out of its elevation map as grazed: the grid as an organised scan
+// with each line's laser at the origin (the points shifted by their line's origin).
+void GrazedStats(const RangeGrid& g, Accumulator& acc) {
+  constexpr double kMapRange_m = 10.0, kCell_m = 0.1;  // MissionConfig::map_range_m, cell_m
+  sensors::Scan3D scan;
+  scan.lines.resize(static_cast<std::size_t>(g.lines));
+  for (int l = 0; l < g.lines; ++l) {
+    for (int b = 0; b < g.beams; ++b) {
+      const std::size_t i = g.Index(l, b);
+      if (g.cell[i] != Cell::kValid) continue;
+      const Eigen::Vector3d p = g.point[i] - g.origin[static_cast<std::size_t>(l)];
+      sensors::ScanPoint sp;
+      sp.x = static_cast<float>(p.x());
+      sp.y = static_cast<float>(p.y());
+      sp.z = static_cast<float>(p.z());
+      sp.range_m = g.range[i];
+      sp.line = static_cast<std::uint16_t>(l);
+      sp.beam = static_cast<std::uint16_t>(b);
+      scan.points.push_back(sp);
+    }
+  }
+  sensors::MountConfig at_origin;
+  at_origin.t_base_mount_m.setZero();
+  at_origin.t_mount_laser_m.setZero();
+  sensors::GrazingConfig config;
+  config.max_spread_m = kCell_m;
+  const std::vector<bool> grazed = sensors::GrazedReturns(scan, at_origin, config);
+  for (std::size_t i = 0; i < scan.points.size(); ++i) {
+    if (scan.points[i].range_m > kMapRange_m) continue;
+    acc.within_map_range += 1;
+    acc.grazed += grazed[i];
+  }
+}
+
 void Measure(const RangeGrid& g, Accumulator& acc) {
+  GrazedStats(g, acc);
   std::vector<PatchFit> fits;
   PlaneStats(g, acc, fits);
   DropoutStats(g, fits, acc);
@@ -467,6 +506,7 @@ std::map<std::string, double> Summarize(const Accumulator& a) {
   s["floor_tilt_deg"] = Mean(a.floor_tilt_deg);
   s["floor_sigma_m"] = Mean(a.floor_sigma_m);
   s["floor_rms_m"] = Mean(a.floor_rms_m);
+  s["grazed_fraction_within_10m"] = a.grazed / a.within_map_range;
   return s;
 }
 

@@ -31,12 +31,23 @@ std::optional<HeightOffset> FitHeightOffset(const mapping::ElevationMap& map,
   }
   std::sort(keyed.begin(), keyed.end());
   std::vector<double> diff;  // scan's cell mean minus the map's
+  // Ground only: a cell whose points, in the scan or in the map, rise more than the cell is wide
+  // holds a face steeper than 45 deg (a wall, a jamb, a desk's edge), which no P3 drives (35 %
+  // grade), and its mean depends on how much of the face each view saw. A stop facing a door a
+  // step away overlapped the map mostly in such cells; their means put its floor 0.14 m low.
+  const double max_rise = g.cell_m;
   for (std::size_t b = 0; b < keyed.size();) {
     std::size_t e = b;
     double sum = 0;
-    for (; e < keyed.size() && keyed[e].first == keyed[b].first; ++e) sum += keyed[e].second;
+    float lo = keyed[b].second, hi = keyed[b].second;
+    for (; e < keyed.size() && keyed[e].first == keyed[b].first; ++e) {
+      sum += keyed[e].second;
+      lo = std::min(lo, keyed[e].second);
+      hi = std::max(hi, keyed[e].second);
+    }
     const mapping::CellStats& m = map.at(keyed[b].first);
-    if (static_cast<int>(e - b) >= kMinPointsPerCell && m.count >= kMinPointsPerCell) {
+    if (static_cast<int>(e - b) >= kMinPointsPerCell && m.count >= kMinPointsPerCell &&
+        hi - lo <= max_rise && m.max_z - m.min_z <= max_rise) {
       diff.push_back(sum / static_cast<double>(e - b) - m.mean_z);
     }
     b = e;

@@ -39,6 +39,30 @@ TEST(HeightFit, RecoversTheShiftOfTheSameGroundDespiteClutter) {
   EXPECT_LE(fit->cells, 120 * 120 - 20 * 20);  // the box's cells are not among them
 }
 
+TEST(HeightFit, WallCellsDoNotSetTheOffsetWhereTheyOutnumberTheGround) {
+  // A flat floor z = 0 with a wall along y = 1 (0.1 m thick, 2 m high) that the map saw from far:
+  // a few wall points per cell. The stop stands a step from it and sees the wall densely and only
+  // 40 cells of floor; its pose is 0.1 m too high. The wall cells' means differ between the two
+  // views by how much of the face each saw, and they outnumber the floor's.
+  mapping::ElevationMap map(mapping::GridGeometry::FromArea(-5, -5, 10, 10, 0.1));
+  std::vector<Eigen::Vector3f> seen;
+  for (double x = -4.98; x < 5; x += 0.04)
+    for (double y = -4.98; y < 0.95; y += 0.04) seen.emplace_back(x, y, 0.0f);
+  for (double x = -4.98; x < 5; x += 0.02)
+    for (double z = 0.0; z <= 0.3; z += 0.1) seen.emplace_back(x, 0.97f, z);
+  (void)map.InsertPoints(seen.data(), seen.size());
+  const double dz = 0.1;
+  std::vector<Eigen::Vector3f> scan;
+  for (double x = -2; x < 2; x += 0.02)
+    for (double z = 0.0; z <= 2.0; z += 0.02) scan.emplace_back(x, 0.97f, z + dz);
+  for (double x = -1; x < 1; x += 0.04)
+    for (double y = 0.51; y < 0.7; y += 0.04) scan.emplace_back(x, y, dz);
+  const std::optional<HeightOffset> fit = FitHeightOffset(map, scan, 20);
+  ASSERT_TRUE(fit);
+  EXPECT_NEAR(fit->dz_m, dz, 1e-5);
+  EXPECT_EQ(fit->cells, 40);  // the floor's 20 x 2 cells (without the rule: 80, the wall's too)
+}
+
 TEST(HeightFit, TooLittleOverlapFitsNothing) {
   const mapping::ElevationMap map = GroundMap();
   std::vector<Eigen::Vector3f> strip;
