@@ -76,10 +76,14 @@ void Inclination(const ElevationMap& map, int ci, int cj, const LayerConfig& con
   Moments points, centres;
   const float z_c = map.at({ci, cj}).mean_z;
   const int r = config.inclination_radius_cells;
-  // A neighbour whose own points rise more than a max_fit_slope surface across a cell's diagonal
-  // holds a step's foot (a wall or a door jamb and the floor before it), not slope: with its mean
-  // still near the floor's, its wall points tilted the fits of the floor cells beside it (office
-  // doors closed by "too steep" floor cells at the jambs under the measured LMS200 model).
+  // A neighbour some of whose points stand off its own mean by more than a max_fit_slope face
+  // across a cell's diagonal holds a step's foot (a wall or a door jamb and the floor before it),
+  // not slope: with its mean still near the floor's, its wall points tilted the fits of the floor
+  // cells beside it (office doors closed by "too steep" floor cells at the jambs under the
+  // measured LMS200 model). A steep slope through a cell spreads its points evenly about the mean,
+  // half the rise each way, and stays in the fit up to a 74 deg face (the bound on the whole rise,
+  // max - min, also took the gully's steep ground out of its neighbours' fits: terrain runs
+  // drove onto slopes they read as gentler and got stuck).
   const double max_own_rise = config.max_fit_slope * std::sqrt(2.0) * g.cell_m;
   for (int dj = -r; dj <= r; ++dj) {
     for (int di = -r; di <= r; ++di) {
@@ -89,7 +93,10 @@ void Inclination(const ElevationMap& map, int ci, int cj, const LayerConfig& con
       if (c.count == 0) continue;
       const double ox = di * g.cell_m, oy = dj * g.cell_m;
       if (std::abs(c.mean_z - z_c) > config.max_fit_slope * std::hypot(ox, oy)) continue;
-      if ((di != 0 || dj != 0) && c.max_z - c.min_z > max_own_rise) continue;
+      if ((di != 0 || dj != 0) &&
+          std::max(c.max_z - c.mean_z, c.mean_z - c.min_z) > max_own_rise) {
+        continue;
+      }
       points.Add(c.count, c.mean_x + ox, c.mean_y + oy, c.mean_z, c.c_xx, c.c_xy, c.c_xz, c.c_yy,
                  c.c_yz);
       centres.Add(1, ox, oy, c.mean_z, 0, 0, 0, 0, 0);

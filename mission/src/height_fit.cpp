@@ -4,6 +4,8 @@
 #include <cmath>
 #include <utility>
 
+#include "pitchlab/mapping/elevation_layers.hpp"
+
 namespace pitchlab::mission {
 namespace {
 
@@ -31,11 +33,13 @@ std::optional<HeightOffset> FitHeightOffset(const mapping::ElevationMap& map,
   }
   std::sort(keyed.begin(), keyed.end());
   std::vector<double> diff;  // scan's cell mean minus the map's
-  // Ground only: a cell whose points, in the scan or in the map, rise more than the cell is wide
-  // holds a face steeper than 45 deg (a wall, a jamb, a desk's edge), which no P3 drives (35 %
-  // grade), and its mean depends on how much of the face each view saw. A stop facing a door a
-  // step away overlapped the map mostly in such cells; their means put its floor 0.14 m low.
-  const double max_rise = g.cell_m;
+  // Ground only: a cell whose points, in the scan or in the map, rise more than a 60 deg face
+  // across the cell's diagonal (mapping::LayerConfig::max_fit_slope, the elevation layers' line
+  // between slope and step) holds a step (a wall, a jamb, a desk's edge), and its mean depends on
+  // how much of the face each view saw. A stop facing a door a step away overlapped the map
+  // mostly in such cells; their means put its floor 0.14 m low. (A 45 deg bound, a cell's width,
+  // also left out the rough ground of terrain runs, whose stops then missed their height fit.)
+  const double max_rise = mapping::LayerConfig{}.max_fit_slope * std::sqrt(2.0) * g.cell_m;
   for (std::size_t b = 0; b < keyed.size();) {
     std::size_t e = b;
     double sum = 0;

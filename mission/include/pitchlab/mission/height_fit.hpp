@@ -24,7 +24,7 @@ struct HeightOffset {
 
 /// The offset of `points` (world frame) against the cells of `map` that hold at least 3 points,
 /// comparing per-cell means where the scan has 3 points or more too and neither's points rise
-/// more than the cell is wide (ground, not a wall's face): the mean difference over
+/// more than a 60 deg face across the cell (ground, not a wall's face): the mean difference over
 /// the cells within 3 scaled MADs (at least 5 cm) of the median, which drops what changed or was
 /// seen from another side (a wall's top, a rock's flank). nullopt below `min_cells` cells.
 std::optional<HeightOffset> FitHeightOffset(const mapping::ElevationMap& map,
