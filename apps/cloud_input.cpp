@@ -1,6 +1,7 @@
 #include "cloud_input.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
@@ -8,12 +9,14 @@
 #include <utility>
 #include <vector>
 
+#include "pitchlab/mapping/line_pitch.hpp"
 #include "pitchlab/sensors/cloud_file.hpp"
 
 namespace pitchlab::apps {
 
 sensors::Scan3D LoadInputCloud(const std::string& path,
-                               const std::optional<Eigen::Vector3d>& sensor_origin_override) {
+                               const std::optional<Eigen::Vector3d>& sensor_origin_override,
+                               bool set_lines_right, nlohmann::json* line_pitch) {
   Result<sensors::Scan3D> scan = sensors::ReadCloudFile(path);
   if (!scan) throw std::runtime_error(scan.error().message);
   if (sensor_origin_override) {
@@ -22,6 +25,37 @@ sensors::Scan3D LoadInputCloud(const std::string& path,
     std::cerr << "warning: '" << path << "' does not say where its sensor stood; assuming the "
               << "origin of its points' frame (give it with --sensor-origin x,y,z [m])\n";
     sensors::SetSensorOrigin(*scan, Eigen::Vector3d::Zero());
+  }
+  if (set_lines_right) {
+    std::vector<Eigen::Vector3f> points;
+    points.reserve(scan->points.size());
+    for (const sensors::ScanPoint& p : scan->points) points.emplace_back(p.x, p.y, p.z);
+    const mapping::LinePitch r = mapping::RectifyLinePitch(points, scan->sensor_origin->cast<float>());
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      scan->points[k].x = points[k].x();
+      scan->points[k].y = points[k].y();
+      scan->points[k].z = points[k].z();
+    }
+    constexpr double kToDeg = 180 / 3.14159265358979323846;
+    if (r.corrected > 0) {
+      std::fprintf(stderr,
+                   "%s: %zu of %zu lines set right by the floor they crossed (pitch corrections "
+                   "%.2f deg RMS, at most %.2f; floor %.1f -> %.1f mm RMS)\n",
+                   path.c_str(), r.corrected, r.lines, r.rms_correction_rad * kToDeg,
+                   r.max_correction_rad * kToDeg, r.floor_rms_before_m * 1e3,
+                   r.floor_rms_after_m * 1e3);
+    }
+    if (line_pitch) {
+      *line_pitch = {{"lines", r.lines},
+                     {"corrected", r.corrected},
+                     {"rms_correction_deg", r.rms_correction_rad * kToDeg},
+                     {"max_correction_deg", r.max_correction_rad * kToDeg},
+                     {"floor_rms_before_m", r.floor_rms_before_m},
+                     {"floor_rms_after_m", r.floor_rms_after_m}};
+      if (!r.note.empty()) (*line_pitch)["note"] = r.note;
+    }
+  } else if (line_pitch) {
+    *line_pitch = {{"corrected", 0}, {"note", "--as-recorded"}};
   }
   return std::move(*scan);
 }

@@ -73,6 +73,7 @@ CliArgs MapArgs() {
       "unknown.");
   args.Positionals("CLOUD", "one or more clouds, any format below", 1, 1000)
       .Option("sensor-origin", "x,y,z", kSensorOriginHelp)
+      .Flag("as-recorded", kAsRecordedHelp)
       .Option("cell", "METRES", "cell size [m]", "0.1")
       .Option("out", "DIR", "output folder to create (refused when it exists, as run refuses)")
       .Option("area", "xmin,ymin,xmax,ymax", "map area [m] (default: the clouds' extent)")
@@ -102,11 +103,14 @@ struct LoadedCloud {
   Eigen::Vector3f sensor_origin;        // approximate laser position in the world
   std::size_t no_position = 0;          // points the file held without one (NaN), dropped
   std::string world;                    // the world it was scanned in, when the file says
+  nlohmann::json line_pitch;            // what setting its lines right did
 };
 
-LoadedCloud LoadCloud(const std::string& path, const std::optional<Eigen::Vector3d>& origin) {
-  const sensors::Scan3D scan = LoadInputCloud(path, origin);  // any format; origin always set
+LoadedCloud LoadCloud(const std::string& path, const std::optional<Eigen::Vector3d>& origin,
+                      bool set_lines_right) {
   LoadedCloud c;
+  // Any format; origin always set; lines set right in the scan's own frame, before its pose.
+  const sensors::Scan3D scan = LoadInputCloud(path, origin, set_lines_right, &c.line_pitch);
   const Eigen::Isometry3f T = scan.T_world_base.cast<float>();
   c.points.reserve(scan.points.size());
   for (const sensors::ScanPoint& p : scan.points)
@@ -235,7 +239,7 @@ int RunMap(int argc, char** argv) {
   std::size_t no_position = 0;
   for (const std::string& path : args.positionals()) {
     progress("reading " + path);
-    clouds.push_back(LoadCloud(path, sensor_origin));
+    clouds.push_back(LoadCloud(path, sensor_origin, !args.Flagged("as-recorded")));
     if (world_path) CheckSameWorld(path, clouds.back().world, *world_path);
     no_position += clouds.back().no_position;
     for (const Eigen::Vector3f& p : clouds.back().points) {
@@ -243,6 +247,10 @@ int RunMap(int argc, char** argv) {
       hi = hi.cwiseMax(p.head<2>().cast<double>());
     }
     total_points += clouds.back().points.size();
+  }
+  nlohmann::json line_pitch = nlohmann::json::array();
+  for (std::size_t k = 0; k < clouds.size(); ++k) {
+    line_pitch.push_back({{"cloud", args.positionals()[k]}, {"result", clouds[k].line_pitch}});
   }
   // Levelling by the first cloud's floor (see --help), before the grid is laid over the points.
   nlohmann::json levelling;
@@ -391,6 +399,7 @@ int RunMap(int argc, char** argv) {
       {"max_height_m", insert.max_height_m},
       {"sensor_height_m", insert.sensor_height_m},
       {"levelling", levelling},
+      {"line_pitch", line_pitch},
       {"known_cells", known},
       {"drop_cells", drops},
       {"insert_time_s", insert_s},

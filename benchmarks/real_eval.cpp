@@ -24,6 +24,7 @@
 #include <Eigen/Eigenvalues>
 #include <nlohmann/json.hpp>
 
+#include "pitchlab/mapping/line_pitch.hpp"
 #include "pitchlab/mapping/registration.hpp"
 #include "pitchlab/sensors/cloud_file.hpp"
 #include "real_map_check.hpp"
@@ -120,6 +121,8 @@ struct Scan {
   sensors::Scan3D scan;
   mapping::PointCloud cloud;
   Eigen::Isometry3d reference;  // slam6d's registered pose
+  mapping::LinePitch line_pitch;  // what setting its lines right did
+  double line_pitch_cpu_s = 0;    // and its CPU time [s]
 };
 
 Scan Load(const fs::path& path) {
@@ -129,6 +132,11 @@ Scan Load(const fs::path& path) {
   if (!scan) throw std::runtime_error(scan.error().message);
   s.scan = *scan;
   s.cloud = mapping::CloudFromScan(s.scan);
+  // Each nodding line set right by the floor it crossed, as the commands read real scans.
+  const double cpu = ThreadCpuSeconds();
+  s.line_pitch = mapping::RectifyLinePitch(
+      s.cloud, s.scan.sensor_origin.value_or(Eigen::Vector3d::Zero()).cast<float>());
+  s.line_pitch_cpu_s = ThreadCpuSeconds() - cpu;
   // The reference: scanNNN.frames, or any scanNNN.frames.* beside it.
   const std::string stem = path.stem().string();
   std::vector<fs::path> frames;
@@ -281,7 +289,20 @@ int main(int argc, char** argv) {
     } else {
       map_check["at_ours"] = "not built: a registration with the prior failed";
     }
+    json line_pitch = json::array();
+    for (const Scan& s : scans) {
+      line_pitch.push_back({{"scan", s.path},
+                            {"lines", s.line_pitch.lines},
+                            {"corrected", s.line_pitch.corrected},
+                            {"rms_correction_deg", s.line_pitch.rms_correction_rad * 180 / M_PI},
+                            {"max_correction_deg", s.line_pitch.max_correction_rad * 180 / M_PI},
+                            {"floor_rms_before_m", s.line_pitch.floor_rms_before_m},
+                            {"floor_rms_after_m", s.line_pitch.floor_rms_after_m},
+                            {"note", s.line_pitch.note},
+                            {"cpu_s", s.line_pitch_cpu_s}});
+    }
     json out = {{"folder", dir},
+                {"line_pitch", line_pitch},
                 {"prior_error", {bound.translation_m, bound.rotation_deg}},
                 {"runs", runs},
                 {"successes", successes},

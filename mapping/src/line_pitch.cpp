@@ -1,0 +1,287 @@
+#include "pitchlab/mapping/line_pitch.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <utility>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+namespace pitchlab::mapping {
+namespace {
+
+// A point relative to the sensor turned about the pitch axis (y) by `angle` [rad].
+Eigen::Vector3d TurnedAboutY(const Eigen::Vector3d& v, double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  return {c * v.x() + s * v.z(), v.y(), -s * v.x() + c * v.z()};
+}
+
+// The scan's lines: indices of points of one elevation about the y axis through the sensor, each
+// of at least min_line_points, and how many finite points there were.
+std::vector<std::vector<std::uint32_t>> LinesOf(const std::vector<Eigen::Vector3f>& points,
+                                                const Eigen::Vector3f& sensor,
+                                                const LinePitchConfig& config,
+                                                std::size_t* finite) {
+  std::vector<std::pair<double, std::uint32_t>> elevation;
+  elevation.reserve(points.size());
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    if (!points[k].allFinite()) continue;
+    const Eigen::Vector3f v = points[k] - sensor;
+    // On the axis itself (a beam along y) the elevation is undefined: such points join no line.
+    if (std::hypot(v.x(), v.z()) < 1e-3f) continue;
+    elevation.emplace_back(std::atan2(-static_cast<double>(v.z()), static_cast<double>(v.x())),
+                           static_cast<std::uint32_t>(k));
+  }
+  *finite = elevation.size();
+  std::sort(elevation.begin(), elevation.end());
+  std::vector<std::vector<std::uint32_t>> lines;
+  std::vector<std::uint32_t> run;
+  for (std::size_t k = 0; k <= elevation.size(); ++k) {
+    if (k == elevation.size() ||
+        (k > 0 && elevation[k].first - elevation[k - 1].first > config.line_gap_rad)) {
+      if (run.size() >= config.min_line_points) lines.push_back(run);
+      run.clear();
+      if (k == elevation.size()) break;
+    }
+    run.push_back(elevation[k].second);
+  }
+  return lines;
+}
+
+struct FloorPlane {
+  Eigen::Vector3d n = Eigen::Vector3d::UnitZ();  // up normal
+  double d = 0;                                  // n . v = d, v relative to the sensor
+};
+
+// Total least squares plane through `v`, normal turned up.
+FloorPlane FitPlane(const std::vector<Eigen::Vector3d>& v) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : v) mean += p;
+  mean /= static_cast<double>(v.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& p : v) cov += (p - mean) * (p - mean).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  FloorPlane plane;
+  plane.n = eig.eigenvectors().col(0);
+  if (plane.n.z() < 0) plane.n = -plane.n;
+  plane.d = plane.n.dot(mean);
+  return plane;
+}
+
+// One line's floor candidates relative to the sensor, and the correction found for it.
+struct Line {
+  std::vector<std::uint32_t> all;         // every point of the line
+  std::vector<Eigen::Vector3d> floor;     // its points in the floor band, relative to the sensor
+  double correction_rad = 0;
+  double lever_m = 0;  // mean |d e / d angle| of its floor points: how far ahead it meets the floor
+  bool corrected = false;
+};
+
+// The correction of one line against `plane`: the angle most of its floor points agree on (the
+// densest window of their individual angles, `tolerance_m` wide at their median lever), refined
+// by least squares over the points then within tolerance_m of the plane. Returns the number of
+// those points (0: no verdict).
+std::size_t CorrectLine(Line& line, const FloorPlane& plane, double tolerance_m,
+                        const LinePitchConfig& config) {
+  // Angle at which each point would lie on the plane, to first order about the current turn.
+  std::vector<double> angle, lever;
+  for (const Eigen::Vector3d& v : line.floor) {
+    const Eigen::Vector3d t = TurnedAboutY(v, line.correction_rad);
+    const double a = plane.n.x() * t.z() - plane.n.z() * t.x();  // n . (y x t)
+    if (std::abs(a) < 1e-3) continue;
+    angle.push_back(line.correction_rad - (plane.n.dot(t) - plane.d) / a);
+    lever.push_back(std::abs(a));
+  }
+  if (angle.size() < config.min_line_points) return 0;
+  std::vector<double> sorted_lever = lever;
+  std::nth_element(sorted_lever.begin(), sorted_lever.begin() + sorted_lever.size() / 2,
+                   sorted_lever.end());
+  const double width = 2 * tolerance_m / sorted_lever[sorted_lever.size() / 2];
+  std::vector<double> sorted = angle;
+  std::sort(sorted.begin(), sorted.end());
+  std::size_t best = 0, best_begin = 0;
+  for (std::size_t b = 0, e = 0; b < sorted.size(); ++b) {
+    while (e < sorted.size() && sorted[e] - sorted[b] <= width) ++e;
+    if (e - b > best) best = e - b, best_begin = b;
+  }
+  double guess = 0;
+  for (std::size_t k = best_begin; k < best_begin + best; ++k) guess += sorted[k];
+  guess /= static_cast<double>(best);
+  // Least squares over the points within tolerance at the guess (Gauss-Newton, two steps).
+  double angle_now = guess;
+  std::size_t used = 0;
+  for (int step = 0; step < 2; ++step) {
+    double num = 0, den = 0, lever_sum = 0;
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero(), sum_sq = Eigen::Vector2d::Zero();
+    used = 0;
+    for (const Eigen::Vector3d& v : line.floor) {
+      const Eigen::Vector3d t = TurnedAboutY(v, angle_now);
+      const double e = plane.n.dot(t) - plane.d;
+      if (!(std::abs(e) <= tolerance_m)) continue;
+      const double a = plane.n.x() * t.z() - plane.n.z() * t.x();
+      num += a * e;
+      den += a * a;
+      lever_sum += std::abs(a);
+      sum += t.head<2>();
+      sum_sq += t.head<2>().cwiseProduct(t.head<2>());
+      ++used;
+    }
+    if (used < config.min_line_points || den <= 0) return 0;
+    // A pitched line meets the floor across the scan (along y, at one distance ahead); points
+    // that line up along x are a wall's foot or an obstacle's, not the floor's trace.
+    const Eigen::Vector2d var = sum_sq / used - (sum / used).cwiseProduct(sum / used);
+    if (!(var.y() >= 9 * var.x())) return 0;
+    angle_now -= num / den;
+    line.lever_m = lever_sum / used;
+  }
+  if (!(std::abs(angle_now) <= config.max_correction_rad)) return 0;
+  line.correction_rad = angle_now;
+  return used;
+}
+
+// Each line's points that may be floor (relative to the sensor): below the sensor within the
+// levelling's radii, and within what the largest correction could move onto `plane`.
+std::vector<Line> FloorCandidates(const std::vector<std::vector<std::uint32_t>>& indices,
+                                  const std::vector<Eigen::Vector3f>& points,
+                                  const Eigen::Vector3f& sensor, const FloorPlane& plane,
+                                  double sigma_m, const LinePitchConfig& config) {
+  std::vector<Line> lines(indices.size());
+  for (std::size_t l = 0; l < indices.size(); ++l) {
+    lines[l].all = indices[l];
+    for (const std::uint32_t k : indices[l]) {
+      const Eigen::Vector3d v = (points[k] - sensor).cast<double>();
+      const double r = std::hypot(v.x(), v.y());
+      if (v.z() >= 0 || r < config.ground.min_radius_m || r > config.ground.max_radius_m) continue;
+      const double e = plane.n.dot(v) - plane.d;
+      if (std::abs(e) <= v.norm() * std::tan(config.max_correction_rad) + 3 * sigma_m) {
+        lines[l].floor.push_back(v);
+      }
+    }
+  }
+  return lines;
+}
+
+// The floor alone cannot tell two patterns of corrections from a change of the floor plane: one
+// angle common to all lines (the frame's tilt about the axis) and angles that fall as 1 /
+// distance ahead (the floor's height under the sensor). Those belong to the plane: the
+// least-squares fit of the corrections by alpha + beta / lever is taken out of them, leaving the
+// smallest corrections that flatten the floor.
+void RemoveGauge(std::vector<Line>& lines) {
+  Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d rhs = Eigen::Vector2d::Zero();
+  double mean = 0;
+  std::size_t corrected = 0;
+  for (const Line& line : lines) {
+    if (!line.corrected) continue;
+    const Eigen::Vector2d basis(1.0, 1.0 / line.lever_m);
+    normal += basis * basis.transpose();
+    rhs += basis * line.correction_rad;
+    mean += line.correction_rad;
+    ++corrected;
+  }
+  if (corrected == 0) return;
+  const Eigen::Vector2d gauge = corrected >= 2 && std::abs(normal.determinant()) > 1e-12
+                                    ? Eigen::Vector2d(normal.ldlt().solve(rhs))
+                                    : Eigen::Vector2d(mean / corrected, 0.0);
+  for (Line& line : lines) {
+    if (line.corrected) line.correction_rad -= gauge.x() + gauge.y() / line.lever_m;
+  }
+}
+
+// Alternates: each line onto the plane, then the plane through the corrected floor points. The
+// tolerance starts at 3 sigma of the levelling's cell fit and becomes 3 sigma of the corrected
+// floor points (the laser's own noise once the lines agree). Returns that sigma [m].
+double AlignLinesToFloor(std::vector<Line>& lines, FloorPlane& plane, double sigma,
+                         const LinePitchConfig& config) {
+  for (int round = 0; round < 4; ++round) {
+    const double tolerance = 3 * std::max(sigma, 1e-3);  // 1 mm: the LMS200's finest resolution
+    for (Line& line : lines) {
+      line.corrected = CorrectLine(line, plane, tolerance, config) > 0;
+      if (!line.corrected) line.correction_rad = 0;
+    }
+    RemoveGauge(lines);
+    std::vector<Eigen::Vector3d> floor;
+    double sum_sq = 0;
+    for (const Line& line : lines) {
+      if (!line.corrected) continue;
+      for (const Eigen::Vector3d& v : line.floor) {
+        const Eigen::Vector3d t = TurnedAboutY(v, line.correction_rad);
+        const double e = plane.n.dot(t) - plane.d;
+        if (std::abs(e) > tolerance) continue;
+        floor.push_back(t);
+        sum_sq += e * e;
+      }
+    }
+    if (floor.size() < 3) break;
+    sigma = std::sqrt(sum_sq / static_cast<double>(floor.size()));
+    plane = FitPlane(floor);
+  }
+  return sigma;
+}
+
+}  // namespace
+
+LinePitch RectifyLinePitch(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f& sensor_m,
+                           const LinePitchConfig& config) {
+  LinePitch out;
+  std::size_t finite = 0;
+  const std::vector<std::vector<std::uint32_t>> indices = LinesOf(points_m, sensor_m, config,
+                                                                  &finite);
+  std::size_t in_lines = 0;
+  for (const auto& l : indices) in_lines += l.size();
+  out.lines = indices.size();
+  if (indices.size() < config.min_lines ||
+      static_cast<double>(in_lines) < config.min_line_share * static_cast<double>(finite)) {
+    out.note = "not a nodding scan about the frame's y axis through the sensor: " +
+               std::to_string(in_lines) + " of " + std::to_string(finite) + " points in " +
+               std::to_string(indices.size()) + " lines of one elevation each";
+    return out;
+  }
+  out.nodding = true;
+  const Result<GroundLevel> level = FitGroundLevel(points_m, sensor_m, config.ground);
+  if (!level) {
+    out.note = level.error().message;
+    return out;
+  }
+  // The floor relative to the sensor.
+  const FloorPlane first{level->normal,
+                         level->offset_m - level->normal.dot(sensor_m.cast<double>())};
+  FloorPlane plane = first;
+  std::vector<Line> lines =
+      FloorCandidates(indices, points_m, sensor_m, plane, level->residual_m, config);
+  const double sigma = AlignLinesToFloor(lines, plane, level->residual_m, config);
+  // Before and after, over the floor points of the corrected lines.
+  double before = 0, after = 0, sum_sq = 0;
+  std::size_t n = 0;
+  for (const Line& line : lines) {
+    if (!line.corrected) continue;
+    ++out.corrected;
+    sum_sq += line.correction_rad * line.correction_rad;
+    out.max_correction_rad = std::max(out.max_correction_rad, std::abs(line.correction_rad));
+    for (const Eigen::Vector3d& v : line.floor) {
+      const double e = plane.n.dot(TurnedAboutY(v, line.correction_rad)) - plane.d;
+      if (std::abs(e) > 3 * std::max(sigma, 1e-3)) continue;
+      after += e * e;
+      before += std::pow(first.n.dot(v) - first.d, 2);
+      ++n;
+    }
+    for (const std::uint32_t k : line.all) {
+      const Eigen::Vector3d v = (points_m[k] - sensor_m).cast<double>();
+      points_m[k] = sensor_m + TurnedAboutY(v, line.correction_rad).cast<float>();
+    }
+  }
+  if (out.corrected == 0) {
+    out.note = "no line crossed the floor within " + std::to_string(config.ground.max_radius_m) +
+               " m in " + std::to_string(config.min_line_points) + " points";
+    return out;
+  }
+  out.rms_correction_rad = std::sqrt(sum_sq / static_cast<double>(out.corrected));
+  if (n > 0) {
+    out.floor_rms_before_m = std::sqrt(before / static_cast<double>(n));
+    out.floor_rms_after_m = std::sqrt(after / static_cast<double>(n));
+  }
+  return out;
+}
+
+}  // namespace pitchlab::mapping
