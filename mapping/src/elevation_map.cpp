@@ -4,7 +4,6 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 
 #include <Eigen/Eigenvalues>
 
@@ -72,45 +71,6 @@ struct FastGrid {
         sy(g.size_y) {}
 };
 
-// Walks the cells under the segment from `from` to `to` (map frame) in order (Amanatides & Woo
-// in 2D), lowering each crossed cell's clearance to the ray's highest z inside it; the cell of
-// `to` (where the point landed) is left alone. Returns the number of cells updated.
-std::size_t TraceClearance(const FastGrid& g, std::vector<CellStats>& cells,
-                           const Eigen::Vector3f& from, const Eigen::Vector3f& to) {
-  const float gx = (from.x() - g.x0) * g.inv_cell, gy = (from.y() - g.y0) * g.inv_cell;
-  const float hx = (to.x() - g.x0) * g.inv_cell, hy = (to.y() - g.y0) * g.inv_cell;
-  int i = static_cast<int>(std::floor(gx)), j = static_cast<int>(std::floor(gy));
-  const int ie = static_cast<int>(std::floor(hx)), je = static_cast<int>(std::floor(hy));
-  const float ddx = hx - gx, ddy = hy - gy;
-  const int step_i = ddx > 0 ? 1 : -1, step_j = ddy > 0 ? 1 : -1;
-  const float t_dx = ddx != 0 ? std::abs(1.0f / ddx) : kInf;
-  const float t_dy = ddy != 0 ? std::abs(1.0f / ddy) : kInf;
-  float t_x = ddx != 0 ? ((ddx > 0 ? (i + 1 - gx) : (gx - i)) * t_dx) : kInf;
-  float t_y = ddy != 0 ? ((ddy > 0 ? (j + 1 - gy) : (gy - j)) * t_dy) : kInf;
-  const float z0 = from.z(), dz = to.z() - from.z();
-  float t_in = 0.0f;
-  std::size_t updated = 0;
-  const int max_steps = std::abs(ie - i) + std::abs(je - j) + 2;
-  for (int s = 0; s < max_steps && !(i == ie && j == je); ++s) {
-    const float t_out = std::min(std::min(t_x, t_y), 1.0f);
-    if (i >= 0 && j >= 0 && i < g.sx && j < g.sy) {
-      const float z_high = z0 + dz * (dz < 0 ? t_in : t_out);
-      CellStats& c = cells[static_cast<std::size_t>(j) * g.sx + i];
-      c.clearance_z = std::min(c.clearance_z, z_high);
-      ++updated;
-    }
-    t_in = t_out;
-    if (t_x < t_y) {
-      i += step_i;
-      t_x += t_dx;
-    } else {
-      j += step_j;
-      t_y += t_dy;
-    }
-  }
-  return updated;
-}
-
 // The grid cell of a finite point inside the grid and the z limits, or false.
 inline bool CellOf(const FastGrid& g, const Eigen::Vector3f& p, float z_lo, float z_hi, int* i,
                    int* j) {
@@ -121,6 +81,28 @@ inline bool CellOf(const FastGrid& g, const Eigen::Vector3f& p, float z_lo, floa
   *j = static_cast<int>(fy);
   return true;
 }
+
+// std::hypot(x, y) as glibc computes it for finite floats (2.36, e_hypotf: read from its
+// disassembly): the exact squares summed and rooted in double, rounded once to float. The same
+// bits without the call and its checks, which took a tenth of a re-pose (issue 20).
+// insert_scan_reference_test holds InsertScan to the version with std::hypot.
+inline float Hypot(float x, float y) {
+  const double dx = x, dy = y;
+  return static_cast<float>(std::sqrt(dx * dx + dy * dy));
+}
+
+// A rectangle of a grid's cells, [i0, i0 + sx) x [j0, j0 + sy).
+struct Window {
+  int i0 = 0, j0 = 0, sx = 0, sy = 0;
+  bool Contains(int i, int j) const {
+    return static_cast<unsigned>(i - i0) < static_cast<unsigned>(sx) &&
+           static_cast<unsigned>(j - j0) < static_cast<unsigned>(sy);
+  }
+  std::size_t Linear(int i, int j) const {
+    return static_cast<std::size_t>(j - j0) * sx + static_cast<std::size_t>(i - i0);
+  }
+  std::size_t size() const { return static_cast<std::size_t>(sx) * sy; }
+};
 
 // Running sums of a set of points: count, sum and sum of outer products (double).
 struct PointSums {
@@ -142,57 +124,206 @@ struct PointSums {
 // Which side of its surface each of the scan's rising points (above the sensor) was seen from.
 enum class Facing : std::uint8_t { kUndecided, kBelow, kAbove };
 
-// InsertConfig::drop_undersides and the band: the side each rising point's surface was seen from. Per cell holding such points, the plane through the rising points of
-// its 3 x 3 cells (points relative to the sensor, so float sums keep millimetres); a plane within
-// 60 deg of level (the same limit as the layers' step rule, tan 60 deg) that the point's ray met
-// from underneath marks the point. Too few points, or points along one line (a thin pole, a
-// single scan line: their plane is not determined), give no verdict and the point is kept.
-std::vector<Facing> SeenFrom(const FastGrid& g, const Eigen::Vector3f* points, std::size_t count,
-                             const Eigen::Vector3f& origin, float z_lo, float z_hi) {
-  std::vector<Facing> facing(count, Facing::kUndecided);
-  std::unordered_map<std::int64_t, PointSums> cells;
-  const auto key = [&](int i, int j) { return static_cast<std::int64_t>(j) * g.sx + i; };
+// Where a point of the scan fell: its cell, or i = kNonFinite / kOffGrid (off the grid or the z
+// limits). Found once and read by every pass.
+struct PointCell {
+  int i, j;
+};
+constexpr int kNonFinite = -1;
+constexpr int kOffGrid = -2;
+
+// InsertScan's buffers, one set per thread and kept between calls: re-posing re-inserts every
+// scan, and a window's buffers allocated (and faulted in) afresh for each are a cost of their own.
+struct ScanScratch {
+  std::vector<PointCell> cells;      // per point
+  std::vector<float> clearance;      // the window's cells' clearance
+  std::vector<std::int32_t> slot;    // the window's cells: index into sums, or -1
+  std::vector<PointSums> sums;       // per cell holding rising points
+  std::vector<CellIndex> slot_cell;  // which cell each of sums is
+  std::vector<Eigen::Vector3d> normal;
+  std::vector<Facing> facing;  // per point
+};
+ScanScratch& Scratch() {
+  thread_local ScanScratch scratch;
+  return scratch;
+}
+
+// Each point's cell (into `cells`), and the window a scan's rays and points stay within: the
+// cells of its points and of the sensor (clamped to the grid's edge), two cells around for
+// round-off at the ends of a ray walk, cut to the grid. Empty when no point is on the grid.
+Window LocatePoints(const FastGrid& g, const Eigen::Vector3f* points, std::size_t count,
+                    const Eigen::Vector3f& origin, float z_lo, float z_hi,
+                    std::vector<PointCell>& cells) {
+  cells.resize(count);
+  int lo_i = g.sx, lo_j = g.sy, hi_i = -1, hi_j = -1;
   for (std::size_t k = 0; k < count; ++k) {
-    const Eigen::Vector3f& p = points[k];
-    int i, j;
-    if (!p.allFinite() || !(p.z() > origin.z()) || !CellOf(g, p, z_lo, z_hi, &i, &j)) continue;
-    cells[key(i, j)].Add((p - origin).cast<double>());
-  }
-  // A plane needs its points spread across both horizontal axes: a quarter cell (std dev) each.
-  const double min_spread = 0.25 * g.cell;
-  const double cos_max_tilt = 0.5;  // cos 60 deg
-  std::unordered_map<std::int64_t, Eigen::Vector3d> normal;  // up normal; zero: no verdict
-  for (const auto& [k, own] : cells) {
-    const int i = static_cast<int>(k % g.sx), j = static_cast<int>(k / g.sx);
-    PointSums pooled;
-    for (int dj = -1; dj <= 1; ++dj)
-      for (int di = -1; di <= 1; ++di) {
-        const auto it = cells.find(key(i + di, j + dj));
-        if (it != cells.end() && i + di >= 0 && i + di < g.sx) pooled.Add(it->second);
-      }
-    Eigen::Vector3d n = Eigen::Vector3d::Zero();
-    if (pooled.n >= 3) {
-      const Eigen::Vector3d mean = pooled.sum / pooled.n;
-      const Eigen::Matrix3d cov = pooled.outer / pooled.n - mean * mean.transpose();
-      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-      if (eig.eigenvalues()(1) > min_spread * min_spread) {
-        n = eig.eigenvectors().col(0);
-        if (n.z() < 0) n = -n;
-        if (n.z() < cos_max_tilt) n.setZero();  // a wall, not a ceiling
-      }
+    PointCell& c = cells[k];
+    if (!points[k].allFinite()) {
+      c.i = kNonFinite;
+    } else if (!CellOf(g, points[k], z_lo, z_hi, &c.i, &c.j)) {
+      c.i = kOffGrid;
+    } else {
+      lo_i = std::min(lo_i, c.i), hi_i = std::max(hi_i, c.i);
+      lo_j = std::min(lo_j, c.j), hi_j = std::max(hi_j, c.j);
     }
-    normal.emplace(k, n);
+  }
+  if (hi_i < 0) return {};
+  const auto clamped = [](float f, int size) {  // NaN: -1
+    return static_cast<int>(std::floor(f > -1.0f ? std::min(f, static_cast<float>(size)) : -1.0f));
+  };
+  const int oi = clamped((origin.x() - g.x0) * g.inv_cell, g.sx);
+  const int oj = clamped((origin.y() - g.y0) * g.inv_cell, g.sy);
+  constexpr int kPad = 2;
+  Window w;
+  w.i0 = std::max(0, std::min(lo_i, oi) - kPad);
+  w.j0 = std::max(0, std::min(lo_j, oj) - kPad);
+  w.sx = std::min(g.sx, std::max(hi_i, oi) + kPad + 1) - w.i0;
+  w.sy = std::min(g.sy, std::max(hi_j, oj) + kPad + 1) - w.j0;
+  return w;
+}
+
+// Walks the cells under the segment from `from` to `to` (map frame) in order (Amanatides & Woo
+// in 2D), lowering each crossed cell's clearance to the ray's highest z inside it; the cell of
+// `to` (where the point landed) is left alone. Returns the number of cells updated. Cells in the
+// window `w` are updated in `clearance` (4 bytes a cell, where CellStats' 52 left the walk
+// waiting on memory), any other cell of the grid in `cells`.
+std::size_t TraceClearance(const FastGrid& g, const Window& w, float* clearance,
+                           std::vector<CellStats>& cells, const Eigen::Vector3f& from,
+                           const Eigen::Vector3f& to) {
+  const float gx = (from.x() - g.x0) * g.inv_cell, gy = (from.y() - g.y0) * g.inv_cell;
+  const float hx = (to.x() - g.x0) * g.inv_cell, hy = (to.y() - g.y0) * g.inv_cell;
+  int i = static_cast<int>(std::floor(gx)), j = static_cast<int>(std::floor(gy));
+  const int ie = static_cast<int>(std::floor(hx)), je = static_cast<int>(std::floor(hy));
+  const float ddx = hx - gx, ddy = hy - gy;
+  const int step_i = ddx > 0 ? 1 : -1, step_j = ddy > 0 ? 1 : -1;
+  const float t_dx = ddx != 0 ? std::abs(1.0f / ddx) : kInf;
+  const float t_dy = ddy != 0 ? std::abs(1.0f / ddy) : kInf;
+  float t_x = ddx != 0 ? ((ddx > 0 ? (i + 1 - gx) : (gx - i)) * t_dx) : kInf;
+  float t_y = ddy != 0 ? ((ddy > 0 ? (j + 1 - gy) : (gy - j)) * t_dy) : kInf;
+  const float z0 = from.z(), dz = to.z() - from.z();
+  float t_in = 0.0f;
+  std::size_t updated = 0;
+  const int max_steps = std::abs(ie - i) + std::abs(je - j) + 2;
+  for (int s = 0; s < max_steps && !(i == ie && j == je); ++s) {
+    const float t_out = std::min(std::min(t_x, t_y), 1.0f);
+    const float z_high = z0 + dz * (dz < 0 ? t_in : t_out);
+    if (w.Contains(i, j)) {
+      float& c = clearance[w.Linear(i, j)];
+      c = std::min(c, z_high);
+      ++updated;
+    } else if (i >= 0 && j >= 0 && i < g.sx && j < g.sy) {
+      CellStats& c = cells[static_cast<std::size_t>(j) * g.sx + i];
+      c.clearance_z = std::min(c.clearance_z, z_high);
+      ++updated;
+    }
+    t_in = t_out;
+    if (t_x < t_y) {
+      i += step_i;
+      t_x += t_dx;
+    } else {
+      j += step_j;
+      t_y += t_dy;
+    }
+  }
+  return updated;
+}
+
+// The rays' pass: each ray's last `ray_len` [m] lowers the clearance of the cells it crosses.
+// The window's clearance is copied out of the cells and back, so every cell sees the same min()s
+// in the same order as when the rays were traced over the cells themselves.
+std::size_t TraceRays(const FastGrid& g, const Window& w, std::vector<CellStats>& cells,
+                      const Eigen::Vector3f* points, std::size_t count,
+                      const Eigen::Vector3f& origin, float ray_len, ScanScratch& s) {
+  s.clearance.resize(w.size());
+  for (int j = 0; j < w.sy; ++j) {
+    const CellStats* row = &cells[static_cast<std::size_t>(j + w.j0) * g.sx + w.i0];
+    for (int i = 0; i < w.sx; ++i)
+      s.clearance[static_cast<std::size_t>(j) * w.sx + i] = row[i].clearance_z;
+  }
+  std::size_t updated = 0;
+  for (std::size_t k = 0; k < count; ++k) {
+    if (s.cells[k].i < 0) continue;
+    const Eigen::Vector3f& p = points[k];
+    const Eigen::Vector3f d = p - origin;
+    const float horizontal = Hypot(d.x(), d.y());
+    if (horizontal < 1e-6f) continue;
+    const Eigen::Vector3f from =
+        horizontal > ray_len ? Eigen::Vector3f(p - d * (ray_len / horizontal)) : origin;
+    updated += TraceClearance(g, w, s.clearance.data(), cells, from, p);
+  }
+  for (int j = 0; j < w.sy; ++j) {
+    CellStats* row = &cells[static_cast<std::size_t>(j + w.j0) * g.sx + w.i0];
+    for (int i = 0; i < w.sx; ++i)
+      row[i].clearance_z = s.clearance[static_cast<std::size_t>(j) * w.sx + i];
+  }
+  return updated;
+}
+
+// The plane through the rising points pooled over cell c's 3 x 3 cells: its up normal, or zero
+// when there is no verdict (see SeenFrom). Pooled in the same order as ever: rows, then columns.
+Eigen::Vector3d PooledNormal(const Window& w, const CellIndex& c, double cell_m,
+                             const ScanScratch& s) {
+  PointSums pooled;
+  for (int dj = -1; dj <= 1; ++dj)
+    for (int di = -1; di <= 1; ++di) {
+      if (!w.Contains(c.i + di, c.j + dj)) continue;  // the window holds every rising point
+      const std::int32_t q = s.slot[w.Linear(c.i + di, c.j + dj)];
+      if (q >= 0) pooled.Add(s.sums[q]);
+    }
+  // A plane needs its points spread across both horizontal axes: a quarter cell (std dev) each.
+  const double min_spread = 0.25 * cell_m;
+  const double cos_max_tilt = 0.5;  // cos 60 deg
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();
+  if (pooled.n >= 3) {
+    const Eigen::Vector3d mean = pooled.sum / pooled.n;
+    const Eigen::Matrix3d cov = pooled.outer / pooled.n - mean * mean.transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    if (eig.eigenvalues()(1) > min_spread * min_spread) {
+      n = eig.eigenvectors().col(0);
+      if (n.z() < 0) n = -n;
+      if (n.z() < cos_max_tilt) n.setZero();  // a wall, not a ceiling
+    }
+  }
+  return n;
+}
+
+// InsertConfig::drop_undersides and the band: the side each rising point's surface was seen from
+// (into s.facing). Per cell holding such points, the plane through the rising points of its 3 x 3
+// cells (points relative to the sensor, so float sums keep millimetres); a plane within 60 deg of
+// level (the same limit as the layers' step rule, tan 60 deg) that the point's ray met from
+// underneath marks the point. Too few points, or points along one line (a thin pole, a single
+// scan line: their plane is not determined), give no verdict and the point is kept. The cells'
+// sums are in an array over the window (a hash map of them took a fifth of InsertScan).
+void SeenFrom(const Window& w, double cell_m, const Eigen::Vector3f* points, std::size_t count,
+              const Eigen::Vector3f& origin, ScanScratch& s) {
+  s.facing.assign(count, Facing::kUndecided);
+  s.slot.assign(w.size(), -1);
+  s.sums.clear();
+  s.slot_cell.clear();
+  const auto rising = [&](std::size_t k) {
+    return s.cells[k].i >= 0 && points[k].z() > origin.z();
+  };
+  for (std::size_t k = 0; k < count; ++k) {
+    if (!rising(k)) continue;
+    std::int32_t& q = s.slot[w.Linear(s.cells[k].i, s.cells[k].j)];
+    if (q < 0) {
+      q = static_cast<std::int32_t>(s.sums.size());
+      s.sums.emplace_back();
+      s.slot_cell.push_back({s.cells[k].i, s.cells[k].j});
+    }
+    s.sums[q].Add((points[k] - origin).cast<double>());
+  }
+  s.normal.resize(s.sums.size());
+  for (std::size_t q = 0; q < s.sums.size(); ++q) {
+    s.normal[q] = PooledNormal(w, s.slot_cell[q], cell_m, s);
   }
   for (std::size_t k = 0; k < count; ++k) {
-    const Eigen::Vector3f& p = points[k];
-    int i, j;
-    if (!p.allFinite() || !(p.z() > origin.z()) || !CellOf(g, p, z_lo, z_hi, &i, &j)) continue;
-    const Eigen::Vector3d& n = normal.at(key(i, j));
+    if (!rising(k)) continue;
+    const Eigen::Vector3d& n = s.normal[s.slot[w.Linear(s.cells[k].i, s.cells[k].j)]];
     if (n.z() <= 0) continue;
     // The ray travels up through the plane: it met the surface's lower face.
-    facing[k] = (p - origin).cast<double>().dot(n) > 0 ? Facing::kBelow : Facing::kAbove;
+    s.facing[k] = (points[k] - origin).cast<double>().dot(n) > 0 ? Facing::kBelow : Facing::kAbove;
   }
-  return facing;
 }
 
 InsertStats InsertPointsImpl(const GridGeometry& geometry, std::vector<CellStats>& cells,
@@ -220,57 +351,35 @@ InsertStats InsertPointsImpl(const GridGeometry& geometry, std::vector<CellStats
   return stats;
 }
 
-// Traces every ray of the scan, then adds the points that do not float over a lower ray.
-InsertStats InsertScanImpl(const GridGeometry& geometry, std::vector<CellStats>& cells,
-                           const Eigen::Vector3f* points, std::size_t count,
-                           const Eigen::Vector3f& origin, const InsertConfig& config) {
-  const FastGrid g(geometry);
-  const float z_lo = static_cast<float>(config.min_z_m), z_hi = static_cast<float>(config.max_z_m);
-  const float ray_len = static_cast<float>(config.clearance_length_m);
+// InsertScan's last pass: the points that are not undersides, above the band or floating over a
+// lower ray go into their cells.
+void AddScanPoints(const FastGrid& g, std::vector<CellStats>& cells, const Eigen::Vector3f* points,
+                   std::size_t count, const Eigen::Vector3f& origin, const InsertConfig& config,
+                   const ScanScratch& s, InsertStats& stats) {
   const float headroom = config.overhang_headroom_m > 0
                              ? static_cast<float>(config.overhang_headroom_m)
                              : std::numeric_limits<float>::infinity();
-  InsertStats stats;
-  if (ray_len > 0.0f) {
-    for (std::size_t k = 0; k < count; ++k) {
-      const Eigen::Vector3f& p = points[k];
-      int i, j;
-      if (!p.allFinite() || !CellOf(g, p, z_lo, z_hi, &i, &j)) continue;
-      const Eigen::Vector3f d = p - origin;
-      const float horizontal = std::hypot(d.x(), d.y());
-      if (horizontal < 1e-6f) continue;
-      const Eigen::Vector3f from =
-          horizontal > ray_len ? Eigen::Vector3f(p - d * (ray_len / horizontal)) : origin;
-      stats.clearance_cells += TraceClearance(g, cells, from, p);
-    }
-  }
   const bool band = std::isfinite(config.max_height_m);
-  const std::vector<Facing> facing = config.drop_undersides || band
-                                         ? SeenFrom(g, points, count, origin, z_lo, z_hi)
-                                         : std::vector<Facing>(count, Facing::kUndecided);
   // The height band's top at the sensor (see InsertConfig::max_height_m).
-  const float band_top = static_cast<float>(origin.z() - config.sensor_height_m +
-                                            config.max_height_m);
+  const float band_top =
+      static_cast<float>(origin.z() - config.sensor_height_m + config.max_height_m);
   const float grade = static_cast<float>(config.band_grade);
   for (std::size_t k = 0; k < count; ++k) {
     const Eigen::Vector3f& p = points[k];
-    if (!p.allFinite()) {
-      ++stats.non_finite;
+    const int i = s.cells[k].i, j = s.cells[k].j;
+    if (i < 0) {
+      ++(i == kNonFinite ? stats.non_finite : stats.outside);
       continue;
     }
-    int i, j;
-    if (!CellOf(g, p, z_lo, z_hi, &i, &j)) {
-      ++stats.outside;
-      continue;
-    }
-    if (config.drop_undersides && facing[k] == Facing::kBelow) {
+    if (config.drop_undersides && s.facing[k] == Facing::kBelow) {
       ++stats.underside;
       continue;
     }
     // Above the band's top at the sensor, only ground seen from above may rise further, by the
     // grade per metre (a hill); a single far scan line, whose side nothing decides, may not.
     if (band && p.z() > band_top &&
-        (facing[k] != Facing::kAbove || p.z() > band_top + grade * (p - origin).head<2>().norm())) {
+        (s.facing[k] != Facing::kAbove ||
+         p.z() > band_top + grade * (p - origin).head<2>().norm())) {
       ++stats.above_band;
       continue;
     }
@@ -283,6 +392,28 @@ InsertStats InsertScanImpl(const GridGeometry& geometry, std::vector<CellStats>&
               p.y() - (g.y0 + j * g.cell + g.half_cell), p.z());
     ++stats.inserted;
   }
+}
+
+// Traces every ray of the scan, then adds the points that do not float over a lower ray. Each
+// point's cell is found once; the passes work within the window of cells the scan touches.
+InsertStats InsertScanImpl(const GridGeometry& geometry, std::vector<CellStats>& cells,
+                           const Eigen::Vector3f* points, std::size_t count,
+                           const Eigen::Vector3f& origin, const InsertConfig& config) {
+  const FastGrid g(geometry);
+  const float z_lo = static_cast<float>(config.min_z_m), z_hi = static_cast<float>(config.max_z_m);
+  const float ray_len = static_cast<float>(config.clearance_length_m);
+  ScanScratch& s = Scratch();
+  const Window w = LocatePoints(g, points, count, origin, z_lo, z_hi, s.cells);
+  InsertStats stats;
+  if (ray_len > 0.0f && w.size() > 0) {
+    stats.clearance_cells = TraceRays(g, w, cells, points, count, origin, ray_len, s);
+  }
+  if (config.drop_undersides || std::isfinite(config.max_height_m)) {
+    SeenFrom(w, g.cell, points, count, origin, s);
+  } else {
+    s.facing.assign(count, Facing::kUndecided);
+  }
+  AddScanPoints(g, cells, points, count, origin, config, s, stats);
   return stats;
 }
 
