@@ -6,9 +6,10 @@
 // MapBuilder keeps them) and PerScanElevationMap::Repose (every scan re-inserted with its rays,
 // then the contributions combined). Iterations alternate between two pose sets 1 cm / 0.1 deg
 // apart, so every scan moves every time. The elevation map is timed with the scans as cast
-// (argument 0) and with the 2 cm voxel copies MapBuilder's loop closure keeps (argument 20,
+// (first argument 0) and with the 2 cm voxel copies MapBuilder's loop closure keeps (20,
 // LoopClosureConfig::scan_voxel_m: half the points of a simulated office scan within 10 m, 28-37k
-// of 67k).
+// of 67k), re-inserted on one thread or up to two (second argument,
+// PerScanElevationMap::set_threads).
 //
 //   build/benchmarks/repose_benchmark --benchmark_counters_tabular=true --benchmark_repetitions=5
 //
@@ -121,6 +122,7 @@ std::uint32_t Fingerprint(const pitchlab::mapping::ElevationMap& map) {
 void BM_ReposeElevationMap(benchmark::State& state) {
   const double voxel_m = state.range(0) / 1000.0;  // [mm] -> [m]; 0: the scans as cast
   PerScanElevationMap map(Area());
+  map.set_threads(static_cast<unsigned>(state.range(1)));
   std::vector<std::pair<std::size_t, Eigen::Isometry3d>> poses[2];
   std::size_t points = 0;
   for (int k = 0; k < kScans; ++k) {
@@ -150,8 +152,8 @@ void BM_ReposeElevationMap(benchmark::State& state) {
   state.counters["points_per_scan"] = static_cast<double>(points) / kScans;
 }
 BENCHMARK(BM_ReposeElevationMap)
-    ->Arg(0)
-    ->Arg(20)
+    ->ArgsProduct({{0, 20}, {1, 2}})
+    ->ArgNames({"voxel_mm", "threads"})
     ->MeasureProcessCPUTime()
     ->Unit(benchmark::kMillisecond);
 

@@ -7,6 +7,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "elevation_insert.hpp"
+
 namespace pitchlab::mapping {
 namespace {
 
@@ -512,6 +514,19 @@ Result<std::size_t> ElevationMap::Merge(const ElevationMap& other, MergeCells ce
 }
 
 void CombineCells(CellStats& into, const CellStats& from) { CombineInto(into, from, 0.0f, 0.0f); }
+
+InsertStats internal::InsertScanInto(const GridGeometry& geometry, std::vector<CellStats>& cells,
+                                     const Eigen::Vector3f* points_m, std::size_t count,
+                                     const Eigen::Vector3f& sensor_origin_m,
+                                     const InsertConfig& config) {
+  return InsertScanImpl(geometry, cells, points_m, count, sensor_origin_m, config);
+}
+
+InsertStats internal::InsertPointsInto(const GridGeometry& geometry, std::vector<CellStats>& cells,
+                                       const Eigen::Vector3f* points_m, std::size_t count,
+                                       const InsertConfig& config) {
+  return InsertPointsImpl(geometry, cells, points_m, count, config);
+}
 
 void ElevationMap::SetCells(std::vector<CellStats> cells) {
   if (cells.size() != geometry_.cell_count()) {

@@ -1,10 +1,15 @@
 #include "pitchlab/mapping/per_scan_elevation_map.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <future>
 #include <limits>
 #include <string>
+#include <thread>
 #include <utility>
+
+#include "elevation_insert.hpp"
 
 namespace pitchlab::mapping {
 namespace {
@@ -45,37 +50,74 @@ std::optional<GridGeometry> ExtentOn(const GridGeometry& g,
   return local;
 }
 
+// A thread's buffers for Contribute, kept between scans: the scan's points in the map frame and
+// the cells of the grid over its extent, every one of them empty (CellStats{}) between calls
+// unless a call was cut short (`clean`).
+struct ContributeBuffers {
+  std::vector<Eigen::Vector3f> points;
+  std::vector<CellStats> view;
+  bool clean = true;
+};
+ContributeBuffers& Buffers() {
+  thread_local ContributeBuffers buffers;
+  return buffers;
+}
+
 }  // namespace
 
 PerScanElevationMap::PerScanElevationMap(const GridGeometry& geometry, const InsertConfig& config)
-    : geometry_(geometry), config_(config), map_(geometry) {}
+    : geometry_(geometry),
+      config_(config),
+      map_(geometry),
+      threads_(std::clamp(std::thread::hardware_concurrency(), 1u, kMaxThreads)) {}
 
 // The scan inserted alone into a grid over its extent, kept as the cells it touched.
-PerScanElevationMap::Contribution PerScanElevationMap::Contribute(const Scan& scan) const {
+void PerScanElevationMap::Contribute(Scan& scan) const {
   const Eigen::Isometry3f T = scan.T_map_base.cast<float>();
-  std::vector<Eigen::Vector3f> points;
-  points.reserve(scan.points_base.size());
+  ContributeBuffers& b = Buffers();
+  std::vector<Eigen::Vector3f>& points = b.points;
+  points.clear();
   for (const Eigen::Vector3f& p : scan.points_base) points.push_back(T * p);
   const std::size_t scan_points = points.size();
   for (const Eigen::Vector3f& p : scan.ground_base) points.push_back(T * p);
   const Eigen::Vector3f sensor = T * scan.sensor_base;
-  Contribution out;
+  Contribution& out = scan.contribution;
+  out.cells.clear();
+  out.stats.clear();
   const std::optional<GridGeometry> local = ExtentOn(geometry_, points, sensor);
-  if (!local) return out;
-  ElevationMap view(*local);
-  (void)view.InsertScan(points.data(), scan_points, sensor, config_);
-  (void)view.InsertPoints(points.data() + scan_points, points.size() - scan_points, config_);
+  if (!local) return;
+  if (!b.clean) b.view.assign(b.view.size(), CellStats{});
+  if (b.view.size() < local->cell_count()) b.view.resize(local->cell_count());
+  b.clean = false;
+  (void)internal::InsertScanInto(*local, b.view, points.data(), scan_points, sensor, config_);
+  (void)internal::InsertPointsInto(*local, b.view, points.data() + scan_points,
+                                   points.size() - scan_points, config_);
   const long di = std::lround((local->x_min_m - geometry_.x_min_m) / geometry_.cell_m);
   const long dj = std::lround((local->y_min_m - geometry_.y_min_m) / geometry_.cell_m);
-  for (std::size_t k = 0; k < view.cells().size(); ++k) {
-    const CellStats& c = view.at(k);
-    if (!c.known() && !std::isfinite(c.clearance_z)) continue;
+  for (std::size_t k = 0; k < local->cell_count(); ++k) {
+    CellStats& c = b.view[k];
+    if (!c.known() && !std::isfinite(c.clearance_z)) continue;  // untouched: empty already
     const CellIndex at = local->FromLinear(k);
     out.cells.push_back(static_cast<std::uint32_t>(
         geometry_.Linear({static_cast<int>(at.i + di), static_cast<int>(at.j + dj)})));
     out.stats.push_back(c);
+    c = CellStats{};
   }
-  return out;
+  b.clean = true;
+}
+
+// Each scan's contribution depends on that scan alone and lands in its own Scan: the threads
+// take scans in any order and the result is the same.
+void PerScanElevationMap::ContributeAll(const std::vector<Scan*>& scans) const {
+  const unsigned threads = static_cast<unsigned>(std::min<std::size_t>(scans.size(), threads_));
+  std::atomic<std::size_t> next{0};
+  const auto work = [&] {
+    for (std::size_t k = next++; k < scans.size(); k = next++) Contribute(*scans[k]);
+  };
+  std::vector<std::future<void>> helpers;
+  for (unsigned t = 1; t < threads; ++t) helpers.push_back(std::async(std::launch::async, work));
+  work();
+  for (std::future<void>& h : helpers) h.get();  // rethrows a helper's exception
 }
 
 // The map from the contributions: every scan's clearance first, then the points in id order,
@@ -127,7 +169,7 @@ Result<void> PerScanElevationMap::Insert(std::size_t id, std::vector<Eigen::Vect
   }
   if (auto ok = CheckPose(T_map_base, id); !ok) return ok;
   Scan scan{std::move(points_base), std::move(ground_base), sensor_base, T_map_base, {}};
-  scan.contribution = Contribute(scan);
+  Contribute(scan);
   scans_.emplace(id, std::move(scan));
   Combine();
   return {};
@@ -152,13 +194,17 @@ Result<std::size_t> PerScanElevationMap::Repose(
     if (auto ok = CheckPose(T, id); !ok) return tl::make_unexpected(ok.error());
   }
   std::size_t moved = 0;
+  std::vector<Scan*> reinsert;  // each moved scan once, at its last pose
   for (const auto& [id, T] : T_map_base) {
     Scan& scan = scans_.at(id);
     if (scan.T_map_base.matrix() == T.matrix()) continue;
     scan.T_map_base = T;
-    scan.contribution = Contribute(scan);
+    if (std::find(reinsert.begin(), reinsert.end(), &scan) == reinsert.end()) {
+      reinsert.push_back(&scan);
+    }
     ++moved;
   }
+  ContributeAll(reinsert);
   if (moved > 0) Combine();
   return moved;
 }

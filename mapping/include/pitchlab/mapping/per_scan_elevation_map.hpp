@@ -28,6 +28,9 @@ namespace pitchlab::mapping {
 /// The elevation map of a set of scans, each kept with its pose so it can be moved or removed.
 class PerScanElevationMap {
  public:
+  /// Threads Repose re-inserts scans on at most (fewer when the hardware has fewer cores).
+  static constexpr unsigned kMaxThreads = 8;
+
   /// An all-unknown map over `geometry`, scans inserted with `config`. Throws
   /// std::invalid_argument on an empty geometry.
   explicit PerScanElevationMap(const GridGeometry& geometry, const InsertConfig& config = {});
@@ -44,11 +47,17 @@ class PerScanElevationMap {
                                     std::vector<Eigen::Vector3f> ground_base = {});
   /// Takes scan `id`'s contribution out. Error: no scan `id`.
   [[nodiscard]] Result<void> Remove(std::size_t id);
-  /// Moves scans to new poses (id, T_map_base) and re-inserts those whose pose changed (any bit);
-  /// returns how many. Errors (the map left as it was): an unknown id, a non-finite or non-rigid
-  /// pose.
+  /// Moves scans to new poses (id, T_map_base) and re-inserts those whose pose changed (any bit),
+  /// on up to threads() threads (each scan's contribution is its own: the map is the same bits
+  /// whatever thread inserted which); returns how many. Errors (the map left as it was): an unknown
+  /// id, a non-finite or non-rigid pose.
   [[nodiscard]] Result<std::size_t> Repose(
       const std::vector<std::pair<std::size_t, Eigen::Isometry3d>>& T_map_base);
+
+  /// At most how many threads Repose uses, the calling one included: by default the hardware's
+  /// cores up to kMaxThreads; 1 keeps it on the calling thread. 0 is taken as 1.
+  unsigned threads() const { return threads_; }
+  void set_threads(unsigned threads) { threads_ = threads > 0 ? threads : 1; }
 
   /// The combined map.
   const ElevationMap& map() const { return map_; }
@@ -72,7 +81,11 @@ class PerScanElevationMap {
     Eigen::Isometry3d T_map_base;
     Contribution contribution;
   };
-  Contribution Contribute(const Scan& scan) const;
+  // Scan's contribution from its points at its pose (into scan.contribution, whose storage is
+  // kept for the next re-pose).
+  void Contribute(Scan& scan) const;
+  // Contribute for each of `scans` (distinct), on up to threads_ threads.
+  void ContributeAll(const std::vector<Scan*>& scans) const;
   void Combine();
 
   GridGeometry geometry_;
@@ -80,6 +93,7 @@ class PerScanElevationMap {
   std::map<std::size_t, Scan> scans_;
   ElevationMap map_;
   std::size_t overhang_cells_ = 0;
+  unsigned threads_;
 };
 
 }  // namespace pitchlab::mapping
