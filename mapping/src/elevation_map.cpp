@@ -184,63 +184,149 @@ Window LocatePoints(const FastGrid& g, const Eigen::Vector3f* points, std::size_
   return w;
 }
 
-// Walks the cells under the segment from `from` to `to` (map frame) in order (Amanatides & Woo
-// in 2D), lowering each crossed cell's clearance to the ray's highest z inside it; the cell of
-// `to` (where the point landed) is left alone. Returns the number of cells updated. Cells in the
-// window `w` are updated in `clearance` (4 bytes a cell, where CellStats' 52 left the walk
-// waiting on memory), any other cell of the grid in `cells`.
-std::size_t TraceClearance(const FastGrid& g, const Window& w, float* clearance,
-                           std::vector<CellStats>& cells, const Eigen::Vector3f& from,
-                           const Eigen::Vector3f& to) {
+// Where a ray's walk starts: Amanatides & Woo in 2D over the cells under the segment from `from`
+// to `to` (map frame), the times [0, 1 along the segment] of the next column and row boundary
+// and between boundaries, and at most how many steps it takes.
+struct RayWalk {
+  float t_x, t_y, t_dx, t_dy, z0, dz;
+  int i, j, ie, je, step_i, step_j, max_steps;
+};
+
+RayWalk StartWalk(const FastGrid& g, const Eigen::Vector3f& from, const Eigen::Vector3f& to) {
   const float gx = (from.x() - g.x0) * g.inv_cell, gy = (from.y() - g.y0) * g.inv_cell;
   const float hx = (to.x() - g.x0) * g.inv_cell, hy = (to.y() - g.y0) * g.inv_cell;
-  int i = static_cast<int>(std::floor(gx)), j = static_cast<int>(std::floor(gy));
-  const int ie = static_cast<int>(std::floor(hx)), je = static_cast<int>(std::floor(hy));
+  RayWalk r;
+  r.i = static_cast<int>(std::floor(gx)), r.j = static_cast<int>(std::floor(gy));
+  r.ie = static_cast<int>(std::floor(hx)), r.je = static_cast<int>(std::floor(hy));
   const float ddx = hx - gx, ddy = hy - gy;
-  const int step_i = ddx > 0 ? 1 : -1, step_j = ddy > 0 ? 1 : -1;
-  const float t_dx = ddx != 0 ? std::abs(1.0f / ddx) : kInf;
-  const float t_dy = ddy != 0 ? std::abs(1.0f / ddy) : kInf;
-  float t_x = ddx != 0 ? ((ddx > 0 ? (i + 1 - gx) : (gx - i)) * t_dx) : kInf;
-  float t_y = ddy != 0 ? ((ddy > 0 ? (j + 1 - gy) : (gy - j)) * t_dy) : kInf;
-  const float z0 = from.z(), dz = to.z() - from.z();
+  r.step_i = ddx > 0 ? 1 : -1, r.step_j = ddy > 0 ? 1 : -1;
+  r.t_dx = ddx != 0 ? std::abs(1.0f / ddx) : kInf;
+  r.t_dy = ddy != 0 ? std::abs(1.0f / ddy) : kInf;
+  r.t_x = ddx != 0 ? ((ddx > 0 ? (r.i + 1 - gx) : (gx - r.i)) * r.t_dx) : kInf;
+  r.t_y = ddy != 0 ? ((ddy > 0 ? (r.j + 1 - gy) : (gy - r.j)) * r.t_dy) : kInf;
+  r.z0 = from.z(), r.dz = to.z() - from.z();
+  r.max_steps = std::abs(r.ie - r.i) + std::abs(r.je - r.j) + 2;
+  return r;
+}
+
+// The clearance arrays of the rays' pass: `scratch` (a rectangle of cells, the array's layout)
+// holds the clearance of the grid's cells in `w` = scratch cut to the grid; its other cells are
+// off the grid and thrown away.
+struct ClearanceArea {
+  Window scratch, w;
+  float* clearance;
+};
+
+// The walk cell by cell in order, lowering each crossed cell's clearance to the ray's highest z
+// inside it; the cell of `to` (where the point landed) is left alone. Cells of a.w are lowered in
+// a.clearance, other cells of the grid in `cells`. Returns the number of cells of the grid
+// updated: the reference walk, for rays that may leave the scratch area or the grid.
+std::size_t CheckedWalk(const FastGrid& g, const ClearanceArea& a, std::vector<CellStats>& cells,
+                        RayWalk r) {
   float t_in = 0.0f;
   std::size_t updated = 0;
-  const int max_steps = std::abs(ie - i) + std::abs(je - j) + 2;
-  for (int s = 0; s < max_steps && !(i == ie && j == je); ++s) {
-    const float t_out = std::min(std::min(t_x, t_y), 1.0f);
-    const float z_high = z0 + dz * (dz < 0 ? t_in : t_out);
-    if (w.Contains(i, j)) {
-      float& c = clearance[w.Linear(i, j)];
+  for (int s = 0; s < r.max_steps && !(r.i == r.ie && r.j == r.je); ++s) {
+    const float t_out = std::min(std::min(r.t_x, r.t_y), 1.0f);
+    const float z_high = r.z0 + r.dz * (r.dz < 0 ? t_in : t_out);
+    if (a.w.Contains(r.i, r.j)) {
+      float& c = a.clearance[a.scratch.Linear(r.i, r.j)];
       c = std::min(c, z_high);
       ++updated;
-    } else if (i >= 0 && j >= 0 && i < g.sx && j < g.sy) {
-      CellStats& c = cells[static_cast<std::size_t>(j) * g.sx + i];
+    } else if (r.i >= 0 && r.j >= 0 && r.i < g.sx && r.j < g.sy) {
+      CellStats& c = cells[static_cast<std::size_t>(r.j) * g.sx + r.i];
       c.clearance_z = std::min(c.clearance_z, z_high);
       ++updated;
     }
     t_in = t_out;
-    if (t_x < t_y) {
-      i += step_i;
-      t_x += t_dx;
+    if (r.t_x < r.t_y) {
+      r.i += r.step_i;
+      r.t_x += r.t_dx;
     } else {
-      j += step_j;
-      t_y += t_dy;
+      r.j += r.step_j;
+      r.t_y += r.t_dy;
     }
   }
   return updated;
 }
 
+// CheckedWalk's loop for a walk known to stay in the scratch area: no bounds, the cell an index
+// stepped along, the end that index (the same cell there), the rising or falling ray's z chosen
+// once. Returns the steps taken; `reached`: whether it ended in the point's cell.
+template <bool kFalling>
+int UncheckedWalk(float* clearance, std::ptrdiff_t at, std::ptrdiff_t at_end,
+                  std::ptrdiff_t row_step, RayWalk r, bool* reached) {
+  float t_in = 0.0f;
+  int s = 0;
+  for (; s < r.max_steps && at != at_end; ++s) {
+    const float t_out = std::min(std::min(r.t_x, r.t_y), 1.0f);
+    const float z_high = r.z0 + r.dz * (kFalling ? t_in : t_out);
+    float& c = clearance[at];
+    c = std::min(c, z_high);
+    t_in = t_out;
+    if (r.t_x < r.t_y) {
+      at += r.step_i;
+      r.t_x += r.t_dx;
+    } else {
+      at += row_step;
+      r.t_y += r.t_dy;
+    }
+  }
+  *reached = at == at_end;
+  return s;
+}
+
+// One ray: unchecked when its walk cannot leave the scratch area. A walk steps its column towards
+// the end's, never back, and in at most max_steps = |columns| + |rows| + 2 steps passes the end's
+// column by at most |rows| + 2 (round-off); rows alike. Its updates are all on the grid when it
+// started on the grid and ended in the point's cell; otherwise (a start off the grid, round-off
+// past the end) CheckedWalk walks it again for the count: min() again with the same z changes no
+// bit.
+std::size_t Walk(const FastGrid& g, const ClearanceArea& a, std::vector<CellStats>& cells,
+                 const RayWalk& r) {
+  const Window& S = a.scratch;
+  const int u = r.i - S.i0, v = r.j - S.j0, ue = r.ie - S.i0, ve = r.je - S.j0;
+  const int past_u = std::abs(ve - v) + 2, past_v = std::abs(ue - u) + 2;
+  if (std::min(u, ue) < past_u || std::min(v, ve) < past_v || std::max(u, ue) + past_u >= S.sx ||
+      std::max(v, ve) + past_v >= S.sy) {
+    return CheckedWalk(g, a, cells, r);
+  }
+  const std::ptrdiff_t at = static_cast<std::ptrdiff_t>(v) * S.sx + u;
+  const std::ptrdiff_t at_end = static_cast<std::ptrdiff_t>(ve) * S.sx + ue;
+  const std::ptrdiff_t row_step = static_cast<std::ptrdiff_t>(r.step_j) * S.sx;
+  bool reached = false;
+  const int steps = r.dz < 0 ? UncheckedWalk<true>(a.clearance, at, at_end, row_step, r, &reached)
+                             : UncheckedWalk<false>(a.clearance, at, at_end, row_step, r, &reached);
+  if (reached && a.w.Contains(r.i, r.j)) return static_cast<std::size_t>(steps);
+  return CheckedWalk(g, a, cells, r);
+}
+
 // The rays' pass: each ray's last `ray_len` [m] lowers the clearance of the cells it crosses.
-// The window's clearance is copied out of the cells and back, so every cell sees the same min()s
-// in the same order as when the rays were traced over the cells themselves.
-std::size_t TraceRays(const FastGrid& g, const Window& w, std::vector<CellStats>& cells,
-                      const Eigen::Vector3f* points, std::size_t count,
-                      const Eigen::Vector3f& origin, float ray_len, ScanScratch& s) {
-  s.clearance.resize(w.size());
-  for (int j = 0; j < w.sy; ++j) {
-    const CellStats* row = &cells[static_cast<std::size_t>(j + w.j0) * g.sx + w.i0];
-    for (int i = 0; i < w.sx; ++i)
-      s.clearance[static_cast<std::size_t>(j) * w.sx + i] = row[i].clearance_z;
+// Traced in a float array (4 bytes a cell, where CellStats' 52 left the walk waiting on memory)
+// over the scan's window `pw` and a guard band as wide as a walk's reach, so most walks need no
+// bounds; the grid's cells there are copied out of the cells and back, so every cell sees the
+// same min()s in the same order as when the rays were traced over the cells themselves. Out of
+// line: inlined into InsertScan, the walk's constants went to the stack.
+[[gnu::noinline]] std::size_t TraceRays(const FastGrid& g, const Window& pw,
+                                        std::vector<CellStats>& cells,
+                                        const Eigen::Vector3f* points, std::size_t count,
+                                        const Eigen::Vector3f& origin, float ray_len,
+                                        ScanScratch& s) {
+  // A walk starts between the sensor and its point (both in pw unless the sensor is off the
+  // grid) and passes its point's cell by at most a ray's rows or columns and 2 (see Walk).
+  const float reach = ray_len * g.inv_cell + 4.0f;
+  const int guard = reach < 100.0f ? static_cast<int>(reach) : 0;  // whole rays: bounds checked
+  ClearanceArea a;
+  a.scratch = {pw.i0 - guard, pw.j0 - guard, pw.sx + 2 * guard, pw.sy + 2 * guard};
+  a.w.i0 = std::max(a.scratch.i0, 0), a.w.j0 = std::max(a.scratch.j0, 0);
+  a.w.sx = std::min(a.scratch.i0 + a.scratch.sx, g.sx) - a.w.i0;
+  a.w.sy = std::min(a.scratch.j0 + a.scratch.sy, g.sy) - a.w.j0;
+  s.clearance.resize(a.scratch.size());
+  a.clearance = s.clearance.data();
+  for (int j = a.w.j0; j < a.w.j0 + a.w.sy; ++j) {
+    for (int i = a.w.i0; i < a.w.i0 + a.w.sx; ++i) {
+      a.clearance[a.scratch.Linear(i, j)] =
+          cells[static_cast<std::size_t>(j) * g.sx + i].clearance_z;
+    }
   }
   std::size_t updated = 0;
   for (std::size_t k = 0; k < count; ++k) {
@@ -251,12 +337,13 @@ std::size_t TraceRays(const FastGrid& g, const Window& w, std::vector<CellStats>
     if (horizontal < 1e-6f) continue;
     const Eigen::Vector3f from =
         horizontal > ray_len ? Eigen::Vector3f(p - d * (ray_len / horizontal)) : origin;
-    updated += TraceClearance(g, w, s.clearance.data(), cells, from, p);
+    updated += Walk(g, a, cells, StartWalk(g, from, p));
   }
-  for (int j = 0; j < w.sy; ++j) {
-    CellStats* row = &cells[static_cast<std::size_t>(j + w.j0) * g.sx + w.i0];
-    for (int i = 0; i < w.sx; ++i)
-      row[i].clearance_z = s.clearance[static_cast<std::size_t>(j) * w.sx + i];
+  for (int j = a.w.j0; j < a.w.j0 + a.w.sy; ++j) {
+    for (int i = a.w.i0; i < a.w.i0 + a.w.sx; ++i) {
+      cells[static_cast<std::size_t>(j) * g.sx + i].clearance_z =
+          a.clearance[a.scratch.Linear(i, j)];
+    }
   }
   return updated;
 }

@@ -1,7 +1,7 @@
 // PerScanElevationMap (issue 20, re-posed maps): a map whose scans were moved or taken out and put
-// back is the map built from scratch with the scans where they are now, bit for bit; one scan
-// alone is ElevationMap::InsertScan's map; a scan's cell floating over another scan's ray is left
-// out whatever the order.
+// back is the map built from scratch with the scans where they are now, bit for bit, on any
+// number of threads; one scan alone is ElevationMap::InsertScan's map; a scan's cell floating
+// over another scan's ray is left out whatever the order.
 
 #include <gtest/gtest.h>
 
@@ -125,6 +125,25 @@ TEST(PerScanElevationMap, ARePosedMapEqualsOneBuiltFromScratchAtTheNewPosesBitFo
   EXPECT_GT(changed, 100u);
   // Poses that did not change re-insert nothing.
   EXPECT_EQ(*drifted.Repose({{2, Stop(2)}, {0, drifted.pose(0)}}), 0u);
+}
+
+// Repose re-inserts scans on several threads: the map is the same bits on one thread or four.
+TEST(PerScanElevationMap, ARePoseOnFourThreadsEqualsOneOnOneThreadBitForBit) {
+  PerScanElevationMap one(Area()), four(Area());
+  one.set_threads(1);
+  four.set_threads(4);
+  std::vector<std::pair<std::size_t, Eigen::Isometry3d>> truth;
+  for (int k = 0; k < 7; ++k) {
+    const std::vector<Eigen::Vector3f> scan = Scan(Stop(k));
+    const Eigen::Isometry3d off = Stop(k) * PoseFromXyzRpyDeg(0.02, -0.01 * k, 0, 0, 0, 0.3);
+    ASSERT_TRUE(one.Insert(k, scan, kSensorBase, off));
+    ASSERT_TRUE(four.Insert(k, scan, kSensorBase, off));
+    truth.emplace_back(k, Stop(k));
+  }
+  EXPECT_EQ(*one.Repose(truth), 7u);
+  EXPECT_EQ(*four.Repose(truth), 7u);
+  ExpectSameCells(one.map(), four.map());
+  EXPECT_GT(KnownCells(four.map()), 500u);
 }
 
 TEST(PerScanElevationMap, RemovingAScanThenInsertingItBackGivesTheSameMapBitForBit) {
