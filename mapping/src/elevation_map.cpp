@@ -138,7 +138,7 @@ constexpr int kOffGrid = -2;
 // scan, and a window's buffers allocated (and faulted in) afresh for each are a cost of their own.
 struct ScanScratch {
   std::vector<PointCell> cells;      // per point
-  std::vector<float> clearance;      // the window's cells' clearance
+  std::vector<float> clearance;      // the rays' area: see TraceRays
   std::vector<std::int32_t> slot;    // the window's cells: index into sums, or -1
   std::vector<PointSums> sums;       // per cell holding rising points
   std::vector<CellIndex> slot_cell;  // which cell each of sums is
@@ -150,9 +150,9 @@ ScanScratch& Scratch() {
   return scratch;
 }
 
-// Each point's cell (into `cells`), and the window a scan's rays and points stay within: the
-// cells of its points and of the sensor (clamped to the grid's edge), two cells around for
-// round-off at the ends of a ray walk, cut to the grid. Empty when no point is on the grid.
+// Each point's cell (into `cells`), and the window of the scan's cells: its points' and the
+// sensor's (clamped to the grid's edge), two cells around, cut to the grid. TraceRays adds a guard
+// band for the rays. Empty when no point is on the grid.
 Window LocatePoints(const FastGrid& g, const Eigen::Vector3f* points, std::size_t count,
                     const Eigen::Vector3f& origin, float z_lo, float z_hi,
                     std::vector<PointCell>& cells) {
