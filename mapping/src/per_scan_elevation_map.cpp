@@ -6,6 +6,7 @@
 #include <future>
 #include <limits>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <utility>
 
@@ -115,7 +116,10 @@ void PerScanElevationMap::ContributeAll(const std::vector<Scan*>& scans) const {
     for (std::size_t k = next++; k < scans.size(); k = next++) Contribute(*scans[k]);
   };
   std::vector<std::future<void>> helpers;
-  for (unsigned t = 1; t < threads; ++t) helpers.push_back(std::async(std::launch::async, work));
+  try {
+    for (unsigned t = 1; t < threads; ++t) helpers.push_back(std::async(std::launch::async, work));
+  } catch (const std::system_error&) {  // no thread to be had: the calling one does the rest
+  }
   work();
   for (std::future<void>& h : helpers) h.get();  // rethrows a helper's exception
 }
