@@ -12,6 +12,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "up_plane_fit.hpp"
+
 namespace pitchlab::mapping {
 namespace {
 
@@ -31,23 +33,10 @@ struct Plane {
   double Distance(const Eigen::Vector3f& p) const { return n.dot(p.cast<double>()) - d; }
 };
 
-// Total least squares plane through `points` (the smallest eigenvector of their covariance),
-// normal turned up.
+// Total least squares plane through `points`, normal turned up.
 Plane FitPlane(const std::vector<Eigen::Vector3f>& points) {
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3f& p : points) mean += p.cast<double>();
-  mean /= static_cast<double>(points.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const Eigen::Vector3f& p : points) {
-    const Eigen::Vector3d e = p.cast<double>() - mean;
-    cov += e * e.transpose();
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-  Plane plane;
-  plane.n = eig.eigenvectors().col(0);
-  if (plane.n.z() < 0) plane.n = -plane.n;
-  plane.d = plane.n.dot(mean);
-  return plane;
+  const auto [n, d] = UpPlaneThrough(points);
+  return Plane{n, d};
 }
 
 // The candidates: finite points below the sensor whose horizontal distance from it lies within

@@ -5,8 +5,9 @@
 #include <cstdint>
 #include <utility>
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+
+#include "up_plane_fit.hpp"
 
 namespace pitchlab::mapping {
 namespace {
@@ -56,17 +57,8 @@ struct FloorPlane {
 
 // Total least squares plane through `v`, normal turned up.
 FloorPlane FitPlane(const std::vector<Eigen::Vector3d>& v) {
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& p : v) mean += p;
-  mean /= static_cast<double>(v.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const Eigen::Vector3d& p : v) cov += (p - mean) * (p - mean).transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-  FloorPlane plane;
-  plane.n = eig.eigenvectors().col(0);
-  if (plane.n.z() < 0) plane.n = -plane.n;
-  plane.d = plane.n.dot(mean);
-  return plane;
+  const auto [n, d] = UpPlaneThrough(v);
+  return FloorPlane{n, d};
 }
 
 // One line's floor candidates relative to the sensor, and the correction found for it.
