@@ -10,7 +10,6 @@
 #include <utility>
 #include <vector>
 
-#include <Eigen/Eigenvalues>
 
 #include "up_plane_fit.hpp"
 
