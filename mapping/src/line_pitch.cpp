@@ -36,15 +36,21 @@ std::vector<std::vector<std::uint32_t>> LinesOf(const std::vector<Eigen::Vector3
   }
   *finite = elevation.size();
   std::sort(elevation.begin(), elevation.end());
+  // A run of elevations is one line only when it spans no more than the gap itself: lines whose
+  // elevation drifts along them (a laser off the pitch axis, a frame that is not the scanner's)
+  // chain into wide runs, and those are no lines.
   std::vector<std::vector<std::uint32_t>> lines;
   std::vector<std::uint32_t> run;
+  double run_first = 0;
   for (std::size_t k = 0; k <= elevation.size(); ++k) {
     if (k == elevation.size() ||
         (k > 0 && elevation[k].first - elevation[k - 1].first > config.line_gap_rad)) {
-      if (run.size() >= config.min_line_points) lines.push_back(run);
+      const double span = k > 0 ? elevation[k - 1].first - run_first : 0.0;
+      if (run.size() >= config.min_line_points && span <= config.line_gap_rad) lines.push_back(run);
       run.clear();
       if (k == elevation.size()) break;
     }
+    if (run.empty()) run_first = elevation[k].first;
     run.push_back(elevation[k].second);
   }
   return lines;

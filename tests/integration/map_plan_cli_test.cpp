@@ -138,6 +138,35 @@ TEST_F(MapPlanCli, MapWritesRastersAndAnOccupancyGridThatPlanReads) {
   EXPECT_GE(nlohmann::json::parse(plan.out)["length_m"].get<double>(), 1.4);
 }
 
+// The real 3DTK pair (a nodding SICK whose lines' pitch is off by ~1 deg RMS): map sets each
+// scan's lines right by the floor, which flattens the floor the levelling fits; --as-recorded
+// keeps the lines, and the simulated office scan (laser off the pitch axis, in base_link) is no
+// nodding scan in its own frame, so nothing of it moves.
+TEST_F(MapPlanCli, MapSetsARealNoddingScansLinesRightByItsFloor) {
+  const std::string real = std::string(PITCHLAB_3DTK_CORRIDOR_DIR) + "/scan000.3d " +
+                           PITCHLAB_3DTK_CORRIDOR_DIR + "/scan001.3d";
+  const CliResult set_right = Run("map " + real + " --out " + (dir_ / "real").string());
+  ASSERT_EQ(set_right.exit_code, 0) << set_right.err;
+  const auto a = nlohmann::json::parse(Slurp(dir_ / "real" / "map.json"));
+  ASSERT_EQ(a["line_pitch"].size(), 2u);
+  for (const auto& c : a["line_pitch"]) {
+    EXPECT_GT(c["result"]["corrected"].get<int>(), 50) << c.dump();
+    EXPECT_LT(c["result"]["floor_rms_after_m"].get<double>(),
+              0.5 * c["result"]["floor_rms_before_m"].get<double>());
+  }
+  EXPECT_NE(set_right.err.find("lines set right by the floor"), std::string::npos);
+  const CliResult kept =
+      Run("map " + real + " --as-recorded --out " + (dir_ / "real_kept").string());
+  ASSERT_EQ(kept.exit_code, 0) << kept.err;
+  const auto b = nlohmann::json::parse(Slurp(dir_ / "real_kept" / "map.json"));
+  EXPECT_EQ(b["line_pitch"][0]["result"]["corrected"].get<int>(), 0);
+  // The levelling's floor fit: 1.0 cm with the lines set right, 2.9 cm as recorded.
+  EXPECT_LT(a["levelling"]["residual_m"].get<double>(),
+            0.5 * b["levelling"]["residual_m"].get<double>());
+  const auto office = nlohmann::json::parse(Slurp(dir_ / "map" / "map.json"));
+  EXPECT_EQ(office["line_pitch"][0]["result"]["corrected"].get<int>(), 0) << office.dump();
+}
+
 TEST_F(MapPlanCli, BadInputOrNoPathGivesAClearErrorANonZeroExitAndPicturesOnlyForNoPath) {
   ASSERT_EQ(map_run_.exit_code, 0) << map_run_.err;
   const std::string map = (dir_ / "map" / "map.plem").string();

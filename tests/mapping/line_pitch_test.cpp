@@ -36,7 +36,8 @@ Eigen::Vector3d Beam(double pitch, double azimuth) {
 // The scan as recorded: each line's ranges measured at pitch + error(line), placed at the
 // recorded pitch; lines every 0.5 deg from 30 deg up to 50 deg down, beams every 0.5 deg.
 template <typename Error>
-std::vector<Eigen::Vector3f> NoddingScan(Error error, double noise_m, unsigned seed) {
+std::vector<Eigen::Vector3f> NoddingScan(Error error, double noise_m, unsigned seed,
+                                         double mirror_above_axis_m = 0) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, noise_m);
   std::vector<Eigen::Vector3f> points;
@@ -44,7 +45,11 @@ std::vector<Eigen::Vector3f> NoddingScan(Error error, double noise_m, unsigned s
   for (double pitch = -30 * kDeg; pitch <= 50.01 * kDeg; pitch += 0.5 * kDeg, ++line) {
     for (double az = -89.5 * kDeg; az <= 89.51 * kDeg; az += 0.5 * kDeg) {
       const double r = RangeInCorridor(Beam(pitch + error(line), az)) + noise(rng);
-      points.push_back((r * Beam(pitch, az)).cast<float>());
+      // The mirror turns with the mount about the axis at the origin (pitchlab's own scans, in
+      // base_link, have it ~5 cm off the axis); the axis itself is the frame's y.
+      const Eigen::Vector3d mirror(mirror_above_axis_m * std::sin(pitch), 0,
+                                   mirror_above_axis_m * std::cos(pitch));
+      points.push_back((mirror + r * Beam(pitch, az)).cast<float>());
     }
   }
   return points;
@@ -101,6 +106,17 @@ TEST(LinePitch, LinesAtTheirRecordedPitchStayWhereTheyAre) {
     if (truth[k].norm() < 10) moved = std::max(moved, double((scan[k] - truth[k]).norm()));
   }
   EXPECT_LT(moved, 0.01);  // at the end wall's 8 m, 0.07 deg is 1 cm
+}
+
+// A scan whose mirror sits off the pitch axis (pitchlab's own, in base_link): its lines' points do
+// not share one elevation about the frame's y axis through the sensor, so it is not taken for a
+// nodding scan in its own frame and nothing moves.
+TEST(LinePitch, AScanWhoseLaserSitsOffThePitchAxisIsLeftAlone) {
+  std::vector<Eigen::Vector3f> scan = NoddingScan(Wobble, 0.003, 4, 0.05);
+  const std::vector<Eigen::Vector3f> copy = scan;
+  const LinePitch r = RectifyLinePitch(scan, Eigen::Vector3f(0, 0, 0.05f));
+  EXPECT_FALSE(r.nodding) << r.lines << " lines";
+  EXPECT_EQ(scan, copy);
 }
 
 TEST(LinePitch, ACloudThatIsNotMadeOfLinesIsLeftAlone) {
