@@ -44,6 +44,7 @@ CliArgs MergeArgs() {
       .Option("prior-error", "metres,degrees",
               "how far each scan's odometry pose may be off since the last merged scan")
       .Option("sensor-origin", "x,y,z", kSensorOriginHelp)
+      .Flag("as-recorded", kAsRecordedHelp)
       .Flag("loop-closure", "close loops over a pose graph of the merged scans")
       .Option("information-scale", "S",
               "with --loop-closure: factor in (0, 1] on every edge's information (default 0.1; "
@@ -166,7 +167,9 @@ int RunMerge(int argc, char** argv) {
   std::vector<double> stamps_s;
   std::vector<std::optional<Eigen::Isometry3d>> truth;  // T_map_base of each scan, when known
   for (const std::string& file : files) {
-    const sensors::Scan3D scan_read = LoadInputCloud(file, origin);
+    nlohmann::json line_pitch;
+    const sensors::Scan3D scan_read =
+        LoadInputCloud(file, origin, !args.Flagged("as-recorded"), &line_pitch);
     const sensors::Scan3D* scan = &scan_read;
     if (!builder) {  // one sensor for the sequence: where the first scan says it sits
       config.sensor_base = scan->sensor_origin->cast<float>();
@@ -190,7 +193,8 @@ int RunMerge(int argc, char** argv) {
                         {"reason", step->registration.reason},
                         {"path", mapping::ToString(step->registration.path)},
                         {"inlier_ratio", step->registration.inlier_ratio},
-                        {"time_s", step->registration.timings.total_s}};
+                        {"time_s", step->registration.timings.total_s},
+                        {"line_pitch", line_pitch}};
     if (truth.back() && step->merged) {
       const mapping::PoseError e = mapping::ComparePoses(step->T_map_base, *truth.back());
       s["ground_truth_error"] = {{"rotation_deg", e.rotation_deg},

@@ -38,6 +38,7 @@ CliArgs RegisterArgs() {
       .Option("previous", "x,y,z,roll,pitch,yaw",
               "the previous pair's motion (constant velocity), tried when there is no --prior")
       .Option("sensor-origin", "x,y,z", kSensorOriginHelp)
+      .Flag("as-recorded", kAsRecordedHelp)
       .Option("config", "FILE.yaml",
               "settings in its 'registration:' section (see mapping/README.md)")
       .Flag("json", "print the result as JSON on stdout");
@@ -131,8 +132,12 @@ int RunRegister(int argc, char** argv) {
   }
   if (args.Has("previous")) prior.previous_motion = PoseOption(args, "previous");
 
-  const sensors::Scan3D source = LoadInputCloud(source_path, origin);
-  const sensors::Scan3D target = LoadInputCloud(target_path, origin);
+  const bool set_lines_right = !args.Flagged("as-recorded");
+  nlohmann::json line_pitch = {{"source", nullptr}, {"target", nullptr}};
+  const sensors::Scan3D source =
+      LoadInputCloud(source_path, origin, set_lines_right, &line_pitch["source"]);
+  const sensors::Scan3D target =
+      LoadInputCloud(target_path, origin, set_lines_right, &line_pitch["target"]);
   if (prior_from_files) prior.odometry = PriorFromFiles(source, source_path, target, target_path);
   prior.source_sensor = source.sensor_origin->cast<float>();  // LoadInputCloud always sets it
   prior.target_sensor = target.sensor_origin->cast<float>();
@@ -143,6 +148,7 @@ int RunRegister(int argc, char** argv) {
   nlohmann::json out = ResultJson(*r);
   out["source"] = source_path;
   out["target"] = target_path;
+  out["line_pitch"] = line_pitch;
   if (source.has_truth && target.has_truth) {  // simulated scans carry their ground truth
     const Eigen::Isometry3d truth = target.T_world_base.inverse() * source.T_world_base;
     const mapping::PoseError e = mapping::ComparePoses(r->T_target_source, truth);

@@ -121,7 +121,6 @@ struct Scan {
   sensors::Scan3D scan;
   mapping::PointCloud cloud;
   Eigen::Isometry3d reference;  // slam6d's registered pose
-  mapping::PointCloud rectified;  // its lines set right by the floor, for the map check
   mapping::LinePitch line_pitch;  // what setting its lines right did
   double line_pitch_cpu_s = 0;    // and its CPU time [s]
 };
@@ -133,12 +132,10 @@ Scan Load(const fs::path& path) {
   if (!scan) throw std::runtime_error(scan.error().message);
   s.scan = *scan;
   s.cloud = mapping::CloudFromScan(s.scan);
-  // Each nodding line set right by the floor it crossed, as `pitchlab map` reads real scans
-  // (registration reads them as recorded: see mapping/README.md, Line pitch).
+  // Each nodding line set right by the floor it crossed, as the commands read real scans.
   const double cpu = ThreadCpuSeconds();
-  s.rectified = s.cloud;
   s.line_pitch = mapping::RectifyLinePitch(
-      s.rectified, s.scan.sensor_origin.value_or(Eigen::Vector3d::Zero()).cast<float>());
+      s.cloud, s.scan.sensor_origin.value_or(Eigen::Vector3d::Zero()).cast<float>());
   s.line_pitch_cpu_s = ThreadCpuSeconds() - cpu;
   // The reference: scanNNN.frames, or any scanNNN.frames.* beside it.
   const std::string stem = path.stem().string();
@@ -278,8 +275,8 @@ int main(int argc, char** argv) {
       const Eigen::Vector3f sensor =
           scans[k].scan.sensor_origin.value_or(Eigen::Vector3d::Zero()).cast<float>();
       at_reference.push_back(
-          {&scans[k].rectified, sensor, scans[0].reference.inverse() * scans[k].reference});
-      at_ours.push_back({&scans[k].rectified, sensor, ours[k]});
+          {&scans[k].cloud, sensor, scans[0].reference.inverse() * scans[k].reference});
+      at_ours.push_back({&scans[k].cloud, sensor, ours[k]});
     }
     std::fprintf(stderr, "  map check\n");
     json map_check = {{"at_reference", benchmarks::CheckMap(at_reference)}};
