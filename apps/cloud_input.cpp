@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "pitchlab/mapping/line_pitch.hpp"
+#include "pitchlab/mapping/point_cloud.hpp"
+#include "pitchlab/mission/registration_json.hpp"
 #include "pitchlab/sensors/cloud_file.hpp"
 
 namespace pitchlab::apps {
@@ -27,17 +29,16 @@ sensors::Scan3D LoadInputCloud(const std::string& path,
     sensors::SetSensorOrigin(*scan, Eigen::Vector3d::Zero());
   }
   if (set_lines_right) {
-    std::vector<Eigen::Vector3f> points;
-    points.reserve(scan->points.size());
-    for (const sensors::ScanPoint& p : scan->points) points.emplace_back(p.x, p.y, p.z);
-    const mapping::LinePitch r = mapping::RectifyLinePitch(points, scan->sensor_origin->cast<float>());
+    mapping::PointCloud points = mapping::CloudFromScan(*scan);
+    const mapping::LinePitch r =
+        mapping::RectifyLinePitch(points, scan->sensor_origin->cast<float>());
     for (std::size_t k = 0; k < points.size(); ++k) {
       scan->points[k].x = points[k].x();
       scan->points[k].y = points[k].y();
       scan->points[k].z = points[k].z();
     }
-    constexpr double kToDeg = 180 / 3.14159265358979323846;
     if (r.corrected > 0) {
+      constexpr double kToDeg = 180 / 3.14159265358979323846;
       std::fprintf(stderr,
                    "%s: %zu of %zu lines set right by the floor they crossed (pitch corrections "
                    "%.2f deg RMS, at most %.2f; floor %.1f -> %.1f mm RMS)\n",
@@ -45,15 +46,7 @@ sensors::Scan3D LoadInputCloud(const std::string& path,
                    r.max_correction_rad * kToDeg, r.floor_rms_before_m * 1e3,
                    r.floor_rms_after_m * 1e3);
     }
-    if (line_pitch) {
-      *line_pitch = {{"lines", r.lines},
-                     {"corrected", r.corrected},
-                     {"rms_correction_deg", r.rms_correction_rad * kToDeg},
-                     {"max_correction_deg", r.max_correction_rad * kToDeg},
-                     {"floor_rms_before_m", r.floor_rms_before_m},
-                     {"floor_rms_after_m", r.floor_rms_after_m}};
-      if (!r.note.empty()) (*line_pitch)["note"] = r.note;
-    }
+    if (line_pitch) *line_pitch = mission::LinePitchJson(r);
   } else if (line_pitch) {
     *line_pitch = {{"corrected", 0}, {"note", "--as-recorded"}};
   }

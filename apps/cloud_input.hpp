@@ -31,7 +31,7 @@ constexpr const char* kAsRecordedHelp =
 /// file's origin; when neither gives one, prints one warning line to stderr and assumes (0,0,0).
 /// With `set_lines_right`, a nodding scan's lines are turned onto the floor they crossed
 /// (mapping::RectifyLinePitch, in the scan's own frame) and one line says so on stderr;
-/// `line_pitch`, when given, receives what was done as JSON (LinePitchJson).
+/// `line_pitch`, when given, receives what was done as JSON (mission::LinePitchJson).
 sensors::Scan3D LoadInputCloud(const std::string& path,
                                const std::optional<Eigen::Vector3d>& sensor_origin_override,
                                bool set_lines_right = false,

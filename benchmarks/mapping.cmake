@@ -11,3 +11,5 @@ foreach(name registration_eval real_eval loop_closure_eval)
   endif()
 endforeach()
 target_sources(real_eval PRIVATE "${CMAKE_CURRENT_LIST_DIR}/real_map_check.cpp")
+# real_eval reports line pitch as the commands do (mission/registration_json.hpp).
+target_link_libraries(real_eval PRIVATE pitchlab::mission)

@@ -26,6 +26,7 @@
 
 #include "pitchlab/mapping/line_pitch.hpp"
 #include "pitchlab/mapping/registration.hpp"
+#include "pitchlab/mission/registration_json.hpp"
 #include "pitchlab/sensors/cloud_file.hpp"
 #include "real_map_check.hpp"
 
@@ -291,15 +292,10 @@ int main(int argc, char** argv) {
     }
     json line_pitch = json::array();
     for (const Scan& s : scans) {
-      line_pitch.push_back({{"scan", s.path},
-                            {"lines", s.line_pitch.lines},
-                            {"corrected", s.line_pitch.corrected},
-                            {"rms_correction_deg", s.line_pitch.rms_correction_rad * 180 / M_PI},
-                            {"max_correction_deg", s.line_pitch.max_correction_rad * 180 / M_PI},
-                            {"floor_rms_before_m", s.line_pitch.floor_rms_before_m},
-                            {"floor_rms_after_m", s.line_pitch.floor_rms_after_m},
-                            {"note", s.line_pitch.note},
-                            {"cpu_s", s.line_pitch_cpu_s}});
+      json j = mission::LinePitchJson(s.line_pitch);
+      j["scan"] = s.path;
+      j["cpu_s"] = s.line_pitch_cpu_s;
+      line_pitch.push_back(j);
     }
     json out = {{"folder", dir},
                 {"line_pitch", line_pitch},

@@ -144,6 +144,7 @@ std::vector<Line> FloorCandidates(const std::vector<std::vector<std::uint32_t>>&
                                   const std::vector<Eigen::Vector3f>& points,
                                   const Eigen::Vector3f& sensor, const FloorPlane& plane,
                                   double sigma_m, const LinePitchConfig& config) {
+  const double reach = std::tan(config.max_correction_rad);  // height per metre of range
   std::vector<Line> lines(indices.size());
   for (std::size_t l = 0; l < indices.size(); ++l) {
     lines[l].all = indices[l];
@@ -152,7 +153,7 @@ std::vector<Line> FloorCandidates(const std::vector<std::vector<std::uint32_t>>&
       const double r = std::hypot(v.x(), v.y());
       if (v.z() >= 0 || r < config.ground.min_radius_m || r > config.ground.max_radius_m) continue;
       const double e = plane.n.dot(v) - plane.d;
-      if (std::abs(e) <= v.norm() * std::tan(config.max_correction_rad) + 3 * sigma_m) {
+      if (std::abs(e) <= v.norm() * reach + 3 * sigma_m) {
         lines[l].floor.push_back(v);
       }
     }

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pitchlab/mapping/line_pitch.hpp"
 #include "pitchlab/mapping/registration.hpp"
 
 namespace pitchlab::mission {
@@ -35,6 +36,20 @@ inline nlohmann::json StageTimingsJson(const mapping::StageTimings& t) {
   return {{"voxel", t.voxel_s},       {"normals", t.normals_s},
           {"features", t.features_s}, {"initial_alignment", t.initial_alignment_s},
           {"icp", t.icp_s},           {"total", t.total_s}};
+}
+
+/// What setting a scan's lines right by its floor did (mapping::RectifyLinePitch), as register,
+/// merge, map and real_eval report it: angles in degrees.
+inline nlohmann::json LinePitchJson(const mapping::LinePitch& r) {
+  constexpr double kToDeg = 180 / 3.14159265358979323846;
+  nlohmann::json j = {{"lines", r.lines},
+                      {"corrected", r.corrected},
+                      {"rms_correction_deg", r.rms_correction_rad * kToDeg},
+                      {"max_correction_deg", r.max_correction_rad * kToDeg},
+                      {"floor_rms_before_m", r.floor_rms_before_m},
+                      {"floor_rms_after_m", r.floor_rms_after_m}};
+  if (!r.note.empty()) j["note"] = r.note;
+  return j;
 }
 
 }  // namespace pitchlab::mission
