@@ -25,6 +25,7 @@
 #include <Eigen/Eigenvalues>
 #include <nlohmann/json.hpp>
 
+#include "pitchlab/mapping/line_pitch.hpp"
 #include "pitchlab/sensors/cloud_file.hpp"
 #include "pitchlab/sensors/grazing_returns.hpp"
 #include "pitchlab/sensors/sensor_config.hpp"
@@ -219,6 +220,11 @@ struct Accumulator {
   // Floor.
   std::vector<double> floor_tilt_deg, floor_roll_deg, floor_pitch_deg, floor_sigma_m, floor_rms_m;
   std::vector<double> floor_points;
+  // Per range bin: a floor return's height off the floor plane less the mean of its two in-line
+  // neighbours', over sqrt(1.5): one beam's own height scatter on the floor. A line's pitch error
+  // moves its three returns alike and cancels; what is left is what each beam adds on its own,
+  // which on a floor met at grazing incidence is the range noise times cos(incidence).
+  std::vector<std::vector<double>> floor_inline = std::vector<std::vector<double>>(5);
   // Grazed returns (sensors::GrazedReturns, with the elevation map's 0.1 m cell) within the
   // mission's 10 m map range.
   double grazed = 0, within_map_range = 0;
@@ -376,6 +382,28 @@ void MixedPixelStats(const RangeGrid& g, Accumulator& acc) {
   }
 }
 
+// Every return within the band of the floor plane n.p + d0 = 0 whose two in-line neighbours are
+// too (far floor returns included: they have too few neighbours for a patch fit).
+void FloorInlineStats(const RangeGrid& g, const Eigen::Vector3d& n, double d0, Accumulator& acc) {
+  const auto off = [&](int l, int b, double* d) {
+    if (b < 0 || b >= g.beams) return false;
+    const std::size_t i = g.Index(l, b);
+    if (g.cell[i] != Cell::kValid) return false;
+    *d = n.dot(g.point[i]) + d0;
+    return std::abs(*d) <= kFloorBand_m;
+  };
+  for (int l = 0; l < g.lines; ++l) {
+    for (int b = 0; b < g.beams; ++b) {
+      double before, here, after;
+      if (!off(l, b, &here) || !off(l, b - 1, &before) || !off(l, b + 1, &after)) continue;
+      const int bin = Bin(kRangeBins_m, g.range[g.Index(l, b)]);
+      if (bin < 0) continue;
+      acc.floor_inline[static_cast<std::size_t>(bin)].push_back(
+          (here - 0.5 * (before + after)) / std::sqrt(1.5));
+    }
+  }
+}
+
 void FloorStats(const RangeGrid& g, const std::vector<PatchFit>& fits, Accumulator& acc) {
   const double origin_z = g.origin.empty() ? 0.0 : g.origin[0].z();
   std::vector<Eigen::Vector3d> cand;
@@ -426,6 +454,7 @@ void FloorStats(const RangeGrid& g, const std::vector<PatchFit>& fits, Accumulat
   acc.floor_sigma_m.push_back(RobustSigma(resid));
   acc.floor_rms_m.push_back(std::sqrt(ss / resid.size()));
   acc.floor_points.push_back(static_cast<double>(resid.size()));
+  FloorInlineStats(g, n, d0, acc);
 }
 
 // What the mission would leave out of its elevation map as grazed: the grid as an organised scan
@@ -488,6 +517,7 @@ std::map<std::string, double> Summarize(const Accumulator& a) {
     // Dropout rates per bin: of the returns that located a bin (those with a plane fit).
     const double n = static_cast<double>(a.by_range[k].size());
     s["dropout_rate.range_" + bin] = a.dropouts_by_range[k] / (n + a.dropouts_by_range[k]);
+    s["floor_inline_sigma_m.range_" + bin] = RobustSigma(a.floor_inline[k]);
   }
   for (std::size_t k = 0; k + 1 < kIncidenceBins_deg.size(); ++k) {
     const std::string bin = BinName(kIncidenceBins_deg, static_cast<int>(k), "deg");
@@ -523,7 +553,30 @@ json Details(const Accumulator& a, const std::vector<std::string>& names) {
   d["floor_roll_deg_per_scan"] = a.floor_roll_deg;
   d["floor_pitch_deg_per_scan"] = a.floor_pitch_deg;
   d["floor_points_per_scan"] = a.floor_points;
+  json inline_counts = json::object();
+  for (std::size_t k = 0; k + 1 < kRangeBins_m.size(); ++k) {
+    inline_counts["range_" + BinName(kRangeBins_m, static_cast<int>(k), "m")] =
+        a.floor_inline[k].size();
+  }
+  d["floor_inline_returns"] = inline_counts;
   return d;
+}
+
+// The real scan's returns with each line turned onto the floor (mapping::RectifyLinePitch about
+// the scanner's own y axis, where 3DTK's frame has it); ranges are unchanged by the turn.
+void SetLinesRight(RangeGrid& g) {
+  std::vector<Eigen::Vector3f> returns;
+  std::vector<std::size_t> at;
+  for (std::size_t i = 0; i < g.point.size(); ++i) {
+    if (g.cell[i] != Cell::kValid) continue;
+    returns.push_back(g.point[i].cast<float>());
+    at.push_back(i);
+  }
+  const mapping::LinePitch lp = mapping::RectifyLinePitch(returns, Eigen::Vector3f::Zero());
+  for (std::size_t k = 0; k < at.size(); ++k) g.point[at[k]] = returns[k].cast<double>();
+  std::fprintf(stderr, "%s: %zu of %zu lines set right, %.2f deg RMS%s%s\n", g.name.c_str(),
+               lp.corrected, lp.lines, lp.rms_correction_rad * kRadToDeg,
+               lp.note.empty() ? "" : ": ", lp.note.c_str());
 }
 
 struct Options {
@@ -533,12 +586,13 @@ struct Options {
   int sim_scans = 2;
   std::uint64_t seed = 1;
   bool legacy = false;
+  bool lines_set_right = false;
 };
 
 [[noreturn]] void Usage(int code) {
   (code ? std::cerr : std::cout)
       << "sensor_realism --real FILE.3d [--real FILE.3d ...] [--world NAME] [--sim-scans N]\n"
-         "               [--seed S] [--sensor FILE.yaml] [--legacy]\n"
+         "               [--seed S] [--sensor FILE.yaml] [--legacy] [--lines-set-right]\n"
          "Prints JSON: the same statistics of the real scans (3DTK uos .3d, cm, left-handed)\n"
          "and of N simulated scans of the world (default corridor; scan k at the default start\n"
          "moved k x 4 m along +x or the next free spot, LMS200 seed S + k), with the ratio sim / "
@@ -546,7 +600,10 @@ struct Options {
          "The simulated LMS200 is Lms200Config::Measured() (the model fitted to real scans).\n"
          "--sensor: lms200/pitch_unit/scan/mount sections over the defaults instead.\n"
          "--legacy: the default (pre-issue-16) LMS200 model (constant noise, no mixed pixels,\n"
-         "no dropouts, perfect mount).\n";
+         "no dropouts, perfect mount).\n"
+         "--lines-set-right: the real scans' lines set right by their floor first\n"
+         "(mapping::RectifyLinePitch, as pitchlab's commands read them): the statistics without\n"
+         "the nodding servo's line-to-line pitch error.\n";
   std::exit(code);
 }
 
@@ -574,6 +631,8 @@ Options Parse(int argc, char** argv) {
         o.seed = std::stoull(value());
       else if (a == "--legacy")
         o.legacy = true;
+      else if (a == "--lines-set-right")
+        o.lines_set_right = true;
       else if (a == "--help")
         Usage(0);
       else {
@@ -599,8 +658,9 @@ int main(int argc, char** argv) {
   try {
     Accumulator real, sim;
     for (const std::string& path : o.real) {
-      const RangeGrid g = ReadUos(path);
+      RangeGrid g = ReadUos(path);
       std::fprintf(stderr, "%s: %d lines x %d beams\n", path.c_str(), g.lines, g.beams);
+      if (o.lines_set_right) SetLinesRight(g);
       Measure(g, real);
     }
     sensors::SensorConfig sensor;
