@@ -125,6 +125,9 @@ AppConfig LoadAppConfig(const std::optional<std::string>& path) {
   ReadImu(root["imu"], source, rig.imu);
   // One seed drives every random source unless a section sets its own.
   if (!(root["lms200"] && root["lms200"]["seed"])) config.sensors.lms200.seed = config.seed;
+  if (!(root["pitch_unit"] && root["pitch_unit"]["seed"])) {
+    config.sensors.pitch_unit.seed = config.seed;
+  }
   rig.odometry.seed = config.seed;
   rig.imu.seed = config.seed;
   rig.lms200 = config.sensors.lms200;

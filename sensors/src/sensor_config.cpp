@@ -133,6 +133,7 @@ SensorConfig ParseSensorConfig(const std::string& yaml_text, const std::string& 
       .Read();
   l.seed = seed;
   auto& p = c.pitch_unit;
+  std::uint64_t pitch_seed = p.seed;
   SectionReader(root, "pitch_unit", source)
       .Field("step_deg", p.step_deg)
       .Field("encoder_counts_per_rev", p.encoder_counts_per_rev)
@@ -140,7 +141,11 @@ SensorConfig ParseSensorConfig(const std::string& yaml_text, const std::string& 
       .Field("max_deg", p.max_deg)
       .Field("max_speed_dps", p.max_speed_dps)
       .Field("settle_s", p.settle_s)
+      .Field("line_pitch_error_deg", p.line_pitch_error_deg)
+      .Field("line_pitch_error_period_deg", p.line_pitch_error_period_deg)
+      .Field("seed", pitch_seed)
       .Read();
+  p.seed = pitch_seed;
   auto& s = c.scan;
   SectionReader(root, "scan", source)
       .Field("pitch_start_deg", s.pitch_start_deg)
@@ -203,7 +208,10 @@ std::string SensorConfigToYaml(const SensorConfig& c) {
      << "  min_deg: " << p.min_deg << "\n"
      << "  max_deg: " << p.max_deg << "\n"
      << "  max_speed_dps: " << p.max_speed_dps << "\n"
-     << "  settle_s: " << p.settle_s << "\n";
+     << "  settle_s: " << p.settle_s << "\n"
+     << "  line_pitch_error_deg: " << p.line_pitch_error_deg << "\n"
+     << "  line_pitch_error_period_deg: " << p.line_pitch_error_period_deg << "\n"
+     << "  seed: " << p.seed << "\n";
   const auto& s = c.scan;
   os << "scan:\n"
      << "  pitch_start_deg: " << s.pitch_start_deg << "\n"

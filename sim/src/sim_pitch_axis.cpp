@@ -43,9 +43,9 @@ Result<double> SimPitchAxis::MoveTo(double pitch_rad, std::chrono::milliseconds 
     }
     sim_.Step(1);
   }
-  return model_.EncoderAngle(sim_.pitch_rad());
+  return model_.ReportedAngle(sim_.pitch_rad());
 }
 
-Result<double> SimPitchAxis::ReadEncoder() { return model_.EncoderAngle(sim_.pitch_rad()); }
+Result<double> SimPitchAxis::ReadEncoder() { return model_.ReportedAngle(sim_.pitch_rad()); }
 
 }  // namespace pitchlab::sim

@@ -1,6 +1,8 @@
 #include "pitchlab/sensors/pitch_unit.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -54,6 +56,56 @@ TEST(PitchUnit, RejectsImpossibleConfigs) {
   config = {};
   config.min_deg = 10;
   config.max_deg = 5;
+  EXPECT_THROW(PitchUnitModel{config}, std::invalid_argument);
+}
+
+// The reported pitch of lines 0.52 deg apart over the 3DTK rig's sweep (-48 .. +67 deg).
+std::vector<double> SweepErrorsDeg(const PitchUnitModel& unit) {
+  std::vector<double> e;
+  for (double a = -48.0; a <= 67.0; a += 0.52) e.push_back(unit.LinePitchError(a * kDeg) / kDeg);
+  return e;
+}
+
+TEST(PitchUnit, ReportsItsTruePitchUnlessGivenALinePitchError) {
+  PitchUnitModel unit{PitchUnitConfig{}};
+  for (double a : {-0.7, 0.0, 0.31, 1.1}) {
+    EXPECT_EQ(unit.LinePitchError(a), 0.0);
+    EXPECT_EQ(unit.ReportedAngle(a), unit.EncoderAngle(a));
+  }
+}
+
+TEST(PitchUnit, ALinePitchErrorWobblesAndJumpsAsTheRealRigsDoes) {
+  PitchUnitConfig config;
+  config.line_pitch_error_deg = 0.9;  // the real rig's RMS
+  config.seed = 7;
+  const PitchUnitModel unit(config);
+  const std::vector<double> e = SweepErrorsDeg(unit);
+  double ss = 0, max_jump = 0;
+  for (std::size_t k = 0; k < e.size(); ++k) {
+    ss += e[k] * e[k];
+    if (k > 0) max_jump = std::max(max_jump, std::abs(e[k] - e[k - 1]));
+  }
+  const double rms = std::sqrt(ss / e.size());
+  EXPECT_GT(rms, 0.6);  // 27 steps and wobbles over the sweep: the RMS is near its 0.9
+  EXPECT_LT(rms, 1.2);
+  // Neighbouring lines jump by up to 2-3 deg at a step; within a step they move by the wobble's
+  // slope at most, 2 pi x 0.9 / 4.2 x 0.52 = 0.7 deg.
+  EXPECT_GT(max_jump, 1.5);
+  // The same pitch gives the same error, whatever was asked before (the real error repeats at the
+  // same pitches from scan to scan); ReportedAngle reads the angle off by it.
+  EXPECT_EQ(unit.LinePitchError(0.2), PitchUnitModel(config).LinePitchError(0.2));
+  EXPECT_NEAR(unit.ReportedAngle(0.2), 0.2 + unit.LinePitchError(0.2),
+              2 * 3.14159265358979 / 36000);
+  config.seed = 8;
+  EXPECT_NE(SweepErrorsDeg(PitchUnitModel(config)), e);
+}
+
+TEST(PitchUnit, RejectsANegativeLinePitchErrorOrPeriod) {
+  PitchUnitConfig config;
+  config.line_pitch_error_deg = -0.1;
+  EXPECT_THROW(PitchUnitModel{config}, std::invalid_argument);
+  config = {};
+  config.line_pitch_error_period_deg = 0;
   EXPECT_THROW(PitchUnitModel{config}, std::invalid_argument);
 }
 
