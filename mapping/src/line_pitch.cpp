@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <stdexcept>
 #include <utility>
 
 #include <Eigen/Geometry>
@@ -219,6 +220,12 @@ double AlignLinesToFloor(std::vector<Line>& lines, FloorPlane& plane, double sig
   return sigma;
 }
 
+// Turns each of `indices`' lines about the y axis through `sensor_m` onto the floor; what was
+// done goes into `out` (RectifyLinePitch).
+void SetLinesRight(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f& sensor_m,
+                   const std::vector<std::vector<std::uint32_t>>& indices,
+                   const LinePitchConfig& config, LinePitch& out);
+
 }  // namespace
 
 LinePitch RectifyLinePitch(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f& sensor_m,
@@ -238,10 +245,39 @@ LinePitch RectifyLinePitch(std::vector<Eigen::Vector3f>& points_m, const Eigen::
     return out;
   }
   out.nodding = true;
+  SetLinesRight(points_m, sensor_m, indices, config, out);
+  return out;
+}
+
+LinePitch RectifyLinePitch(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f& axis_m,
+                           const std::vector<std::vector<std::uint32_t>>& lines,
+                           const LinePitchConfig& config) {
+  LinePitch out;
+  std::vector<std::vector<std::uint32_t>> kept;
+  for (const auto& line : lines) {
+    for (const std::uint32_t k : line) {
+      if (k >= points_m.size()) {
+        throw std::invalid_argument("RectifyLinePitch: point index " + std::to_string(k) +
+                                    " of " + std::to_string(points_m.size()));
+      }
+    }
+    if (line.size() >= config.min_line_points) kept.push_back(line);
+  }
+  out.lines = kept.size();
+  out.nodding = true;
+  SetLinesRight(points_m, axis_m, kept, config, out);
+  return out;
+}
+
+namespace {
+
+void SetLinesRight(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f& sensor_m,
+                   const std::vector<std::vector<std::uint32_t>>& indices,
+                   const LinePitchConfig& config, LinePitch& out) {
   const Result<GroundLevel> level = FitGroundLevel(points_m, sensor_m, config.ground);
   if (!level) {
     out.note = level.error().message;
-    return out;
+    return;
   }
   // The floor relative to the sensor.
   const FloorPlane first{level->normal,
@@ -273,14 +309,15 @@ LinePitch RectifyLinePitch(std::vector<Eigen::Vector3f>& points_m, const Eigen::
   if (out.corrected == 0) {
     out.note = "no line crossed the floor within " + std::to_string(config.ground.max_radius_m) +
                " m in " + std::to_string(config.min_line_points) + " points";
-    return out;
+    return;
   }
   out.rms_correction_rad = std::sqrt(sum_sq / static_cast<double>(out.corrected));
   if (n > 0) {
     out.floor_rms_before_m = std::sqrt(before / static_cast<double>(n));
     out.floor_rms_after_m = std::sqrt(after / static_cast<double>(n));
   }
-  return out;
 }
+
+}  // namespace
 
 }  // namespace pitchlab::mapping

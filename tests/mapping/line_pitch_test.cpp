@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <stdexcept>
 #include <random>
 #include <vector>
 
@@ -117,6 +119,26 @@ TEST(LinePitch, AScanWhoseLaserSitsOffThePitchAxisIsLeftAlone) {
   const LinePitch r = RectifyLinePitch(scan, Eigen::Vector3f(0, 0, 0.05f));
   EXPECT_FALSE(r.nodding) << r.lines << " lines";
   EXPECT_EQ(scan, copy);
+}
+
+// The same scan with its lines given (as pitchlab's own Scan3D knows them): each line is turned
+// about the pitch axis, not about the mirror, and the floor is flat again.
+TEST(LinePitch, AScanThatKnowsItsLinesIsSetRightAboutThePitchAxis) {
+  std::vector<Eigen::Vector3f> scan = NoddingScan(Wobble, 0.003, 4, 0.05);
+  constexpr std::uint32_t kBeams = 359;  // -89.5 .. 89.5 deg every 0.5 deg
+  ASSERT_EQ(scan.size() % kBeams, 0u);
+  std::vector<std::vector<std::uint32_t>> lines(scan.size() / kBeams);
+  for (std::uint32_t k = 0; k < scan.size(); ++k) lines[k / kBeams].push_back(k);
+  const double before = FloorSpread(scan, 4.0);
+  const LinePitch r = RectifyLinePitch(scan, Eigen::Vector3f::Zero(), lines);
+  EXPECT_EQ(r.lines, 161u);
+  EXPECT_GT(r.corrected, 60u) << r.note;
+  EXPECT_GT(before, 0.03);
+  EXPECT_LT(FloorSpread(scan, 4.0), 0.015);
+  EXPECT_LT(r.floor_rms_after_m, 0.004);
+  // An index past the points is a caller's error, named.
+  lines[0].push_back(static_cast<std::uint32_t>(scan.size()));
+  EXPECT_THROW(RectifyLinePitch(scan, Eigen::Vector3f::Zero(), lines), std::invalid_argument);
 }
 
 TEST(LinePitch, ACloudThatIsNotMadeOfLinesIsLeftAlone) {

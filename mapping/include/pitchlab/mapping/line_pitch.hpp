@@ -13,6 +13,7 @@
 // their pitch: nothing in one scan tells their error.
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -65,6 +66,15 @@ struct LinePitch {
 /// Points are changed in place; a scan that is not line-structured, or whose floor cannot be
 /// found, is left as it was and the result's note says why. O(n log n).
 LinePitch RectifyLinePitch(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f& sensor_m,
+                           const LinePitchConfig& config = {});
+
+/// The same for a scan that knows its lines (`lines[l]`: the indices of line l's points; lines of
+/// fewer than min_line_points are left as they are), such as pitchlab's own (sensors::ScanPoint::
+/// line), whose laser sits off the pitch axis so that a line's points do not share one elevation
+/// about it. Each line is turned about the y axis through `axis_m`, the pitch axis (in base_link:
+/// the mount's origin). Throws std::invalid_argument for an index outside `points_m`.
+LinePitch RectifyLinePitch(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f& axis_m,
+                           const std::vector<std::vector<std::uint32_t>>& lines,
                            const LinePitchConfig& config = {});
 
 }  // namespace pitchlab::mapping
