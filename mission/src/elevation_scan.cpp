@@ -1,6 +1,7 @@
 #include "pitchlab/mission/elevation_scan.hpp"
 
 #include <algorithm>
+#include <cstdint>
 
 namespace pitchlab::mission {
 
@@ -31,6 +32,26 @@ ElevationScan ElevationScanOf(const sensors::Scan3D& scan, double map_range_m,
     }
   }
   return out;
+}
+
+mapping::LinePitch SetLinesRight(sensors::Scan3D& scan, const sensors::MountConfig& mount) {
+  std::vector<Eigen::Vector3f> points;
+  points.reserve(scan.points.size());
+  std::vector<std::vector<std::uint32_t>> lines(scan.lines.size());
+  for (std::size_t k = 0; k < scan.points.size(); ++k) {
+    const sensors::ScanPoint& p = scan.points[k];
+    points.emplace_back(p.x, p.y, p.z);
+    if (p.line >= lines.size()) lines.resize(p.line + 1u);
+    lines[p.line].push_back(static_cast<std::uint32_t>(k));
+  }
+  const mapping::LinePitch done =
+      mapping::RectifyLinePitch(points, mount.t_base_mount_m.cast<float>(), lines);
+  for (std::size_t k = 0; k < scan.points.size(); ++k) {
+    scan.points[k].x = points[k].x();
+    scan.points[k].y = points[k].y();
+    scan.points[k].z = points[k].z();
+  }
+  return done;
 }
 
 mapping::ElevationMap ViewOver(const mapping::GridGeometry& area,

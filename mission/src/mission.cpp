@@ -306,6 +306,7 @@ bool Mission::Stop(int k) {
   }
   stop.scan = std::move(*scan);
   stop.stamp_s = stop.scan.stamp_s;
+  if (config_.set_lines_right) stop.line_pitch = SetLinesRight(stop.scan, config_.mount);
   if (probes_.true_pose) stop.T_world_base_true = probes_.true_pose();
   Result<sensors::Odometry> odo = base_.ReadOdometry();
   if (!odo) {

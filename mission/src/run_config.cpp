@@ -110,6 +110,9 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
         // MapBuilder's loop closure (mapping/README.md); off by default, so every figure measured
         // without it stays.
         m.registration.loop_closure.enabled = kv.second.as<bool>();
+      } else if (key == "set_lines_right") {
+        // MissionConfig::set_lines_right; off by default, as every figure was measured.
+        m.set_lines_right = kv.second.as<bool>();
       } else if (key == "algorithm") {
         m.algorithm = planning::ParseAlgorithm(kv.second.as<std::string>());
       } else if (auto it = numbers.find(key); it != numbers.end()) {
@@ -237,6 +240,7 @@ std::string RunSettingsToYaml(const RunSettings& s) {
      << "  unknown_margin_m: " << m.unknown_margin_m << "\n"
      << "  map_range_m: " << m.map_range_m << "\n"
      << "  loop_closure: " << (m.registration.loop_closure.enabled ? "true" : "false") << "\n"
+     << "  set_lines_right: " << (m.set_lines_right ? "true" : "false") << "\n"
      << "  odometry_error_m: " << m.odometry_error_m << "\n"
      << "  odometry_error_per_m: " << m.odometry_error_per_m << "\n"
      << "  odometry_error_deg: " << m.odometry_error_deg << "\n"

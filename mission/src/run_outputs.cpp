@@ -97,6 +97,7 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
                                                       {"cells", stop.height_fit->cells}}
                                      : nlohmann::json()},
       {"elevation_cells_filled", stop.elevation_cells_filled},
+      {"line_pitch", stop.line_pitch ? LinePitchJson(*stop.line_pitch) : nlohmann::json()},
       {"deskewed", stop.scan.deskewed},
       {"deskew_deg", stop.scan.deskew_max_rad * kRadToDeg},
       {"success", reg.success},

@@ -164,6 +164,17 @@ TEST(RunSettings, LoopClosureIsOffUnlessTheRunSectionSwitchesItOn) {
   }
 }
 
+TEST(RunSettings, LinesAreSetRightOnlyWhenTheRunSectionAsks) {
+  EXPECT_FALSE(ParseRunSettings("", "f.yaml", sim::P3Model::kP3DX).mission.set_lines_right);
+  const RunSettings on =
+      ParseRunSettings("run: {set_lines_right: true}\n", "f.yaml", sim::P3Model::kP3DX);
+  EXPECT_TRUE(on.mission.set_lines_right);
+  EXPECT_TRUE(ParseRunSettings(RunSettingsToYaml(on), "back", sim::P3Model::kP3DX)
+                  .mission.set_lines_right);
+  EXPECT_THROW(ParseRunSettings("run: {set_lines_right: 2deg}\n", "f.yaml", sim::P3Model::kP3DX),
+               std::invalid_argument);
+}
+
 TEST(RunSettings, WrittenYamlReadsBackTheSame) {
   const RunSettings s = ParseRunSettings(
       "run: {goal_tolerance_m: 0.3, odometry_error_m: 0.2, tilt_tolerance_deg: 0.8}\n"

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include "pitchlab/mapping/elevation_map.hpp"
+#include "pitchlab/mapping/line_pitch.hpp"
 #include "pitchlab/sensors/grazing_returns.hpp"
 #include "pitchlab/sensors/scan3d.hpp"
 
@@ -35,6 +36,11 @@ struct ElevationScan {
 ElevationScan ElevationScanOf(const sensors::Scan3D& scan, double map_range_m,
                               const sensors::MountConfig& mount, double beam_divergence_rad,
                               double cell_m);
+
+/// Sets each of `scan`'s lines right by the floor it crossed (mapping::RectifyLinePitch with the
+/// scan's own lines, turned about the pitch axis through `mount`'s origin); ranges stay as they
+/// are (the laser turns with its line). What was done is returned.
+mapping::LinePitch SetLinesRight(sensors::Scan3D& scan, const sensors::MountConfig& mount);
 
 /// `points` (world frame [m], rays from `laser`) inserted alone into a grid over their extent,
 /// aligned to `area`'s cells: the view of a stop that did not register, which fills only the

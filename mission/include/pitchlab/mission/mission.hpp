@@ -14,6 +14,7 @@
 #include "pitchlab/mission/path_follower.hpp"
 #include "pitchlab/mission/stage_times.hpp"
 #include "pitchlab/mapping/elevation_map.hpp"
+#include "pitchlab/mapping/line_pitch.hpp"
 #include "pitchlab/mapping/map_builder.hpp"
 #include "pitchlab/planning/planner.hpp"
 #include "pitchlab/planning/traversability.hpp"
@@ -50,6 +51,12 @@ struct MissionConfig {
   /// centimetres a cell: overlapping far views of two scans read as steps and slopes that cut
   /// every way (terrain). The robot rescans every drive_per_stop_m, well inside this [m].
   double map_range_m = 10.0;
+  /// Set each scan's lines right by the floor they crossed (mapping::RectifyLinePitch, about the
+  /// mount's pitch axis) before registration and mapping: for a pitch unit whose reported pitch is
+  /// off per line, as the real 3DTK rig's is (0.9 deg RMS; sensors::PitchUnitConfig's
+  /// line_pitch_error_deg simulates one). Off by default: a unit that reports its true pitch
+  /// gains nothing, and every figure so far was measured without it.
+  bool set_lines_right = false;
   /// How far odometry may be off the motion since the last merged scan (plus that scan's own
   /// registration error), the registration prior's error bound (mapping::GuessUncertainty): it
   /// narrows the geometric constraint and the search around the guess to itself, and lets
@@ -138,6 +145,8 @@ struct StopRecord {
   /// With elevation_from_odometry: the map's unknown cells the scan filled; it leaves the cells
   /// the map has already seen as they are [1].
   std::size_t elevation_cells_filled = 0;
+  /// With MissionConfig::set_lines_right: what setting the scan's lines right did.
+  std::optional<mapping::LinePitch> line_pitch;
   /// What this stop heads for: via_m[target] while target < via_m.size(), else the goal [1].
   std::size_t target = 0;
   double distance_to_goal_m = 0;  ///< from the estimate to the target it heads for [m]
