@@ -403,7 +403,15 @@ bool Mission::Arrived(StopRecord& stop) {
 
 void Mission::UpdateElevation(StopRecord& stop) {
   const Eigen::Isometry3f T = stop.T_world_base.cast<float>();
-  const ElevationScan scan = ElevationScanOf(stop.scan, config_.map_range_m, config_.mount,
+  // With the lines set right, a line set right by the floor within the line pitch's radius is
+  // right everywhere, but the floor beyond that radius is met by lines that were not (their
+  // floor lies farther): the real rig's 0.9 deg lifts that floor by 6-16 cm at 4-10 m, over the
+  // 0.089 m step, so it stays out of the elevation map the robot plans on.
+  const double map_range_m =
+      config_.set_lines_right
+          ? std::min(config_.map_range_m, mapping::LinePitchConfig{}.ground.max_radius_m)
+          : config_.map_range_m;
+  const ElevationScan scan = ElevationScanOf(stop.scan, map_range_m, config_.mount,
                                               config_.beam_divergence_rad, config_.map_area.cell_m);
   std::vector<Eigen::Vector3f> near;  // map frame, within map_range_m of the laser
   near.reserve(scan.points_base.size());
@@ -411,7 +419,7 @@ void Mission::UpdateElevation(StopRecord& stop) {
   if (!stop.elevation_from_odometry) {  // a registered view only
     const mapping::GridGeometry& g = config_.map_area;
     for (const sensors::ScanPoint& p : stop.scan.points) {
-      if (p.range_m > config_.map_range_m) continue;
+      if (p.range_m > map_range_m) continue;
       const Eigen::Vector3f at = T * Eigen::Vector3f(p.x, p.y, p.z);
       const mapping::CellIndex c = g.IndexOf(at.x(), at.y());
       if (!g.Contains(c)) continue;

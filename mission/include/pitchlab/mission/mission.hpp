@@ -54,8 +54,12 @@ struct MissionConfig {
   /// Set each scan's lines right by the floor they crossed (mapping::RectifyLinePitch, about the
   /// mount's pitch axis) before registration and mapping: for a pitch unit whose reported pitch is
   /// off per line, as the real 3DTK rig's is (0.9 deg RMS; sensors::PitchUnitConfig's
-  /// line_pitch_error_deg simulates one). Off by default: a unit that reports its true pitch
-  /// gains nothing, and every figure so far was measured without it.
+  /// line_pitch_error_deg simulates one). The elevation map then takes returns only within the
+  /// radius the lines were set right by (LinePitchConfig's ground radius, 4 m): the floor beyond
+  /// is met by lines whose floor lay farther, which keep their error. Ground that is not level
+  /// within 4 m (terrain) is levelled with the lines: this is for level floors. Off by default:
+  /// a unit that reports its true pitch gains nothing, and every figure so far was measured
+  /// without it.
   bool set_lines_right = false;
   /// How far odometry may be off the motion since the last merged scan (plus that scan's own
   /// registration error), the registration prior's error bound (mapping::GuessUncertainty): it
