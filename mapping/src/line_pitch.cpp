@@ -224,55 +224,6 @@ double AlignLinesToFloor(std::vector<Line>& lines, FloorPlane& plane, double sig
 // done goes into `out` (RectifyLinePitch).
 void SetLinesRight(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f& sensor_m,
                    const std::vector<std::vector<std::uint32_t>>& indices,
-                   const LinePitchConfig& config, LinePitch& out);
-
-}  // namespace
-
-LinePitch RectifyLinePitch(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f& sensor_m,
-                           const LinePitchConfig& config) {
-  LinePitch out;
-  std::size_t finite = 0;
-  const std::vector<std::vector<std::uint32_t>> indices = LinesOf(points_m, sensor_m, config,
-                                                                  &finite);
-  std::size_t in_lines = 0;
-  for (const auto& l : indices) in_lines += l.size();
-  out.lines = indices.size();
-  if (indices.size() < config.min_lines ||
-      static_cast<double>(in_lines) < config.min_line_share * static_cast<double>(finite)) {
-    out.note = "not a nodding scan about the frame's y axis through the sensor: " +
-               std::to_string(in_lines) + " of " + std::to_string(finite) + " points in " +
-               std::to_string(indices.size()) + " lines of one elevation each";
-    return out;
-  }
-  out.nodding = true;
-  SetLinesRight(points_m, sensor_m, indices, config, out);
-  return out;
-}
-
-LinePitch RectifyLinePitch(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f& axis_m,
-                           const std::vector<std::vector<std::uint32_t>>& lines,
-                           const LinePitchConfig& config) {
-  LinePitch out;
-  std::vector<std::vector<std::uint32_t>> kept;
-  for (const auto& line : lines) {
-    for (const std::uint32_t k : line) {
-      if (k >= points_m.size()) {
-        throw std::invalid_argument("RectifyLinePitch: point index " + std::to_string(k) +
-                                    " of " + std::to_string(points_m.size()));
-      }
-    }
-    if (line.size() >= config.min_line_points) kept.push_back(line);
-  }
-  out.lines = kept.size();
-  out.nodding = true;
-  SetLinesRight(points_m, axis_m, kept, config, out);
-  return out;
-}
-
-namespace {
-
-void SetLinesRight(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f& sensor_m,
-                   const std::vector<std::vector<std::uint32_t>>& indices,
                    const LinePitchConfig& config, LinePitch& out) {
   const Result<GroundLevel> level = FitGroundLevel(points_m, sensor_m, config.ground);
   if (!level) {
@@ -319,5 +270,46 @@ void SetLinesRight(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f
 }
 
 }  // namespace
+
+LinePitch RectifyLinePitch(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f& sensor_m,
+                           const LinePitchConfig& config) {
+  LinePitch out;
+  std::size_t finite = 0;
+  const std::vector<std::vector<std::uint32_t>> indices = LinesOf(points_m, sensor_m, config,
+                                                                  &finite);
+  std::size_t in_lines = 0;
+  for (const auto& l : indices) in_lines += l.size();
+  out.lines = indices.size();
+  if (indices.size() < config.min_lines ||
+      static_cast<double>(in_lines) < config.min_line_share * static_cast<double>(finite)) {
+    out.note = "not a nodding scan about the frame's y axis through the sensor: " +
+               std::to_string(in_lines) + " of " + std::to_string(finite) + " points in " +
+               std::to_string(indices.size()) + " lines of one elevation each";
+    return out;
+  }
+  out.nodding = true;
+  SetLinesRight(points_m, sensor_m, indices, config, out);
+  return out;
+}
+
+LinePitch RectifyLinePitch(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f& axis_m,
+                           const std::vector<std::vector<std::uint32_t>>& lines,
+                           const LinePitchConfig& config) {
+  LinePitch out;
+  std::vector<std::vector<std::uint32_t>> kept;
+  for (const auto& line : lines) {
+    for (const std::uint32_t k : line) {
+      if (k >= points_m.size()) {
+        throw std::invalid_argument("RectifyLinePitch: point index " + std::to_string(k) +
+                                    " of " + std::to_string(points_m.size()));
+      }
+    }
+    if (line.size() >= config.min_line_points) kept.push_back(line);
+  }
+  out.lines = kept.size();
+  out.nodding = true;
+  SetLinesRight(points_m, axis_m, kept, config, out);
+  return out;
+}
 
 }  // namespace pitchlab::mapping

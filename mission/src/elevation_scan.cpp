@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdint>
 
+#include "pitchlab/mapping/point_cloud.hpp"
+
 namespace pitchlab::mission {
 
 ElevationScan ElevationScanOf(const sensors::Scan3D& scan, double map_range_m,
@@ -35,14 +37,12 @@ ElevationScan ElevationScanOf(const sensors::Scan3D& scan, double map_range_m,
 }
 
 mapping::LinePitch SetLinesRight(sensors::Scan3D& scan, const sensors::MountConfig& mount) {
-  std::vector<Eigen::Vector3f> points;
-  points.reserve(scan.points.size());
+  mapping::PointCloud points = mapping::CloudFromScan(scan);
   std::vector<std::vector<std::uint32_t>> lines(scan.lines.size());
   for (std::size_t k = 0; k < scan.points.size(); ++k) {
-    const sensors::ScanPoint& p = scan.points[k];
-    points.emplace_back(p.x, p.y, p.z);
-    if (p.line >= lines.size()) lines.resize(p.line + 1u);
-    lines[p.line].push_back(static_cast<std::uint32_t>(k));
+    const std::size_t line = scan.points[k].line;
+    if (line >= lines.size()) lines.resize(line + 1);
+    lines[line].push_back(static_cast<std::uint32_t>(k));
   }
   const mapping::LinePitch done =
       mapping::RectifyLinePitch(points, mount.t_base_mount_m.cast<float>(), lines);
