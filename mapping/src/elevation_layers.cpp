@@ -124,6 +124,20 @@ void Inclination(const ElevationMap& map, int ci, int cj, const LayerConfig& con
 // passed under (a desk top, a car's body, a canopy: its points hang over free space) is not ground
 // at its lowest point but at most at that ray: rays under an office desk read the floor between
 // its legs as drops below the desk top, which closed rooms off.
+PointSpan SpanOf(const CellStats& c, double cell_m) {
+  const float half = static_cast<float>(0.5 * cell_m);
+  const float reach = std::sqrt(std::min(3.0f, static_cast<float>(c.count) - 1.0f));
+  const auto span = [&](float mean, float comoment, float& lo, float& hi) {
+    const float r = reach * std::sqrt(std::max(0.0f, comoment) / static_cast<float>(c.count));
+    lo = std::clamp(mean - r, -half, half);
+    hi = std::clamp(mean + r, -half, half);
+  };
+  PointSpan s;
+  span(c.mean_x, c.c_xx, s.lo_x, s.hi_x);
+  span(c.mean_y, c.c_yy, s.lo_y, s.hi_y);
+  return s;
+}
+
 float LowestObservedNeighbour(const ElevationLayers& L, const CellIndex& c) {
   const GridGeometry& g = L.geometry;
   float ref = std::numeric_limits<float>::infinity();
@@ -246,6 +260,7 @@ void ComputeLayersInto(const ElevationMap& map, const LayerConfig& config, Eleva
   L.phi_y.assign(n, kNaN);
   L.clearance_z.assign(n, std::numeric_limits<float>::infinity());
   L.plane_residual.assign(n, kNaN);
+  L.point_span.assign(n, PointSpan{});
   for (int j = 0; j < g.size_y; ++j) {
     for (int i = 0; i < g.size_x; ++i) {
       const std::size_t k = g.Linear({i, j});
@@ -259,6 +274,7 @@ void ComputeLayersInto(const ElevationMap& map, const LayerConfig& config, Eleva
       L.max_z[k] = c.max_z;
       L.roughness[k] = Roughness(c);  // Eq. 3
       L.plane_residual[k] = PlaneResidual(c, config.min_spread_m);
+      L.point_span[k] = SpanOf(c, g.cell_m);
       Inclination(map, i, j, config, &L.phi_x[k], &L.phi_y[k]);
     }
   }

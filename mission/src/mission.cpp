@@ -13,6 +13,7 @@
 #include "pitchlab/mission/elevation_scan.hpp"
 #include "pitchlab/mission/slope_guard.hpp"
 
+#include "line_gaps.hpp"
 #include "optimised_elevation.hpp"
 
 namespace pitchlab::mission {
@@ -228,6 +229,8 @@ class Mission {
   // recovery doubts only what was never seen from close: doubt measured from where the robot
   // stands made it walk back and forth between two routes, each far from the other's end.
   std::vector<float> nearest_view_m_;
+  // Per map cell, what a line gap that stayed a gap when seen from close is (line_gaps.hpp).
+  std::vector<RefutedGap> refuted_gaps_;
   // Plan's working grids, kept between stops so that their buffers (about 80 bytes a cell: a
   // 641 x 641 terrain map's are 33 MB) are allocated once, not at every stop (Plan says which
   // holds what).
@@ -561,11 +564,27 @@ void Mission::Plan(StopRecord& stop) {
   sensors::Stopwatch watch;
   mapping::ComputeLayersInto(result_.elevation, config_.layers, layers_);
   for (const FeltHazard& f : felt_) MarkFelt(layers_, f);
+  MarkRefutedGaps(layers_, refuted_gaps_);
   result_.stages[Stage::kMapUpdate] += watch.Read();
   const mapping::ElevationLayers& layers = layers_;
   stop.felt_hazards = static_cast<int>(felt_.size());
   const planning::PlannerConfig planner = MissionPlanner(config_);
   Traversability(layers, planner, grid_);
+  // The line gaps this stop's laser saw from where its lines are denser than the cells, still
+  // gaps: not ground the lines skipped (line_gaps.hpp). Only at a registered pose: at an
+  // odometry pose the scan only filled the map's unknown cells, a metre off at worst.
+  if (!stop.elevation_from_odometry) {
+    const Eigen::Isometry3d laser = stop.T_world_base * config_.mount.BaseToLaser(0.0);
+    const Eigen::Matrix3d R = stop.T_world_base.linear();
+    const double radius_m =
+        DenseLinesRadius(stop.scan, config_.mount.BaseToLaser(0.0).translation().z(),
+                         config_.map_area.cell_m);
+    if (RefuteLineGaps(grid_, layers_, laser.translation().head<2>(),
+                       std::atan2(R(1, 0), R(0, 0)), radius_m, refuted_gaps_) > 0) {
+      MarkRefutedGaps(layers_, refuted_gaps_);
+      Traversability(layers, planner, grid_);
+    }
+  }
   const planning::TraversabilityGrid& grid = grid_;  // the relaxed grid when a recovery plans
   const Eigen::Vector2d here = stop.T_world_base.translation().head<2>();
   auto path = PlanOn(grid, here);
@@ -640,7 +659,9 @@ void Mission::Plan(StopRecord& stop) {
   for (std::size_t i = 1; i < path->waypoints.size(); ++i) {
     const planning::Waypoint& w = path->waypoints[i];
     const mapping::CellIndex c = grid.geometry.IndexOf(w.x_m, w.y_m);
-    if (!std::isfinite(grid.z_m[grid.geometry.Linear(c)])) break;
+    // A line gap is ground only until a look from closer says otherwise (line_gaps.hpp).
+    const std::size_t k = grid.geometry.Linear(c);
+    if (!std::isfinite(grid.z_m[k]) || grid.line_gap[k]) break;
     const planning::Waypoint& v = path->waypoints[i - 1];
     stop.plan_known_m += std::hypot(w.x_m - v.x_m, w.y_m - v.y_m);
   }

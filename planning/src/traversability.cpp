@@ -428,6 +428,7 @@ void StartTraversability(const GridGeometry& g, const PlannerConfig& config,
   T.phi_x_rad.assign(n, 0.0f);
   T.phi_y_rad.assign(n, 0.0f);
   T.blocked.assign(n, Blocked::kFree);
+  T.line_gap.assign(n, false);
 }
 
 void FinishTraversability(TraversabilityGrid& T) {

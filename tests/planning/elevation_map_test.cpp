@@ -193,6 +193,25 @@ TEST(ElevationMap, RoughnessOfAKnownDistribution) {
   EXPECT_NEAR(map.at({0, 0}).mean_z, 0.5, tol_m);
 }
 
+TEST(ElevationMap, PointSpanIsWhereTheCellsPointsLie) {
+  ElevationMap map(GridGeometry::FromArea(0, 0, 0.3, 0.1, 0.1));
+  // Cell 0: one point 0.03 m right of the centre and 0.01 m below it; cell 1: two points, 0.06 m
+  // apart in x; cell 2: 101 points spread evenly over x (sqrt(3) sigma: the cell's half width).
+  std::vector<Eigen::Vector3f> pts = {{0.08f, 0.04f, 0}, {0.12f, 0.05f, 0}, {0.18f, 0.05f, 0}};
+  for (int k = 0; k <= 100; ++k) pts.emplace_back(0.2f + 0.001f * k, 0.05f, 0.0f);
+  (void)map.InsertPoints(pts.data(), pts.size());
+  const ElevationLayers L = ComputeLayers(map);
+  ASSERT_EQ(L.point_span.size(), 3u);
+  EXPECT_NEAR(L.point_span[0].lo_x, 0.03, 1e-6);
+  EXPECT_NEAR(L.point_span[0].hi_x, 0.03, 1e-6);
+  EXPECT_NEAR(L.point_span[0].lo_y, -0.01, 1e-6);
+  EXPECT_NEAR(L.point_span[1].lo_x, -0.03, 1e-6);  // two points: exactly where they lie
+  EXPECT_NEAR(L.point_span[1].hi_x, 0.03, 1e-6);
+  EXPECT_NEAR(L.point_span[1].hi_y, 0.0, 1e-6);
+  EXPECT_NEAR(L.point_span[2].lo_x, -0.05, 0.002);  // evenly spread: the cell's edges
+  EXPECT_NEAR(L.point_span[2].hi_x, 0.05, 0.002);
+}
+
 TEST(ElevationMap, UnknownWhereNoPointFellAndOutsidePointsCounted) {
   ElevationMap map(GridGeometry::FromArea(0, 0, 1, 1, 0.5));
   const std::vector<Eigen::Vector3f> pts = {

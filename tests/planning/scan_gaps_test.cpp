@@ -36,6 +36,27 @@ mapping::ElevationLayers FloorWithGap(int gap_from, int gap_to, double ray_above
   return L;
 }
 
+// A level floor as FloorWithGap's, 4 points a cell 0.01 m either side of x0 (so they span
+// sqrt(3) x 0.01 m either side of it), x0 `left` cells from the centre in the cells left of the
+// gap and `right` cells in those right of it (positive: towards +x); a ray crossed the gap 0.03 m
+// up.
+mapping::ElevationLayers FloorWithPointsAt(int gap_from, int gap_to, double left, double right) {
+  mapping::ElevationMap map(mapping::GridGeometry{0, 0, kCell, kSizeX, kSizeY});
+  std::vector<Eigen::Vector3f> pts;
+  for (int j = 0; j < kSizeY; ++j)
+    for (int i = 0; i < kSizeX; ++i) {
+      if (i >= gap_from && i < gap_to) continue;
+      const double x0 = (i + 0.5 + (i < gap_from ? left : right)) * kCell;
+      for (const double dx : {-0.01, 0.01})
+        for (const double dy : {0.25, 0.75}) pts.emplace_back(x0 + dx, (j + dy) * kCell, 0.0f);
+    }
+  (void)map.InsertPoints(pts.data(), pts.size());
+  mapping::ElevationLayers L = mapping::ComputeLayers(map);
+  for (int j = 0; j < kSizeY; ++j)
+    for (int i = gap_from; i < gap_to; ++i) L.clearance_z[L.geometry.Linear({i, j})] = 0.03f;
+  return L;
+}
+
 Blocked At(const TraversabilityGrid& T, int i, int j) {
   return T.blocked[T.geometry.Linear({i, j})];
 }
@@ -62,6 +83,24 @@ TEST(ScanGaps, AOneCellGapRaysCrossedJustAboveTheFloorIsGround) {
   EXPECT_TRUE(PathAcross(T));
   // Two cells (0.2 m) are within the P3-AT's 0.21 m too.
   EXPECT_TRUE(PathAcross(BuildTraversability(FloorWithGap(15, 17, 0.03), p3at)));
+}
+
+TEST(ScanGaps, AGapWiderBetweenItsPointsThanTheWheelsSpanIsALineGap) {
+  const PlannerConfig p3at;
+  const auto line_gap = [&](const mapping::ElevationLayers& L) {
+    const TraversabilityGrid T = BuildTraversability(L, p3at);
+    EXPECT_EQ(T.bridged_cells, static_cast<std::size_t>(kSizeY));  // ground for the planner
+    EXPECT_EQ(At(T, 15, 10), Blocked::kFree);
+    return T.line_gap[T.geometry.Linear({15, 10})];
+  };
+  // Two cells, their bounding points 0.3 cell towards the gap: 0.205 m apart, within the
+  // P3-AT's 0.212 m; about the ends' centres 0.265 m apart, which only a gap between scan lines
+  // bridges.
+  EXPECT_FALSE(line_gap(FloorWithPointsAt(15, 17, 0.3, -0.3)));
+  EXPECT_TRUE(line_gap(FloorWithPointsAt(15, 17, 0.0, 0.0)));
+  // One cell whose points lie 0.3 cell away from it: 0.225 m apart; about the centres 0.165 m.
+  EXPECT_TRUE(line_gap(FloorWithPointsAt(15, 16, -0.3, 0.3)));
+  EXPECT_FALSE(line_gap(FloorWithPointsAt(15, 16, 0.0, 0.0)));
 }
 
 TEST(ScanGaps, WhatTheScanCannotRuleOutStaysUnknown) {

@@ -66,6 +66,11 @@ struct LayerConfig {
   double max_slope_error = 0.35 / 3;
 };
 
+/// Where a cell's points lie about its centre, along x and along y [m].
+struct PointSpan {
+  float lo_x = 0, hi_x = 0, lo_y = 0, hi_y = 0;
+};
+
 /// Dense per-cell layers over the map's geometry (index as GridGeometry::Linear).
 struct ElevationLayers {
   GridGeometry geometry;
@@ -84,6 +89,13 @@ struct ElevationLayers {
   /// sides seen) leaves about a quarter of its height, which the mean heights alone smear into
   /// two half steps.
   std::vector<float> plane_residual;
+  /// Where the cell's points lie about its centre: per axis their mean -/+ their standard
+  /// deviation times min(sqrt(3), sqrt(n - 1)), within the cell. sqrt(3) sigma is the half range
+  /// of points spread evenly; n points lie within sqrt(n - 1) sigma of their mean (Samuelson's
+  /// inequality), so one point spans nothing and two exactly their distance. A gap in the ground
+  /// is measured between the points that bound it, not between cell edges. All zero when unknown;
+  /// may be empty (layers made by hand): every cell's points are then taken at its centre.
+  std::vector<PointSpan> point_span;
 
   /// Overall tilt of the cell's plane, atan(sqrt(tan^2 phi_x + tan^2 phi_y)) [rad]; NaN unknown.
   float Tilt(std::size_t k) const;

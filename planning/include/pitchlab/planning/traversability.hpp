@@ -155,6 +155,11 @@ struct TraversabilityGrid {
   /// Unknown cells read as ground because they are a gap between scan lines the robot's wheels
   /// roll over (BuildTraversability, "Gaps between scan lines") [1].
   std::size_t bridged_cells = 0;
+  /// Bridged cells of a gap wider, between the points that bound it, than the wheels span
+  /// (MaxBridgedGap): ground only if the gap lies between scan lines, as it does at range (lines
+  /// meet a floor h below the laser d^2 dtheta / h apart). A crack or a hole looks the same from
+  /// afar; a look from where the lines are denser than the cells tells them apart.
+  std::vector<bool> line_gap;
 
   bool Free(std::size_t k) const { return blocked[k] == Blocked::kFree; }
 };
