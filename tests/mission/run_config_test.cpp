@@ -175,6 +175,17 @@ TEST(RunSettings, LinesAreSetRightOnlyWhenTheRunSectionAsks) {
                std::invalid_argument);
 }
 
+TEST(RunSettings, TheMountIsLevelledOnlyWhenTheRunSectionAsks) {
+  EXPECT_FALSE(ParseRunSettings("", "f.yaml", sim::P3Model::kP3AT).mission.level_mount);
+  const RunSettings on =
+      ParseRunSettings("run: {level_mount: true}\n", "f.yaml", sim::P3Model::kP3AT);
+  EXPECT_TRUE(on.mission.level_mount);
+  EXPECT_TRUE(
+      ParseRunSettings(RunSettingsToYaml(on), "back", sim::P3Model::kP3AT).mission.level_mount);
+  EXPECT_THROW(ParseRunSettings("run: {level_mount: often}\n", "f.yaml", sim::P3Model::kP3AT),
+               std::invalid_argument);
+}
+
 TEST(RunSettings, WrittenYamlReadsBackTheSame) {
   const RunSettings s = ParseRunSettings(
       "run: {goal_tolerance_m: 0.3, odometry_error_m: 0.2, tilt_tolerance_deg: 0.8}\n"
