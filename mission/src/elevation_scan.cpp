@@ -59,11 +59,8 @@ mapping::LinePitch SetLinesRight(sensors::Scan3D& scan, const sensors::MountConf
 
 Result<Eigen::Matrix3d> MountTiltFromFloor(const sensors::Scan3D& scan,
                                            const sensors::MountConfig& mount, double max_tilt_rad) {
-  std::vector<Eigen::Vector3f> points;
-  points.reserve(scan.points.size());
-  for (const sensors::ScanPoint& p : scan.points) points.emplace_back(p.x, p.y, p.z);
   const Eigen::Vector3f laser = mount.BaseToLaser(0.0).translation().cast<float>();
-  Result<mapping::GroundLevel> level = mapping::FitGroundLevel(points, laser);
+  Result<mapping::GroundLevel> level = mapping::FitGroundLevel(mapping::CloudFromScan(scan), laser);
   if (!level) return tl::make_unexpected(level.error());
   if (!(level->tilt_rad <= max_tilt_rad)) {
     return Fail(Error::Code::kFailed, "the floor at the start tilts " +

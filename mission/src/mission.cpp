@@ -597,11 +597,11 @@ void Mission::Plan(StopRecord& stop) {
   // gaps: not ground the lines skipped (line_gaps.hpp). Only at a registered pose: at an
   // odometry pose the scan only filled the map's unknown cells, a metre off at worst.
   if (!stop.elevation_from_odometry) {
-    const Eigen::Isometry3d laser = stop.T_world_base * config_.mount.BaseToLaser(0.0);
+    const Eigen::Isometry3d laser_base = config_.mount.BaseToLaser(0.0);
+    const Eigen::Isometry3d laser = stop.T_world_base * laser_base;
     const Eigen::Matrix3d R = stop.T_world_base.linear();
     const double radius_m =
-        DenseLinesRadius(stop.scan, config_.mount.BaseToLaser(0.0).translation().z(),
-                         config_.map_area.cell_m);
+        DenseLinesRadius(stop.scan, laser_base.translation().z(), config_.map_area.cell_m);
     if (RefuteLineGaps(grid_, layers_, laser.translation().head<2>(),
                        std::atan2(R(1, 0), R(0, 0)), radius_m, refuted_gaps_) > 0) {
       MarkRefutedGaps(layers_, refuted_gaps_);
