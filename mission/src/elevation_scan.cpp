@@ -5,7 +5,6 @@
 #include <cstdint>
 #include <string>
 
-#include "pitchlab/mapping/ground_level.hpp"
 #include "pitchlab/mapping/point_cloud.hpp"
 
 namespace pitchlab::mission {
@@ -55,31 +54,6 @@ mapping::LinePitch SetLinesRight(sensors::Scan3D& scan, const sensors::MountConf
     scan.points[k].z = points[k].z();
   }
   return done;
-}
-
-Result<Eigen::Matrix3d> MountTiltFromFloor(const sensors::Scan3D& scan,
-                                           const sensors::MountConfig& mount, double max_tilt_rad) {
-  const Eigen::Vector3f laser = mount.BaseToLaser(0.0).translation().cast<float>();
-  Result<mapping::GroundLevel> level = mapping::FitGroundLevel(mapping::CloudFromScan(scan), laser);
-  if (!level) return tl::make_unexpected(level.error());
-  if (!(level->tilt_rad <= max_tilt_rad)) {
-    return Fail(Error::Code::kFailed, "the floor at the start tilts " +
-                                          std::to_string(level->tilt_rad * 180 / M_PI) +
-                                          " deg in base_link, more than a mount error (" +
-                                          std::to_string(max_tilt_rad * 180 / M_PI) + " deg)");
-  }
-  return level->R_level;
-}
-
-void TurnAboutMount(sensors::Scan3D& scan, const sensors::MountConfig& mount,
-                    const Eigen::Matrix3d& R) {
-  const Eigen::Vector3d o = mount.t_base_mount_m;
-  for (sensors::ScanPoint& p : scan.points) {
-    const Eigen::Vector3d q = R * (Eigen::Vector3d(p.x, p.y, p.z) - o) + o;
-    p.x = static_cast<float>(q.x());
-    p.y = static_cast<float>(q.y());
-    p.z = static_cast<float>(q.z());
-  }
 }
 
 mapping::ElevationMap ViewOver(const mapping::GridGeometry& area,

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "pitchlab/mapping/elevation_layers.hpp"
+#include "pitchlab/mapping/mount_from_floor.hpp"
 #include "pitchlab/mapping/point_cloud.hpp"
 #include "pitchlab/mission/elevation_scan.hpp"
 #include "pitchlab/mission/slope_guard.hpp"
@@ -139,9 +140,9 @@ class Mission {
   // failed) the pose's height is first taken from the map's ground (FitHeightOffset), and the scan
   // fills only the cells the map has not seen (FillUnknown).
   void UpdateElevation(StopRecord& stop);
-  // With level_mount: at stop 0 the mount's tilt from the floor the robot stands on, then every
+  // With calibrate_mount: at stop 0 the mount's tilt from the floor the robot stands on, then every
   // scan turned by it about the mount.
-  void LevelMount(int k, sensors::Scan3D& scan);
+  void CalibrateMount(int k, sensors::Scan3D& scan);
   // Loop closure on: a registered stop's scan joins the per-scan map at the graph's pose, and
   // when this merge's optimisation moved poses every kept scan follows.
   void UpdateOptimisedElevation(const StopRecord& stop, const ElevationScan& scan);
@@ -234,9 +235,9 @@ class Mission {
   std::vector<float> nearest_view_m_;
   // Per map cell, what a line gap that stayed a gap when seen from close is (line_gaps.hpp).
   std::vector<RefutedGap> refuted_gaps_;
-  // With level_mount: the laser's roll and pitch off its nominal mount, from the first scan's
-  // floor (MountTiltFromFloor), turned out of every scan (TurnAboutMount).
-  std::optional<Eigen::Matrix3d> mount_fix_;
+  // With calibrate_mount: the mount the first scan's floor says the laser is on
+  // (mapping::CalibrateMountFromFloor), every scan re-assembled on it.
+  std::optional<sensors::MountConfig> calibrated_mount_;
   // Plan's working grids, kept between stops so that their buffers (about 80 bytes a cell: a
   // 641 x 641 terrain map's are 33 MB) are allocated once, not at every stop (Plan says which
   // holds what).
@@ -315,8 +316,8 @@ bool Mission::Stop(int k) {
   }
   stop.scan = std::move(*scan);
   stop.stamp_s = stop.scan.stamp_s;
+  if (config_.calibrate_mount) CalibrateMount(k, stop.scan);
   if (config_.set_lines_right) stop.line_pitch = SetLinesRight(stop.scan, config_.mount);
-  if (config_.level_mount) LevelMount(k, stop.scan);
   if (probes_.true_pose) stop.T_world_base_true = probes_.true_pose();
   Result<sensors::Odometry> odo = base_.ReadOdometry();
   if (!odo) {
@@ -411,20 +412,24 @@ bool Mission::Arrived(StopRecord& stop) {
   }
 }
 
-void Mission::LevelMount(int k, sensors::Scan3D& scan) {
+void Mission::CalibrateMount(int k, sensors::Scan3D& scan) {
   if (k == 0) {
-    Result<Eigen::Matrix3d> fix = MountTiltFromFloor(scan, config_.mount);
-    if (fix) {
-      mount_fix_ = *fix;
-      const double deg = Eigen::AngleAxisd(*fix).angle() * 180.0 / kPi;
-      char text[128];
-      std::snprintf(text, sizeof(text), "mount levelled by the floor at the start: %.2f deg", deg);
+    Result<mapping::MountFromFloor> found = mapping::CalibrateMountFromFloor(scan, config_.mount);
+    if (found) {
+      calibrated_mount_ = found->mount;
+      const Eigen::Vector3d deg = found->correction_rpy_rad * 180.0 / kPi;
+      const Eigen::Vector3d sigma = found->sigma_rpy_rad * 180.0 / kPi;
+      char text[192];
+      std::snprintf(text, sizeof(text),
+                    "mount calibrated by the floor at the start: roll %+.2f, pitch %+.2f, yaw "
+                    "%+.2f deg (+-%.2f, %.2f, %.2f) off nominal",
+                    deg.x(), deg.y(), deg.z(), sigma.x(), sigma.y(), sigma.z());
       Progress(text);
     } else {
-      Progress("mount not levelled: " + fix.error().message);
+      Progress("mount not calibrated: " + found.error().message);
     }
   }
-  if (mount_fix_) TurnAboutMount(scan, config_.mount, *mount_fix_);
+  if (calibrated_mount_) sensors::ReassembleScan(scan, config_.mount, *calibrated_mount_);
 }
 
 void Mission::UpdateElevation(StopRecord& stop) {

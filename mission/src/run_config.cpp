@@ -110,9 +110,9 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
         // MapBuilder's loop closure (mapping/README.md); off by default, so every figure measured
         // without it stays.
         m.registration.loop_closure.enabled = kv.second.as<bool>();
-      } else if (key == "level_mount") {
-        // MissionConfig::level_mount; off by default, as every figure was measured.
-        m.level_mount = kv.second.as<bool>();
+      } else if (key == "calibrate_mount") {
+        // MissionConfig::calibrate_mount; off by default, as every figure was measured.
+        m.calibrate_mount = kv.second.as<bool>();
       } else if (key == "set_lines_right") {
         // MissionConfig::set_lines_right; off by default, as every figure was measured.
         m.set_lines_right = kv.second.as<bool>();
@@ -244,7 +244,7 @@ std::string RunSettingsToYaml(const RunSettings& s) {
      << "  map_range_m: " << m.map_range_m << "\n"
      << "  loop_closure: " << (m.registration.loop_closure.enabled ? "true" : "false") << "\n"
      << "  set_lines_right: " << (m.set_lines_right ? "true" : "false") << "\n"
-     << "  level_mount: " << (m.level_mount ? "true" : "false") << "\n"
+     << "  calibrate_mount: " << (m.calibrate_mount ? "true" : "false") << "\n"
      << "  odometry_error_m: " << m.odometry_error_m << "\n"
      << "  odometry_error_per_m: " << m.odometry_error_per_m << "\n"
      << "  odometry_error_deg: " << m.odometry_error_deg << "\n"

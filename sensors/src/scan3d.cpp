@@ -100,4 +100,28 @@ Scan3D AssembleScan(std::vector<LaserLine> lines, const MountConfig& mount,
   return scan;
 }
 
+void ReassembleScan(Scan3D& scan, const MountConfig& from, const MountConfig& to) {
+  std::vector<Eigen::Isometry3d> from_to(scan.lines.size());
+  for (std::size_t l = 0; l < scan.lines.size(); ++l) {
+    const double gamma = scan.lines[l].pitch_rad;
+    from_to[l] = to.BaseToLaser(gamma) * from.BaseToLaser(gamma).inverse();
+  }
+  for (const ScanPoint& p : scan.points) {
+    if (p.line >= from_to.size()) {
+      throw std::invalid_argument("ReassembleScan: a point of line " + std::to_string(p.line) +
+                                  " in a scan of " + std::to_string(from_to.size()) + " lines");
+    }
+  }
+  for (ScanPoint& p : scan.points) {
+    const Eigen::Vector3d q = from_to[p.line] * Eigen::Vector3d(p.x, p.y, p.z);
+    p.x = static_cast<float>(q.x());
+    p.y = static_cast<float>(q.y());
+    p.z = static_cast<float>(q.z());
+  }
+  if (scan.sensor_origin) {
+    *scan.sensor_origin += (to.t_base_mount_m + to.t_mount_laser_m) -
+                           (from.t_base_mount_m + from.t_mount_laser_m);
+  }
+}
+
 }  // namespace pitchlab::sensors

@@ -176,13 +176,13 @@ TEST(RunSettings, LinesAreSetRightOnlyWhenTheRunSectionAsks) {
 }
 
 TEST(RunSettings, TheMountIsLevelledOnlyWhenTheRunSectionAsks) {
-  EXPECT_FALSE(ParseRunSettings("", "f.yaml", sim::P3Model::kP3AT).mission.level_mount);
+  EXPECT_FALSE(ParseRunSettings("", "f.yaml", sim::P3Model::kP3AT).mission.calibrate_mount);
   const RunSettings on =
-      ParseRunSettings("run: {level_mount: true}\n", "f.yaml", sim::P3Model::kP3AT);
-  EXPECT_TRUE(on.mission.level_mount);
+      ParseRunSettings("run: {calibrate_mount: true}\n", "f.yaml", sim::P3Model::kP3AT);
+  EXPECT_TRUE(on.mission.calibrate_mount);
   EXPECT_TRUE(
-      ParseRunSettings(RunSettingsToYaml(on), "back", sim::P3Model::kP3AT).mission.level_mount);
-  EXPECT_THROW(ParseRunSettings("run: {level_mount: often}\n", "f.yaml", sim::P3Model::kP3AT),
+      ParseRunSettings(RunSettingsToYaml(on), "back", sim::P3Model::kP3AT).mission.calibrate_mount);
+  EXPECT_THROW(ParseRunSettings("run: {calibrate_mount: often}\n", "f.yaml", sim::P3Model::kP3AT),
                std::invalid_argument);
 }
 

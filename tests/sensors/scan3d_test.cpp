@@ -153,5 +153,33 @@ TEST(AssembleScan, RejectsAttitudesThatAreNotOnePerLine) {
   EXPECT_THROW((void)AssembleScan(sweep.lines, mount, sweep.attitudes), std::invalid_argument);
 }
 
+TEST(ReassembleScan, IsTheScanTheOtherMountAssembles) {
+  const MountConfig nominal = SeedMount();
+  MountConfig off = nominal;
+  off.misalignment_rpy_rad = {0.4 * kDeg, -0.3 * kDeg, 0.5 * kDeg};
+  off.t_mount_laser_m = {0.01, 0.0, 0.1};
+  const RockedSweep sweep = SweepFlatGroundWhileRocking(nominal);
+  Scan3D scan = AssembleScan(sweep.lines, nominal);
+  const Scan3D want = AssembleScan(sweep.lines, off);
+  ReassembleScan(scan, nominal, off);
+  ASSERT_EQ(scan.points.size(), want.points.size());
+  double worst_m = 0;
+  for (std::size_t k = 0; k < scan.points.size(); ++k) {
+    const ScanPoint &a = scan.points[k], &b = want.points[k];
+    worst_m = std::max(worst_m, (Eigen::Vector3d(a.x, a.y, a.z) - Eigen::Vector3d(b.x, b.y, b.z))
+                                    .cwiseAbs()
+                                    .maxCoeff());
+    EXPECT_EQ(a.range_m, b.range_m);
+  }
+  EXPECT_LT(worst_m, 1e-5);  // float points
+  ASSERT_TRUE(scan.sensor_origin);
+  EXPECT_TRUE(scan.sensor_origin->isApprox(*want.sensor_origin, 1e-12));
+  // A point of a line the scan does not hold: refused, nothing moved.
+  scan.points.front().line = static_cast<std::uint16_t>(scan.lines.size());
+  const Scan3D before = scan;
+  EXPECT_THROW(ReassembleScan(scan, off, nominal), std::invalid_argument);
+  EXPECT_EQ(scan.points.back().x, before.points.back().x);
+}
+
 }  // namespace
 }  // namespace pitchlab::sensors

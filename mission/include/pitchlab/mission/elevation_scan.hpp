@@ -43,22 +43,6 @@ ElevationScan ElevationScanOf(const sensors::Scan3D& scan, double map_range_m,
 /// are (the laser turns with its line). What was done is returned.
 mapping::LinePitch SetLinesRight(sensors::Scan3D& scan, const sensors::MountConfig& mount);
 
-/// The rotation that turns the floor `scan` stands on (base_link's z = 0 plane, the ground under
-/// the robot) level again: the laser's roll and pitch off its nominal mount (`mount`), which a
-/// scan reads as a tilted floor. A robust plane fit of the returns 0.5-4 m from the laser
-/// (mapping::FitGroundLevel). The LMS200's mount is off by a fraction of a degree (the measured
-/// model draws 0.25 deg per axis); held to the attitude sensor's roll and pitch, a scan tilted by
-/// it pulled terrain registrations 0.4-0.6 m off. Fails when no floor is found or its tilt exceeds
-/// `max_tilt_rad` (not a mount error: the robot did not start on its own plane).
-Result<Eigen::Matrix3d> MountTiltFromFloor(const sensors::Scan3D& scan,
-                                           const sensors::MountConfig& mount,
-                                           double max_tilt_rad = 2.0 * 3.14159265358979323846 /
-                                                                 180);
-
-/// Turns every point of `scan` by `R` about the mount's pitch axis origin (in base_link).
-void TurnAboutMount(sensors::Scan3D& scan, const sensors::MountConfig& mount,
-                    const Eigen::Matrix3d& R);
-
 /// `points` (world frame [m], rays from `laser`) inserted alone into a grid over their extent,
 /// aligned to `area`'s cells: the view of a stop that did not register, which fills only the
 /// cells the map has not seen (ElevationMap::Merge with MergeCells::kUnknown).

@@ -61,12 +61,12 @@ struct MissionConfig {
   /// a unit that reports its true pitch gains nothing, and every figure so far was measured
   /// without it.
   bool set_lines_right = false;
-  /// Level the laser's mount by the floor the robot stands on at its first stop
-  /// (MountTiltFromFloor): the roll and pitch the laser is off its nominal mount are turned out
-  /// of every scan. For a rig whose mount was never calibrated (the measured LMS200 model draws
-  /// 0.25 deg per axis); the robot must start on ground planar within 4 m of it. Off by default:
-  /// every figure so far was measured without it.
-  bool level_mount = false;
+  /// Calibrate the laser's mount by the floor the robot stands on at its first stop
+  /// (mapping::CalibrateMountFromFloor): the roll, pitch and yaw the scan plane is off its
+  /// nominal mount, and every scan re-assembled on the mount found. For a rig whose mount was
+  /// never calibrated (the measured LMS200 model draws 0.25 deg per axis); the robot must start
+  /// on ground planar within 4 m of it.
+  bool calibrate_mount = false;
   /// How far odometry may be off the motion since the last merged scan (plus that scan's own
   /// registration error), the registration prior's error bound (mapping::GuessUncertainty): it
   /// narrows the geometric constraint and the search around the guess to itself, and lets

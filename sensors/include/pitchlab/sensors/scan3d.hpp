@@ -86,4 +86,12 @@ double MaxTurnToLast(const std::vector<Eigen::Quaterniond>& attitudes);
 Scan3D AssembleScan(std::vector<LaserLine> lines, const MountConfig& mount,
                     const std::vector<Eigen::Quaterniond>& attitudes = {});
 
+/// The points of `scan`, assembled with `from`, as the mount `to` places them: each point taken
+/// back into its line's laser frame through `from` and out through `to` (Eq. 1 at the line's
+/// encoder pitch with the other mount), the sensor origin with it. Ranges, lines and stamps stay.
+/// A deskewed scan's lines were also turned by the base's rotation since; the two turns commute
+/// to the product of their angles (a 0.3 deg mount change after a 1 deg rock: 1e-4 rad).
+/// Throws std::invalid_argument for a point whose line the scan does not hold.
+void ReassembleScan(Scan3D& scan, const MountConfig& from, const MountConfig& to);
+
 }  // namespace pitchlab::sensors
