@@ -51,6 +51,76 @@ double HalfNormalQuantile(double q) {
   return 0.5 * (lo + hi);
 }
 
+// The floor band's points (below the laser, 0.5-4 m from it), each back in its line's laser
+// frame, and their distances from the levelling's plane [m].
+struct Band {
+  std::vector<FloorPoint> points;
+  std::vector<double> distance;
+};
+
+Band FloorBand(const sensors::Scan3D& scan, const sensors::MountConfig& nominal,
+               const Eigen::Vector3f& laser, const GroundLevel& level,
+               const GroundLevelConfig& ground) {
+  Band band;
+  for (const sensors::ScanPoint& p : scan.points) {
+    const Eigen::Vector3f at(p.x, p.y, p.z);
+    if (p.line >= scan.lines.size() || !at.allFinite() || at.z() >= laser.z()) continue;
+    const float r = (at - laser).head<2>().norm();
+    if (r < ground.min_radius_m || r > ground.max_radius_m) continue;
+    const double gamma = scan.lines[p.line].pitch_rad;
+    band.points.push_back({nominal.BaseToLaser(gamma).inverse() * at.cast<double>(), gamma});
+    band.distance.push_back(std::abs(level.normal.dot(at.cast<double>()) - level.offset_m));
+  }
+  return band;
+}
+
+// The unknowns: the correction's roll, pitch, yaw [rad], the floor's base_link z [m], and the
+// normal matrix of the last solve (its inverse their covariance).
+struct Solution {
+  Eigen::Vector3d x = Eigen::Vector3d::Zero();
+  double floor_z = 0;
+  Eigen::Matrix4d A = Eigen::Matrix4d::Identity();
+};
+
+// Gauss-Newton on the heights of `floor` minus floor_z, weighted by 1 / sigma^2, with the prior
+// `prior_w` (1 / sigma^2 per angle) pulling the angles to zero; from `s`, in place.
+void SolveLevel(const std::vector<FloorPoint>& floor, const sensors::MountConfig& nominal,
+                double sigma_m, double prior_w, Solution& s) {
+  constexpr double kStep_rad = 1e-6;  // finite differences: heights move by ~4e-6 m
+  const double w = 1.0 / (sigma_m * sigma_m);
+  for (int iteration = 0; iteration < 20; ++iteration) {
+    const sensors::MountConfig m = WithCorrection(nominal, s.x);
+    std::array<sensors::MountConfig, 3> moved;
+    for (int k = 0; k < 3; ++k)
+      moved[k] = WithCorrection(nominal, s.x + kStep_rad * Eigen::Vector3d::Unit(k));
+    s.A.setZero();
+    Eigen::Vector4d b = Eigen::Vector4d::Zero();
+    for (const FloorPoint& f : floor) {
+      const double z = HeightOn(m, f);
+      Eigen::Vector4d J;
+      for (int k = 0; k < 3; ++k) J[k] = (HeightOn(moved[k], f) - z) / kStep_rad;
+      J[3] = -1.0;
+      s.A.noalias() += w * J * J.transpose();
+      b.noalias() -= w * J * (z - s.floor_z);
+    }
+    s.A.topLeftCorner<3, 3>().diagonal().array() += prior_w;
+    b.head<3>() -= prior_w * s.x;
+    const Eigen::Vector4d step = s.A.ldlt().solve(b);
+    s.x += step.head<3>();
+    s.floor_z += step[3];
+    if (step.head<3>().norm() < 1e-9 && std::abs(step[3]) < 1e-7) break;
+  }
+}
+
+// RMS of the heights of `floor` about floor_z on the mount `m` [m], at least 1e-4 m (far below
+// any laser's noise: keeps a noise-free synthetic floor's threshold above rounding).
+double RmsHeight(const std::vector<FloorPoint>& floor, const sensors::MountConfig& m,
+                 double floor_z) {
+  double ss = 0;
+  for (const FloorPoint& f : floor) ss += std::pow(HeightOn(m, f) - floor_z, 2);
+  return std::max(std::sqrt(ss / std::max<std::size_t>(floor.size(), 1)), 1e-4);
+}
+
 }  // namespace
 
 Result<MountFromFloor> CalibrateMountFromFloor(const sensors::Scan3D& scan,
@@ -70,98 +140,57 @@ Result<MountFromFloor> CalibrateMountFromFloor(const sensors::Scan3D& scan,
                     " deg in base_link, more than a mount error (" +
                     std::to_string(config.max_tilt_rad * 180 / M_PI) + " deg)");
   }
-  // The band's points, each back in its line's laser frame, and their distance from the plane.
-  std::vector<FloorPoint> band;
-  std::vector<double> distance;
-  for (const sensors::ScanPoint& p : scan.points) {
-    const Eigen::Vector3f at(p.x, p.y, p.z);
-    if (p.line >= scan.lines.size() || !at.allFinite() || at.z() >= laser.z()) continue;
-    const float r = (at - laser).head<2>().norm();
-    if (r < config.ground.min_radius_m || r > config.ground.max_radius_m) continue;
-    const double gamma = scan.lines[p.line].pitch_rad;
-    band.push_back({nominal.BaseToLaser(gamma).inverse() * at.cast<double>(), gamma});
-    distance.push_back(std::abs(level->normal.dot(at.cast<double>()) - level->offset_m));
-  }
-  if (band.size() < config.ground.min_points) {
-    return Fail(Error::Code::kFailed, "mount calibration: " + std::to_string(band.size()) +
+  Band band = FloorBand(scan, nominal, laser, *level, config.ground);
+  if (band.points.size() < config.ground.min_points) {
+    return Fail(Error::Code::kFailed, "mount calibration: " + std::to_string(band.points.size()) +
                                           " points of the scan's lines near the floor");
   }
   // The points' own scatter about the floor (the plane was fitted to cell medians, which scatter
   // less): the floor is at least the levelling's quantile of the band, so that quantile of the
   // distances is a Gaussian's with this sigma, as FitGroundLevel starts.
-  const std::vector<double> near_plane = distance;
-  const std::size_t q_index = static_cast<std::size_t>(config.ground.quantile * (band.size() - 1));
-  std::nth_element(distance.begin(), distance.begin() + q_index, distance.end());
-  double sigma_m =
-      std::max(distance[q_index] / HalfNormalQuantile(config.ground.quantile), 1e-4);
+  std::vector<double> sorted = band.distance;
+  const std::size_t q = static_cast<std::size_t>(config.ground.quantile * (sorted.size() - 1));
+  std::nth_element(sorted.begin(), sorted.begin() + q, sorted.end());
+  double sigma_m = std::max(sorted[q] / HalfNormalQuantile(config.ground.quantile), 1e-4);
 
   MountFromFloor out;
   out.tilt_before_rad = level->tilt_rad;
   out.residual_before_m = sigma_m;
-  // The first floor: the band's points near the plane; later, those near level on the mount found.
+  // The first floor: the band's points near the plane; then those near level on the mount found,
+  // until they stop changing.
   std::vector<FloorPoint> floor;
-  Eigen::Vector3d x = Eigen::Vector3d::Zero();  // the correction's roll, pitch, yaw [rad]
-  double floor_z = 0;                           // base_link z of the floor [m]
+  for (std::size_t k = 0; k < band.points.size(); ++k)
+    if (band.distance[k] < 3.0 * sigma_m) floor.push_back(band.points[k]);
+  Solution s;
+  for (const FloorPoint& f : floor) s.floor_z += HeightOn(nominal, f) / floor.size();
   const double prior_w = 1.0 / (config.prior_sigma_rad * config.prior_sigma_rad);
-  Eigen::Matrix4d A = Eigen::Matrix4d::Identity();
-  constexpr double kStep_rad = 1e-6;  // finite differences: heights move by ~4e-6 m
   for (int round = 0; round < 10; ++round) {
-    if (round == 0) {
-      for (std::size_t k = 0; k < band.size(); ++k)
-        if (near_plane[k] < 3.0 * sigma_m) floor.push_back(band[k]);
-      double sum = 0;
-      for (const FloorPoint& f : floor) sum += HeightOn(nominal, f);
-      floor_z = floor.empty() ? 0 : sum / floor.size();
-    } else {
-      floor = Within(band, WithCorrection(nominal, x), floor_z, 3.0 * sigma_m);
-    }
     if (floor.size() < config.ground.min_points) {
       return Fail(Error::Code::kFailed, "mount calibration: only " +
                                             std::to_string(floor.size()) + " of " +
-                                            std::to_string(band.size()) +
+                                            std::to_string(band.points.size()) +
                                             " points near the laser lie on one level floor");
     }
-    const std::size_t before = floor.size();
-    // Gauss-Newton on (roll, pitch, yaw, floor z): the heights minus floor_z, with the prior.
-    for (int iteration = 0; iteration < 20; ++iteration) {
-      const sensors::MountConfig m = WithCorrection(nominal, x);
-      std::array<sensors::MountConfig, 3> moved;
-      for (int k = 0; k < 3; ++k) moved[k] = WithCorrection(nominal, x + kStep_rad * Eigen::Vector3d::Unit(k));
-      A.setZero();
-      Eigen::Vector4d b = Eigen::Vector4d::Zero();
-      const double w = 1.0 / (sigma_m * sigma_m);
-      for (const FloorPoint& f : floor) {
-        const double z = HeightOn(m, f);
-        Eigen::Vector4d J;
-        for (int k = 0; k < 3; ++k) J[k] = (HeightOn(moved[k], f) - z) / kStep_rad;
-        J[3] = -1.0;
-        A.noalias() += w * J * J.transpose();
-        b.noalias() -= w * J * (z - floor_z);
-      }
-      A.topLeftCorner<3, 3>().diagonal().array() += prior_w;
-      b.head<3>() -= prior_w * x;
-      const Eigen::Vector4d step = A.ldlt().solve(b);
-      x += step.head<3>();
-      floor_z += step[3];
-      if (step.head<3>().norm() < 1e-9 && std::abs(step[3]) < 1e-7) break;
-    }
-    const sensors::MountConfig m = WithCorrection(nominal, x);
-    double ss = 0;
-    for (const FloorPoint& f : floor) ss += std::pow(HeightOn(m, f) - floor_z, 2);
-    sigma_m = std::max(std::sqrt(ss / floor.size()), 1e-4);
-    out.residual_m = sigma_m;
-    if (round > 0 && Within(band, m, floor_z, 3.0 * sigma_m).size() == before) break;
+    SolveLevel(floor, nominal, sigma_m, prior_w, s);
+    const sensors::MountConfig m = WithCorrection(nominal, s.x);
+    sigma_m = RmsHeight(floor, m, s.floor_z);
+    std::vector<FloorPoint> next = Within(band.points, m, s.floor_z, 3.0 * sigma_m);
+    const bool settled = round > 0 && next.size() == floor.size();
+    if (settled) break;
+    floor = std::move(next);
   }
-  if (!(x.norm() <= config.max_tilt_rad)) {
+  if (!(s.x.norm() <= config.max_tilt_rad)) {
     return Fail(Error::Code::kFailed,
                 "mount calibration: the floor asks for a mount " +
-                    std::to_string(x.norm() * 180 / M_PI) + " deg off, more than a mount error (" +
+                    std::to_string(s.x.norm() * 180 / M_PI) +
+                    " deg off, more than a mount error (" +
                     std::to_string(config.max_tilt_rad * 180 / M_PI) + " deg)");
   }
-  out.mount = WithCorrection(nominal, x);
-  out.correction_rpy_rad = x;
-  out.sigma_rpy_rad = A.inverse().diagonal().head<3>().cwiseSqrt();
-  out.floor_z_m = floor_z;
+  out.mount = WithCorrection(nominal, s.x);
+  out.correction_rpy_rad = s.x;
+  out.sigma_rpy_rad = s.A.inverse().diagonal().head<3>().cwiseSqrt();
+  out.floor_z_m = s.floor_z;
+  out.residual_m = sigma_m;
   out.points = floor.size();
   return out;
 }

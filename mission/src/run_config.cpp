@@ -111,7 +111,7 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
         // without it stays.
         m.registration.loop_closure.enabled = kv.second.as<bool>();
       } else if (key == "calibrate_mount") {
-        // MissionConfig::calibrate_mount; off by default, as every figure was measured.
+        // MissionConfig::calibrate_mount; on by default.
         m.calibrate_mount = kv.second.as<bool>();
       } else if (key == "set_lines_right") {
         // MissionConfig::set_lines_right; off by default, as every figure was measured.

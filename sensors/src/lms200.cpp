@@ -98,15 +98,7 @@ Lms200Config Lms200Config::Legacy() {
   return c;
 }
 
-Lms200Config Lms200Config::Measured() {
-  Lms200Config c;
-  c.noise_sigma_m = 0.002;
-  c.noise_per_m = 0.0015;
-  c.incidence_noise_gain = 0.4;
-  c.dropout_far_per_m = 0.001;
-  c.mount_error_sigma_deg = 0.25;
-  return c;
-}
+Lms200Config Lms200Config::Measured() { return Lms200Config{}; }
 
 std::array<double, 3> DrawMountErrorRpyRad(const Lms200Config& config) {
   std::array<double, 3> rpy = {0.0, 0.0, 0.0};

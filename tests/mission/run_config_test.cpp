@@ -175,13 +175,13 @@ TEST(RunSettings, LinesAreSetRightOnlyWhenTheRunSectionAsks) {
                std::invalid_argument);
 }
 
-TEST(RunSettings, TheMountIsLevelledOnlyWhenTheRunSectionAsks) {
-  EXPECT_FALSE(ParseRunSettings("", "f.yaml", sim::P3Model::kP3AT).mission.calibrate_mount);
-  const RunSettings on =
-      ParseRunSettings("run: {calibrate_mount: true}\n", "f.yaml", sim::P3Model::kP3AT);
-  EXPECT_TRUE(on.mission.calibrate_mount);
-  EXPECT_TRUE(
-      ParseRunSettings(RunSettingsToYaml(on), "back", sim::P3Model::kP3AT).mission.calibrate_mount);
+TEST(RunSettings, TheMountIsCalibratedUnlessTheRunSectionSaysNo) {
+  EXPECT_TRUE(ParseRunSettings("", "f.yaml", sim::P3Model::kP3AT).mission.calibrate_mount);
+  const RunSettings off =
+      ParseRunSettings("run: {calibrate_mount: false}\n", "f.yaml", sim::P3Model::kP3AT);
+  EXPECT_FALSE(off.mission.calibrate_mount);
+  EXPECT_FALSE(
+      ParseRunSettings(RunSettingsToYaml(off), "back", sim::P3Model::kP3AT).mission.calibrate_mount);
   EXPECT_THROW(ParseRunSettings("run: {calibrate_mount: often}\n", "f.yaml", sim::P3Model::kP3AT),
                std::invalid_argument);
 }
