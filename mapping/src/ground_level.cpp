@@ -11,20 +11,11 @@
 #include <vector>
 
 
+#include "half_normal_quantile.hpp"
 #include "up_plane_fit.hpp"
 
 namespace pitchlab::mapping {
 namespace {
-
-// The q-quantile of |x| for x ~ N(0, 1): the z with erf(z / sqrt 2) = q (bisection).
-double HalfNormalQuantile(double q) {
-  double lo = 0, hi = 10;
-  for (int k = 0; k < 60; ++k) {
-    const double mid = 0.5 * (lo + hi);
-    (std::erf(mid / std::sqrt(2.0)) < q ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
 
 struct Plane {
   Eigen::Vector3d n = Eigen::Vector3d::UnitZ();  // up normal

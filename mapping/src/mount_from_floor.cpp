@@ -11,6 +11,8 @@
 
 #include "pitchlab/mapping/point_cloud.hpp"
 
+#include "half_normal_quantile.hpp"
+
 namespace pitchlab::mapping {
 namespace {
 
@@ -39,16 +41,6 @@ std::vector<FloorPoint> Within(const std::vector<FloorPoint>& band, const sensor
   for (const FloorPoint& f : band)
     if (std::abs(HeightOn(m, f) - floor_z) < threshold_m) in.push_back(f);
   return in;
-}
-
-// The q-quantile of |x| for x ~ N(0, 1) (bisection on erf).
-double HalfNormalQuantile(double q) {
-  double lo = 0, hi = 10;
-  for (int k = 0; k < 60; ++k) {
-    const double mid = 0.5 * (lo + hi);
-    (std::erf(mid / std::sqrt(2.0)) < q ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
 }
 
 // The floor band's points (below the laser, 0.5-4 m from it), each back in its line's laser
