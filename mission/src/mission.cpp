@@ -9,7 +9,6 @@
 #include <stdexcept>
 
 #include "pitchlab/mapping/elevation_layers.hpp"
-#include "pitchlab/mapping/mount_from_floor.hpp"
 #include "pitchlab/mapping/point_cloud.hpp"
 #include "pitchlab/mission/elevation_scan.hpp"
 #include "pitchlab/mission/slope_guard.hpp"
@@ -417,6 +416,7 @@ void Mission::CalibrateMount(int k, sensors::Scan3D& scan) {
     Result<mapping::MountFromFloor> found = mapping::CalibrateMountFromFloor(scan, config_.mount);
     if (found) {
       calibrated_mount_ = found->mount;
+      result_.mount_calibration = *found;
       const Eigen::Vector3d deg = found->correction_rpy_rad * 180.0 / kPi;
       const Eigen::Vector3d sigma = found->sigma_rpy_rad * 180.0 / kPi;
       char text[192];
@@ -426,6 +426,7 @@ void Mission::CalibrateMount(int k, sensors::Scan3D& scan) {
                     deg.x(), deg.y(), deg.z(), sigma.x(), sigma.y(), sigma.z());
       Progress(text);
     } else {
+      result_.mount_calibration_note = found.error().message;
       Progress("mount not calibrated: " + found.error().message);
     }
   }

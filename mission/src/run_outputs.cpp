@@ -178,6 +178,34 @@ void WriteStopOutputs(RunFolder& folder, const StopRecord& stop, const MissionRe
   WriteStopPictures(folder, d, so_far, stop.plan);
 }
 
+namespace {
+
+nlohmann::json Degrees(const Eigen::Vector3d& rad) {
+  return {rad.x() * kRadToDeg, rad.y() * kRadToDeg, rad.z() * kRadToDeg};
+}
+
+// The mount calibration at the first stop: what it found (roll, pitch, yaw added to the nominal
+// mount, their sigmas, the floor's fit), or why it found nothing; in simulation also the drawn
+// error and the largest difference from it.
+nlohmann::json MountCalibrationJson(const RunContext& c, const MissionResult& r) {
+  if (!r.mount_calibration) return {{"calibrated", false}, {"note", r.mount_calibration_note}};
+  const mapping::MountFromFloor& f = *r.mount_calibration;
+  nlohmann::json j = {{"calibrated", true},
+                      {"correction_rpy_deg", Degrees(f.correction_rpy_rad)},
+                      {"sigma_rpy_deg", Degrees(f.sigma_rpy_rad)},
+                      {"floor_tilt_before_deg", f.tilt_before_rad * kRadToDeg},
+                      {"floor_residual_m", f.residual_m},
+                      {"floor_points", f.points}};
+  if (c.mount_error_rpy_rad) {
+    j["truth_rpy_deg"] = Degrees(*c.mount_error_rpy_rad);
+    j["max_error_deg"] =
+        (f.correction_rpy_rad - *c.mount_error_rpy_rad).cwiseAbs().maxCoeff() * kRadToDeg;
+  }
+  return j;
+}
+
+}  // namespace
+
 nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
                           const std::optional<RunScore>& score) {
   const double sim_s = r.end_s - r.start_s;
@@ -202,6 +230,9 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
   if (!r.stops.empty()) m["final_estimate"] = PoseJson(r.stops.back().T_world_base);
   if (!c.via.empty()) m["route"] = RouteJson(c, r);  // run --via, --round-trip
   if (c.loop_closure) m["loop_closures"] = LoopClosureJson(r);  // run: {loop_closure: true}
+  if (r.mount_calibration || !r.mount_calibration_note.empty()) {
+    m["mount_calibration"] = MountCalibrationJson(c, r);  // run: {calibrate_mount: true}
+  }
   // The stops' ATE and RPE at their final poses (null without truth); with loop closure also as
   // they were registered, before later loops moved them.
   m["trajectory_error"] = TrajectoryErrorJson(r, StopPoses::kFinal);

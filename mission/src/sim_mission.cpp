@@ -143,6 +143,7 @@ RunContext SimContext(const SimMissionSpec& spec, const RunSettings& settings,
   context.goal = settings.mission.goal_m;
   context.via = settings.mission.via_m;
   context.geodetic_origin = origin;
+  context.mount_error_rpy_rad = rig.mount_error_rpy_rad();
   const Eigen::Vector3d mount_error_deg = rig.mount_error_rpy_rad() * 180.0 / kPi;
   std::ostringstream truth;
   truth.precision(6);

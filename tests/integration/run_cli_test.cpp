@@ -68,6 +68,12 @@ TEST_F(RunCli, AMissionAroundABlockReachesTheGoalAndWritesEveryOutput) {
   EXPECT_LE(step["p95_m"].get<double>(), step["max_m"].get<double>());
   EXPECT_LT(step["max_m"].get<double>(), kPoseBound_m);
   EXPECT_LT(step["max_deg"].get<double>(), 1.0);
+  // The mount calibrated on the start pad against the error the simulator drew (the measured
+  // model's 0.25 deg per axis): found to a tenth of a degree.
+  const nlohmann::json& mount = metrics["mount_calibration"];
+  ASSERT_TRUE(mount["calibrated"].get<bool>()) << mount;
+  EXPECT_EQ(mount["truth_rpy_deg"].size(), 3u);
+  EXPECT_LT(mount["max_error_deg"].get<double>(), 0.1) << mount;
   EXPECT_GT(metrics["closest_approach_to_forbidden_m"].get<double>(), 0.0);  // never on a hazard
   EXPECT_EQ(metrics["hazard_cells_crossed"].get<int>(), 0);
   EXPECT_LE(metrics["hazard_cells_crossed"].get<int>(),

@@ -16,6 +16,7 @@
 #include "pitchlab/mapping/elevation_map.hpp"
 #include "pitchlab/mapping/line_pitch.hpp"
 #include "pitchlab/mapping/map_builder.hpp"
+#include "pitchlab/mapping/mount_from_floor.hpp"
 #include "pitchlab/planning/planner.hpp"
 #include "pitchlab/planning/traversability.hpp"
 #include "pitchlab/sensors/mobile_base.hpp"
@@ -189,6 +190,9 @@ struct MissionResult {
   /// accepted (scan indices are MergeStep::scan_index); zero and empty when off.
   mapping::LoopClosureCounts loop_counts;
   std::vector<mapping::LoopClosure> loop_closures;
+  /// With calibrate_mount: the mount the first scan's floor gave, or why there is none.
+  std::optional<mapping::MountFromFloor> mount_calibration;
+  std::string mount_calibration_note;
 };
 
 /// Called after each stop is planned (for output as it happens) and with progress text.

@@ -27,6 +27,9 @@ struct RunContext {
   std::vector<Eigen::Vector2d> via;  ///< waypoints before the goal, in order [m]
   bool loop_closure = false;  ///< the mission closed loops (run: {loop_closure: true})
   std::optional<mapping::GeodeticOrigin> geodetic_origin;
+  /// Simulated runs: the scanner's mount error the simulator drew, roll, pitch, yaw [rad]
+  /// (truth the mission never saw; metrics.json scores the mount calibration against it).
+  std::optional<Eigen::Vector3d> mount_error_rpy_rad;
   std::string config_yaml;  ///< the configuration as used
   /// The planner as the mission used it (robot width including the safety margin).
   planning::PlannerConfig planner;
