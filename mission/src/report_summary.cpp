@@ -164,6 +164,8 @@ std::vector<MetricRow> KeyMetrics(const nlohmann::json& m) {
        "motion between stops against truth"},
       {"registration_step_error.p95_deg", "registration step error, 95th percentile", "deg", ""},
       {"registration_failures", "registration failures", "", "stops that fell back to odometry"},
+      {"mount_calibration.max_error_deg", "mount calibration error", "deg",
+       "largest of roll, pitch, yaw found on the first stop's floor against the drawn error"},
       {"map_hazards.false_hazard_cells", "false hazard cells in the final map", "",
        "hazards where the truth is free"},
       {"map_hazards.missed_hazard_cells", "missed hazard cells in the final map", "",
