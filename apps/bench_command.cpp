@@ -644,6 +644,13 @@ json Max(const std::vector<double>& v) {
   return *std::max_element(v.begin(), v.end());
 }
 
+/// How many of `records` have a number above zero at `key` (runs that crossed a cell they should
+/// not have; a run without the number, unscored, does not count).
+std::size_t CountPositive(const std::vector<const json*>& records, const char* key) {
+  const std::vector<double> v = Numbers(records, key);
+  return static_cast<std::size_t>(std::count_if(v.begin(), v.end(), [](double x) { return x > 0; }));
+}
+
 /// One summary row over `records` (all of one world, or all of them).
 json SummaryRow(const std::string& world, const std::vector<const json*>& records) {
   std::size_t successes = 0;
@@ -676,6 +683,8 @@ json SummaryRow(const std::string& world, const std::vector<const json*>& record
           {"max_registration_step_deg", Max(Numbers(records, "registration_step_max_deg"))},
           {"median_cost_ratio", Median(Numbers(records, "cost_ratio"))},
           {"median_false_hazard_percent", Median(FalseHazardPercent(records))},
+          {"runs_over_forbidden_cells", CountPositive(records, "forbidden_cells_crossed")},
+          {"runs_over_true_hazards", CountPositive(records, "hazard_cells_crossed")},
           {"failure_reasons", reasons}};
 }
 
@@ -715,11 +724,13 @@ void PrintTable(const json& summary, std::FILE* out) {
   // haz": the final map's false hazard cells per cell compared with the truth, median over runs;
   // "ATE med": the stops' absolute trajectory error (RMSE, unaligned, at the final poses), median
   // over runs; "loops acc/rej/wrong": loop edges accepted and refused by the pose graph's test,
-  // and accepted ones more than 0.1 m or 1 deg off the truth, summed ("-": loop closure off).
-  std::fprintf(out, "%-14s %5s %5s %8s %18s %8s %14s %13s %13s %20s %13s %20s\n", "world",
+  // and accepted ones more than 0.1 m or 1 deg off the truth, summed ("-": loop closure off);
+  // "unsafe forb/haz": runs whose robot crossed a forbidden cell (within half its width of a true
+  // hazard) / a true hazard cell, what report.html calls "unsafe", success or not.
+  std::fprintf(out, "%-14s %5s %5s %8s %18s %8s %14s %13s %13s %20s %13s %16s %20s\n", "world",
                "runs", "ok", "success", "wall med/max [s]", "RTF med", "pose err [m]",
                "ATE med [m]", "reg max [m]", "reg step max [m/deg]", "false haz [%]",
-               "loops acc/rej/wrong");
+               "unsafe forb/haz", "loops acc/rej/wrong");
   std::vector<json> rows(summary["worlds"].begin(), summary["worlds"].end());
   rows.push_back(summary["total"]);
   for (const json& r : rows) {
@@ -730,14 +741,17 @@ void PrintTable(const json& summary, std::FILE* out) {
     const std::string loops = Cell(r["loop_closures_accepted"], "%.0f") + " / " +
                               Cell(r["loop_closures_rejected"], "%.0f") + " / " +
                               Cell(r["wrong_loop_closures"], "%.0f");
-    std::fprintf(out, "%-14s %5zu %5zu %7.1f%% %18s %8s %14s %13s %13s %20s %13s %20s\n",
+    const std::string unsafe = std::to_string(r.value("runs_over_forbidden_cells", 0)) + " / " +
+                               std::to_string(r.value("runs_over_true_hazards", 0));
+    std::fprintf(out, "%-14s %5zu %5zu %7.1f%% %18s %8s %14s %13s %13s %20s %13s %16s %20s\n",
                  r["world"].get<std::string>().c_str(), r["runs"].get<std::size_t>(),
                  r["successes"].get<std::size_t>(), 100.0 * r["success_rate"].get<double>(),
                  wall.c_str(), Cell(r["median_real_time_factor"], "%.1fx").c_str(),
                  Cell(r["median_final_pose_error_m"], "%.3f").c_str(),
                  Cell(r["median_ate_m"], "%.3f").c_str(),
                  Cell(r["max_registration_error_m"], "%.3f").c_str(), step.c_str(),
-                 Cell(r["median_false_hazard_percent"], "%.2f").c_str(), loops.c_str());
+                 Cell(r["median_false_hazard_percent"], "%.2f").c_str(), unsafe.c_str(),
+                 loops.c_str());
   }
   for (const auto& [reason, count] : summary["total"]["failure_reasons"].items()) {
     std::fprintf(out, "  failed %dx: %s\n", count.get<int>(), reason.c_str());

@@ -65,6 +65,8 @@ json Counts(const json& row) {
           {"runs", row["runs"]},
           {"successes", row["successes"]},
           {"failures", row["failures"]},
+          {"runs_over_forbidden_cells", row["runs_over_forbidden_cells"]},
+          {"runs_over_true_hazards", row["runs_over_true_hazards"]},
           {"failure_reasons", row["failure_reasons"]}};
 }
 
@@ -91,6 +93,15 @@ TEST_F(BenchCli, ShardsCoverEveryRunOnceAndMergeToTheUnshardedSummary) {
     EXPECT_TRUE(r["cost_ratio"].is_number());
     EXPECT_TRUE(fs::exists(dir_ / "whole" / r["run_dir"].get<std::string>() / "metrics.json"));
   }
+  // The unsafe runs the table counts are the runs whose robot crossed such cells.
+  int over_forbidden = 0, over_hazards = 0;
+  for (const json& r : all) {
+    over_forbidden += r["forbidden_cells_crossed"].get<int>() > 0;
+    over_hazards += r["hazard_cells_crossed"].get<int>() > 0;
+  }
+  EXPECT_EQ(summary["total"]["runs_over_forbidden_cells"], over_forbidden);
+  EXPECT_EQ(summary["total"]["runs_over_true_hazards"], over_hazards);
+  EXPECT_NE(whole.err.find("unsafe forb/haz"), std::string::npos) << whole.err;
 
   for (const char* shard : {"1/2", "2/2"}) {
     const std::string out = (dir_ / ("shard" + std::string(1, shard[0]))).string();
