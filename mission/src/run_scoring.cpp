@@ -142,9 +142,11 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
   s.forbidden_cells_crossed = on_truth.forbidden_cells;
   for (std::size_t i = 1; i < driven.cells.size(); ++i) {  // the start excluded, as above
     const planning::Blocked b = truth.blocked[truth.geometry.Linear(driven.cells[i])];
-    s.hazard_cells_crossed += b == planning::Blocked::kStep || b == planning::Blocked::kDrop ||
-                              b == planning::Blocked::kTooSteep;
+    s.crossed_steps += b == planning::Blocked::kStep;
+    s.crossed_drops += b == planning::Blocked::kDrop;
+    s.crossed_too_steep += b == planning::Blocked::kTooSteep;
   }
+  s.hazard_cells_crossed = s.crossed_steps + s.crossed_drops + s.crossed_too_steep;
   auto optimum = PlanRoute(truth, start_m, via_m, goal_m, algorithm);
   if (optimum) {
     s.true_optimal_cost = optimum->cost;
@@ -159,7 +161,13 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
   for (std::size_t k = 0; k < truth.blocked.size(); ++k) {
     const HazardVerdict v = CompareHazard(estimated, truth, k);
     s.map_cells_compared += v != HazardVerdict::kNotCompared;
-    s.missed_hazard_cells += v == HazardVerdict::kMissedHazard;
+    if (v == HazardVerdict::kMissedHazard) {
+      const planning::Blocked t = truth.blocked[k];
+      ++s.missed_hazard_cells;
+      s.missed_steps += t == planning::Blocked::kStep;
+      s.missed_drops += t == planning::Blocked::kDrop;
+      s.missed_too_steep += t == planning::Blocked::kTooSteep;
+    }
     if (v == HazardVerdict::kFalseHazard) {
       const planning::Blocked e = estimated.blocked[k];
       ++s.false_hazard_cells;

@@ -84,6 +84,13 @@ TEST_F(RunCli, AMissionAroundABlockReachesTheGoalAndWritesEveryOutput) {
   EXPECT_GT(compared, 2000);
   EXPECT_LT(hazards["false_hazard_cells"].get<double>(), 0.01 * compared);
   EXPECT_LT(hazards["missed_hazard_cells"].get<double>(), 0.01 * compared);
+  // Every missed (and crossed) hazard is one of the three kinds, by the truth.
+  const nlohmann::json& missed = hazards["missed_as"];
+  EXPECT_EQ(missed["step"].get<int>() + missed["drop"].get<int>() + missed["too_steep"].get<int>(),
+            hazards["missed_hazard_cells"].get<int>());
+  const nlohmann::json& crossed = metrics["hazard_cells_crossed_as"];
+  EXPECT_EQ(crossed["step"].get<int>() + crossed["drop"].get<int>() + crossed["too_steep"].get<int>(),
+            metrics["hazard_cells_crossed"].get<int>());
   EXPECT_GT(metrics["distance_m"].get<double>(), 11.0);  // around the block, not through it
   EXPECT_GE(metrics["cost_ratio"].get<double>(), 0.95);
   EXPECT_LT(metrics["cost_ratio"].get<double>(), 1.5);

@@ -45,6 +45,10 @@ struct RunScore {
   /// Of those, what the map took them for: a step, a drop, too steep [1].
   std::size_t false_steps = 0, false_drops = 0, false_too_steep = 0;
   std::size_t missed_hazard_cells = 0;  ///< free in the map, truly a hazard
+  /// Of those, what the truth calls them: a step, a drop, too steep [1].
+  std::size_t missed_steps = 0, missed_drops = 0, missed_too_steep = 0;
+  /// Of hazard_cells_crossed, what the truth calls them [1].
+  std::size_t crossed_steps = 0, crossed_drops = 0, crossed_too_steep = 0;
 };
 
 /// How a map's cell compares with the truth's (both on one grid): kNotCompared where either does
