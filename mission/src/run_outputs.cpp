@@ -180,6 +180,10 @@ void WriteStopOutputs(RunFolder& folder, const StopRecord& stop, const MissionRe
 
 namespace {
 
+nlohmann::json KindsJson(const HazardKinds& k) {
+  return {{"step", k.step}, {"drop", k.drop}, {"too_steep", k.too_steep}};
+}
+
 nlohmann::json Degrees(const Eigen::Vector3d& rad) {
   return {rad.x() * kRadToDeg, rad.y() * kRadToDeg, rad.z() * kRadToDeg};
 }
@@ -258,20 +262,12 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
         score->cost_ratio && r.success ? nlohmann::json(*score->cost_ratio) : nlohmann::json();
     m["forbidden_cells_crossed"] = score->forbidden_cells_crossed;
     m["hazard_cells_crossed"] = score->hazard_cells_crossed;
-    m["hazard_cells_crossed_as"] = {{"step", score->crossed_steps},
-                                    {"drop", score->crossed_drops},
-                                    {"too_steep", score->crossed_too_steep}};
+    m["hazard_cells_crossed_as"] = KindsJson(score->crossed_as);
     m["map_hazards"] = {{"cells_compared", score->map_cells_compared},
                         {"false_hazard_cells", score->false_hazard_cells},
-                        {"false_as",
-                         {{"step", score->false_steps},
-                          {"drop", score->false_drops},
-                          {"too_steep", score->false_too_steep}}},
+                        {"false_as", KindsJson(score->false_as)},
                         {"missed_hazard_cells", score->missed_hazard_cells},
-                        {"missed_as",
-                         {{"step", score->missed_steps},
-                          {"drop", score->missed_drops},
-                          {"too_steep", score->missed_too_steep}}}};
+                        {"missed_as", KindsJson(score->missed_as)}};
     if (std::isfinite(score->closest_hazard_m)) {
       m["closest_approach_to_forbidden_m"] = score->closest_hazard_m;
       m["closest_approach_at"] = {{"x_m", score->closest_hazard_at.x()},

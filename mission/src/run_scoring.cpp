@@ -142,11 +142,9 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
   s.forbidden_cells_crossed = on_truth.forbidden_cells;
   for (std::size_t i = 1; i < driven.cells.size(); ++i) {  // the start excluded, as above
     const planning::Blocked b = truth.blocked[truth.geometry.Linear(driven.cells[i])];
-    s.crossed_steps += b == planning::Blocked::kStep;
-    s.crossed_drops += b == planning::Blocked::kDrop;
-    s.crossed_too_steep += b == planning::Blocked::kTooSteep;
+    s.crossed_as.Count(b);
   }
-  s.hazard_cells_crossed = s.crossed_steps + s.crossed_drops + s.crossed_too_steep;
+  s.hazard_cells_crossed = s.crossed_as.Total();
   auto optimum = PlanRoute(truth, start_m, via_m, goal_m, algorithm);
   if (optimum) {
     s.true_optimal_cost = optimum->cost;
@@ -162,18 +160,12 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
     const HazardVerdict v = CompareHazard(estimated, truth, k);
     s.map_cells_compared += v != HazardVerdict::kNotCompared;
     if (v == HazardVerdict::kMissedHazard) {
-      const planning::Blocked t = truth.blocked[k];
       ++s.missed_hazard_cells;
-      s.missed_steps += t == planning::Blocked::kStep;
-      s.missed_drops += t == planning::Blocked::kDrop;
-      s.missed_too_steep += t == planning::Blocked::kTooSteep;
+      s.missed_as.Count(truth.blocked[k]);
     }
     if (v == HazardVerdict::kFalseHazard) {
-      const planning::Blocked e = estimated.blocked[k];
       ++s.false_hazard_cells;
-      s.false_steps += e == planning::Blocked::kStep;
-      s.false_drops += e == planning::Blocked::kDrop;
-      s.false_too_steep += e == planning::Blocked::kTooSteep;
+      s.false_as.Count(estimated.blocked[k]);
     }
   }
   return s;

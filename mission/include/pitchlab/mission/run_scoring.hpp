@@ -11,6 +11,18 @@
 
 namespace pitchlab::mission {
 
+/// Hazard cells counted by kind: a step, a drop, too steep [1].
+struct HazardKinds {
+  std::size_t step = 0, drop = 0, too_steep = 0;
+  /// Counts `b` when it is one of the three (free, near a hazard and unknown are not).
+  void Count(planning::Blocked b) {
+    step += b == planning::Blocked::kStep;
+    drop += b == planning::Blocked::kDrop;
+    too_steep += b == planning::Blocked::kTooSteep;
+  }
+  std::size_t Total() const { return step + drop + too_steep; }
+};
+
 struct RunScore {
   double final_translation_error_m = 0;             ///< last estimate vs truth [m]
   double final_rotation_error_deg = 0;              ///< [deg]
@@ -42,13 +54,13 @@ struct RunScore {
   /// unlike success these counts change smoothly with the map's quality [1].
   std::size_t map_cells_compared = 0;
   std::size_t false_hazard_cells = 0;   ///< hazard in the map, truly free (not even near one)
-  /// Of those, what the map took them for: a step, a drop, too steep [1].
-  std::size_t false_steps = 0, false_drops = 0, false_too_steep = 0;
+  /// Of those, what the map took them for [1].
+  HazardKinds false_as;
   std::size_t missed_hazard_cells = 0;  ///< free in the map, truly a hazard
-  /// Of those, what the truth calls them: a step, a drop, too steep [1].
-  std::size_t missed_steps = 0, missed_drops = 0, missed_too_steep = 0;
+  /// Of those, what the truth calls them [1].
+  HazardKinds missed_as;
   /// Of hazard_cells_crossed, what the truth calls them [1].
-  std::size_t crossed_steps = 0, crossed_drops = 0, crossed_too_steep = 0;
+  HazardKinds crossed_as;
 };
 
 /// How a map's cell compares with the truth's (both on one grid): kNotCompared where either does
