@@ -16,10 +16,10 @@
 namespace pitchlab::mapping {
 namespace {
 
-// A floor point in its line's laser frame (nominal mount) and the line's encoder pitch.
+// A floor point in its line's laser frame (nominal mount) and its line's index.
 struct FloorPoint {
   Eigen::Vector3d q;
-  double gamma = 0;
+  std::size_t line = 0;
 };
 
 sensors::MountConfig WithCorrection(const sensors::MountConfig& nominal,
@@ -29,17 +29,29 @@ sensors::MountConfig WithCorrection(const sensors::MountConfig& nominal,
   return m;
 }
 
-// The point's height in base_link on the mount `m`.
-double HeightOn(const sensors::MountConfig& m, const FloorPoint& f) {
-  return (m.BaseToLaser(f.gamma) * f.q).z();
+// Each line's laser frame in base_link on the mount `nominal` + `correction`: built once per
+// line (a scan's ~200), not per point, for every evaluation of the heights.
+std::vector<Eigen::Isometry3d> LineFrames(const sensors::Scan3D& scan,
+                                          const sensors::MountConfig& nominal,
+                                          const Eigen::Vector3d& correction) {
+  const sensors::MountConfig m = WithCorrection(nominal, correction);
+  std::vector<Eigen::Isometry3d> frames(scan.lines.size());
+  for (std::size_t l = 0; l < frames.size(); ++l) frames[l] = m.BaseToLaser(scan.lines[l].pitch_rad);
+  return frames;
 }
 
-// The band's points within 3 sigma of the floor: |z - floor_z| on the mount `m`.
-std::vector<FloorPoint> Within(const std::vector<FloorPoint>& band, const sensors::MountConfig& m,
-                               double floor_z, double threshold_m) {
+// The point's height in base_link with its line's frame from `frames`.
+double HeightOn(const std::vector<Eigen::Isometry3d>& frames, const FloorPoint& f) {
+  return (frames[f.line] * f.q).z();
+}
+
+// The band's points within `threshold_m` of the level floor at floor_z, with the lines' `frames`.
+std::vector<FloorPoint> Within(const std::vector<FloorPoint>& band,
+                               const std::vector<Eigen::Isometry3d>& frames, double floor_z,
+                               double threshold_m) {
   std::vector<FloorPoint> in;
   for (const FloorPoint& f : band)
-    if (std::abs(HeightOn(m, f) - floor_z) < threshold_m) in.push_back(f);
+    if (std::abs(HeightOn(frames, f) - floor_z) < threshold_m) in.push_back(f);
   return in;
 }
 
@@ -54,13 +66,13 @@ Band FloorBand(const sensors::Scan3D& scan, const sensors::MountConfig& nominal,
                const Eigen::Vector3f& laser, const GroundLevel& level,
                const GroundLevelConfig& ground) {
   Band band;
+  const std::vector<Eigen::Isometry3d> frames = LineFrames(scan, nominal, Eigen::Vector3d::Zero());
   for (const sensors::ScanPoint& p : scan.points) {
     const Eigen::Vector3f at(p.x, p.y, p.z);
     if (p.line >= scan.lines.size() || !at.allFinite() || at.z() >= laser.z()) continue;
     const float r = (at - laser).head<2>().norm();
     if (r < ground.min_radius_m || r > ground.max_radius_m) continue;
-    const double gamma = scan.lines[p.line].pitch_rad;
-    band.points.push_back({nominal.BaseToLaser(gamma).inverse() * at.cast<double>(), gamma});
+    band.points.push_back({frames[p.line].inverse() * at.cast<double>(), p.line});
     band.distance.push_back(std::abs(level.normal.dot(at.cast<double>()) - level.offset_m));
   }
   return band;
@@ -76,19 +88,20 @@ struct Solution {
 
 // Gauss-Newton on the heights of `floor` minus floor_z, weighted by 1 / sigma^2, with the prior
 // `prior_w` (1 / sigma^2 per angle) pulling the angles to zero; from `s`, in place.
-void SolveLevel(const std::vector<FloorPoint>& floor, const sensors::MountConfig& nominal,
-                double sigma_m, double prior_w, Solution& s) {
+void SolveLevel(const std::vector<FloorPoint>& floor, const sensors::Scan3D& scan,
+                const sensors::MountConfig& nominal, double sigma_m, double prior_w,
+                Solution& s) {
   constexpr double kStep_rad = 1e-6;  // finite differences: heights move by ~4e-6 m
   const double w = 1.0 / (sigma_m * sigma_m);
   for (int iteration = 0; iteration < 20; ++iteration) {
-    const sensors::MountConfig m = WithCorrection(nominal, s.x);
-    std::array<sensors::MountConfig, 3> moved;
+    const std::vector<Eigen::Isometry3d> frames = LineFrames(scan, nominal, s.x);
+    std::array<std::vector<Eigen::Isometry3d>, 3> moved;
     for (int k = 0; k < 3; ++k)
-      moved[k] = WithCorrection(nominal, s.x + kStep_rad * Eigen::Vector3d::Unit(k));
+      moved[k] = LineFrames(scan, nominal, s.x + kStep_rad * Eigen::Vector3d::Unit(k));
     s.A.setZero();
     Eigen::Vector4d b = Eigen::Vector4d::Zero();
     for (const FloorPoint& f : floor) {
-      const double z = HeightOn(m, f);
+      const double z = HeightOn(frames, f);
       Eigen::Vector4d J;
       for (int k = 0; k < 3; ++k) J[k] = (HeightOn(moved[k], f) - z) / kStep_rad;
       J[3] = -1.0;
@@ -106,10 +119,10 @@ void SolveLevel(const std::vector<FloorPoint>& floor, const sensors::MountConfig
 
 // RMS of the heights of `floor` about floor_z on the mount `m` [m], at least 1e-4 m (far below
 // any laser's noise: keeps a noise-free synthetic floor's threshold above rounding).
-double RmsHeight(const std::vector<FloorPoint>& floor, const sensors::MountConfig& m,
+double RmsHeight(const std::vector<FloorPoint>& floor, const std::vector<Eigen::Isometry3d>& frames,
                  double floor_z) {
   double ss = 0;
-  for (const FloorPoint& f : floor) ss += std::pow(HeightOn(m, f) - floor_z, 2);
+  for (const FloorPoint& f : floor) ss += std::pow(HeightOn(frames, f) - floor_z, 2);
   return std::max(std::sqrt(ss / std::max<std::size_t>(floor.size(), 1)), 1e-4);
 }
 
@@ -154,7 +167,9 @@ Result<MountFromFloor> CalibrateMountFromFloor(const sensors::Scan3D& scan,
   for (std::size_t k = 0; k < band.points.size(); ++k)
     if (band.distance[k] < 3.0 * sigma_m) floor.push_back(band.points[k]);
   Solution s;
-  for (const FloorPoint& f : floor) s.floor_z += HeightOn(nominal, f) / floor.size();
+  const std::vector<Eigen::Isometry3d> nominal_frames =
+      LineFrames(scan, nominal, Eigen::Vector3d::Zero());
+  for (const FloorPoint& f : floor) s.floor_z += HeightOn(nominal_frames, f) / floor.size();
   const double prior_w = 1.0 / (config.prior_sigma_rad * config.prior_sigma_rad);
   for (int round = 0; round < 10; ++round) {
     if (floor.size() < config.ground.min_points) {
@@ -163,10 +178,10 @@ Result<MountFromFloor> CalibrateMountFromFloor(const sensors::Scan3D& scan,
                                             std::to_string(band.points.size()) +
                                             " points near the laser lie on one level floor");
     }
-    SolveLevel(floor, nominal, sigma_m, prior_w, s);
-    const sensors::MountConfig m = WithCorrection(nominal, s.x);
-    sigma_m = RmsHeight(floor, m, s.floor_z);
-    std::vector<FloorPoint> next = Within(band.points, m, s.floor_z, 3.0 * sigma_m);
+    SolveLevel(floor, scan, nominal, sigma_m, prior_w, s);
+    const std::vector<Eigen::Isometry3d> frames = LineFrames(scan, nominal, s.x);
+    sigma_m = RmsHeight(floor, frames, s.floor_z);
+    std::vector<FloorPoint> next = Within(band.points, frames, s.floor_z, 3.0 * sigma_m);
     const bool settled = round > 0 && next.size() == floor.size();
     if (settled) break;
     floor = std::move(next);

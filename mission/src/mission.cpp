@@ -139,8 +139,8 @@ class Mission {
   // failed) the pose's height is first taken from the map's ground (FitHeightOffset), and the scan
   // fills only the cells the map has not seen (FillUnknown).
   void UpdateElevation(StopRecord& stop);
-  // With calibrate_mount: at stop 0 the mount's tilt from the floor the robot stands on, then every
-  // scan turned by it about the mount.
+  // With calibrate_mount: at stop 0 the mount the floor the robot stands on says the laser is
+  // on, then every scan re-assembled on it.
   void CalibrateMount(int k, sensors::Scan3D& scan);
   // Loop closure on: a registered stop's scan joins the per-scan map at the graph's pose, and
   // when this merge's optimisation moved poses every kept scan follows.
