@@ -57,11 +57,13 @@ nlohmann::json FloorPlane(const std::vector<Eigen::Vector3d>& cells, const Eigen
           {"by_distance", bands}};
 }
 
-// The farthest along `axis` (from `from`) of the observed cells reachable from `start` through
-// allowed moves [m]: with unknown cells enterable a search may wander off the seen floor, and only
-// what was seen counts as plannable.
-double ReachAlong(const planning::TraversabilityGrid& grid, const mapping::CellIndex& start,
-                  const Eigen::Vector2d& from, const Eigen::Vector2d& axis) {
+// The farthest along `axis` (from `from`) of the floor cells (`floor`, by linear index) reachable
+// from `start` through allowed moves [m]: with unknown cells enterable a search may wander off
+// the seen floor, and only the seen floor counts as plannable (a free cell 33 m away on a shelf
+// is no corridor).
+double ReachAlong(const planning::TraversabilityGrid& grid, const std::vector<char>& floor,
+                  const mapping::CellIndex& start, const Eigen::Vector2d& from,
+                  const Eigen::Vector2d& axis) {
   const mapping::GridGeometry& g = grid.geometry;
   if (!g.Contains(start)) return 0;
   std::vector<char> seen(g.cell_count(), 0);
@@ -72,7 +74,7 @@ double ReachAlong(const planning::TraversabilityGrid& grid, const mapping::CellI
     const std::size_t k = queue.front();
     queue.pop_front();
     const mapping::CellIndex c = g.FromLinear(k);
-    if (grid.blocked[k] == planning::Blocked::kFree && std::isfinite(grid.z_m[k])) {
+    if (floor[k] && grid.blocked[k] == planning::Blocked::kFree) {
       farthest = std::max(farthest, (g.CenterOf(c) - from).dot(axis));
     }
     for (int b = 0; b < 8; ++b) {
@@ -128,6 +130,7 @@ nlohmann::json CheckMap(const std::vector<PosedCloud>& scans) {
   Eigen::Vector2d axis = sensors.back().head<2>().cast<double>() - from;
   axis = axis.norm() > 1e-6 ? axis.normalized() : Eigen::Vector2d::UnitX();
   std::vector<Eigen::Vector3d> floor;
+  std::vector<char> is_floor(g.cell_count(), 0);
   double seen_m = 0;
   for (std::size_t k = 0; k < g.cell_count(); ++k) {
     if (layers.state[k] != mapping::CellState::kObserved) continue;
@@ -135,6 +138,7 @@ nlohmann::json CheckMap(const std::vector<PosedCloud>& scans) {
     if (!(std::abs(z - floor_z) <= kFloorBand_m)) continue;
     const Eigen::Vector2d c = g.CenterOf(g.FromLinear(k));
     floor.emplace_back(c.x(), c.y(), z);
+    is_floor[k] = 1;
     seen_m = std::max(seen_m, (c - from).dot(axis));
   }
   nlohmann::json reach;
@@ -143,7 +147,7 @@ nlohmann::json CheckMap(const std::vector<PosedCloud>& scans) {
     planning::PlannerConfig config;
     config.unknown = policy;
     const planning::TraversabilityGrid grid = planning::BuildTraversability(layers, config);
-    reach[name] = ReachAlong(grid, g.IndexOf(from.x(), from.y()), from, axis);
+    reach[name] = ReachAlong(grid, is_floor, g.IndexOf(from.x(), from.y()), from, axis);
   }
   return {{"levelling",
            {{"tilt_removed_deg", level->tilt_rad * 180 / kPi},

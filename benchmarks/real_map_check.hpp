@@ -25,7 +25,7 @@ struct PosedCloud {
 /// of the level floor under the first sensor): cells, the tilt of their least-squares plane, the
 /// RMS residual about it and the share within +-2 cm; the seen floor's extent along the line from
 /// the first scan's sensor to the last's; and, for each unknown policy, how far along that line
-/// the cells reachable from the first sensor's cell extend. Throws std::runtime_error when the
+/// the floor cells reachable from the first sensor's cell extend. Throws std::runtime_error when the
 /// floor cannot be levelled.
 nlohmann::json CheckMap(const std::vector<PosedCloud>& scans);
 
