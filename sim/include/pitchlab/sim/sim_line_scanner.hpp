@@ -36,7 +36,7 @@ class SimLineScanner final : public sensors::LineScanner {
   sensors::RayCaster& caster_;
   sensors::Lms200Model model_;
   std::vector<float> origins_, directions_, ranges_, edge_lo_, edge_hi_, along_, across_,
-      cos_incidence_;
+      along_back_, across_back_, cos_incidence_;
   sensors::Elapsed line_time_;
 };
 
