@@ -108,9 +108,14 @@ std::vector<bool> GrazedReturns(const Scan3D& scan, const MountConfig& mount,
   for (std::size_t i = 0; i < scan.points.size(); ++i) {
     const ScanPoint& p = scan.points[i];
     const std::int32_t before = index(p.line, p.beam - 1), after = index(p.line, p.beam + 1);
-    if (before == kNone || after == kNone) continue;
+    if (before == kNone && after == kNone) continue;
     const float r = p.range_m;
-    const bool between = (range(before) - r) * (range(after) - r) < 0.0f;
+    // A neighbour that gave no return (a dropout, or the beam past a jamb into the open) counts
+    // as beyond the return: the surface receded from it.
+    const float inf = std::numeric_limits<float>::infinity();
+    const float r_before = before != kNone ? range(before) : inf;
+    const float r_after = after != kNone ? range(after) : inf;
+    const bool between = (r_before - r) * (r_after - r) < 0.0f;
     // Nearer than both (or farther than both): a pole or a leg hit by a beam or two, with the
     // background on either side, whose lines before and after meet it at its own range; or the
     // end of a surface met at grazing incidence, whose returns scatter along their beams, in
@@ -120,7 +125,7 @@ std::vector<bool> GrazedReturns(const Scan3D& scan, const MountConfig& mount,
     for (const std::int32_t k : {index(p.line - 1, p.beam), index(p.line + 1, p.beam)}) {
       if (k != kNone) across_scatter = std::max(across_scatter, std::abs(range(k) - r));
     }
-    const float step_before = std::abs(range(before) - r), step_after = std::abs(range(after) - r);
+    const float step_before = std::abs(r_before - r), step_after = std::abs(r_after - r);
     if (!between && !(std::min(step_before, step_after) <= across_scatter)) continue;
 
     const Eigen::Vector3d here = At(p);
@@ -142,7 +147,7 @@ std::vector<bool> GrazedReturns(const Scan3D& scan, const MountConfig& mount,
       const float step_out = std::abs(range(outer) - range(inner));
       return step_out < 0.5f * step_in || step_out > 2.0f * step_in;
     };
-    if (between &&
+    if (between && before != kNone && after != kNone &&
         SpreadTowards(beam, r, scan.points[std::size_t(before)], here, config) > config.max_spread_m &&
         SpreadTowards(beam, r, scan.points[std::size_t(after)], here, config) > config.max_spread_m &&
         jump(before, index(p.line, p.beam - 2)) && jump(after, index(p.line, p.beam + 2))) {

@@ -255,6 +255,46 @@ TEST(GrazedReturns, NoisyReturnsPastAGrazedWallsEndAreFlagged) {
   EXPECT_LT(kept_flagged, kept_surfaces / 200) << kept_flagged << " of " << kept_surfaces;
 }
 
+// The beam past a grazed wall's end that gave no return (a dropout, or a doorway into the open)
+// counts as beyond the wall's last return, which is flagged as if the room behind had answered.
+TEST(GrazedReturns, AGrazedWallsLastReturnIsFlaggedWhenTheBeamPastTheEndDroppedOut) {
+  const MountConfig mount;
+  std::mt19937 rng(16);
+  CastScan cast = CastAll(mount, &rng);
+  // Each line's return next to the wall's last one, past the end (the facing wall), drops out.
+  std::set<std::pair<int, int>> wall_end, dropped;  // (line, beam)
+  std::set<std::pair<int, int>> on_wall;
+  for (std::size_t i = 0; i < cast.scan.points.size(); ++i) {
+    if (cast.hits[i].surface == Surface::kSideWall) {
+      on_wall.insert({cast.scan.points[i].line, cast.scan.points[i].beam});
+    }
+  }
+  for (std::size_t i = 0; i < cast.scan.points.size(); ++i) {
+    const ScanPoint& p = cast.scan.points[i];
+    if (cast.hits[i].surface != Surface::kFacingWall) continue;
+    for (const int side : {-1, 1}) {
+      if (on_wall.count({p.line, p.beam + side}) && !on_wall.count({p.line, p.beam - side})) {
+        wall_end.insert({p.line, p.beam + side});
+        dropped.insert({p.line, p.beam});
+      }
+    }
+  }
+  Scan3D scan;
+  scan.lines = cast.scan.lines;
+  for (const ScanPoint& p : cast.scan.points) {
+    if (!dropped.count({p.line, p.beam})) scan.points.push_back(p);
+  }
+  const std::vector<bool> grazed = GrazedReturns(scan, mount);
+  int last = 0, last_flagged = 0;
+  for (std::size_t i = 0; i < scan.points.size(); ++i) {
+    if (!wall_end.count({scan.points[i].line, scan.points[i].beam})) continue;
+    ++last;
+    last_flagged += grazed[i];
+  }
+  EXPECT_GT(last, 20);
+  EXPECT_EQ(last_flagged, last);
+}
+
 TEST(GrazedReturns, ReturnsWithoutNeighboursOnBothSidesAreKept) {
   Scan3D scan;
   scan.lines.resize(2);

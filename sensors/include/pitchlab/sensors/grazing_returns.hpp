@@ -8,25 +8,29 @@
 // door 1.05 m wide, which the P3-AT passes with 0.2 m to spare, closed on the measured LMS200
 // model (issue 16). On ground that spread slides a point along the ground: its height stays right.
 //
-// The surface of each return comes from its neighbours in the organised scan: the neighbour in its
-// line and the one in the next line whose ranges are nearest its own (the same surface when there
-// is one). A return is "grazed" when
+// The surface of each return is the least-squares plane of the returns of its beam and of its
+// in-line neighbour nearest in range, each in the lines before and after (those within twice that
+// neighbour's range step, plus max_spread_m): with the measured noise a grazed return moves
+// decimetres along its beam, nearly in the surface, so six returns span it where two neighbour
+// vectors, mostly noise, did not. A return is "grazed" when
 //   - that surface is steeper than ground (its normal more than `max_ground_tilt_rad` from
-//     base_link's z),
+//     base_link's z), and
 //   - the return lies between its two in-line neighbours in range, as on a surface that the
-//     beams meet one after another, each farther than the last (a thin leg or pole hit by a beam
-//     or two has both neighbours behind it, on the background, and is no grazed surface), and
+//     beams meet one after another (a neighbour that gave no return, a dropout or a beam into
+//     the open, counts as beyond it), or is nearer (farther) than both with the nearer one
+//     within the range scatter of its own beam's lines before and after:
+//     the end of a grazed surface, whose noise put it in front of the next beam's (a door jamb's
+//     last return, 0.37 m into the doorway); a thin leg or pole hit by a beam or two has the
+//     background on both sides, far beyond its own lines' scatter, and is kept, and
 //   - its footprint's range spread, r * delta * tan(incidence), exceeds `max_spread_m`.
-// A return that lies between its in-line neighbours is also flagged, whatever its surface, when
-// each of them is so far from it in range that the surface joining them would spread the
-// footprint over more than `max_spread_m` (delta |dr| / dtheta for beams dtheta apart: 0.2 m of
-// range between the LMS200's 0.5 deg beams): a mixed pixel. A beam straddling a depth edge (a door
-// jamb against the room behind it) returns a blend of both ranges, a point in the air between the
-// two surfaces (Lms200Config::mixed_pixels, as real LMS scanners do); in an office doorway, seen
-// from 7 m, such points stood 0.3-1.4 m high in the opening and closed a 1.05 m door as steps.
-// A thin pole hit by one beam has both neighbours behind it, is not between them, and is kept.
-// A return without neighbours on both sides in its line, or without one in an adjacent line
-// (for the grazed surface), is never flagged (nothing to measure its surface with).
+// A return that lies between its in-line neighbours on a surface steeper than ground is also
+// flagged when each of them is so far from it in range that the surface joining them would spread
+// the footprint over more than `max_spread_m` (delta |dr| / dtheta for beams dtheta apart: 0.2 m
+// of range between the LMS200's 0.5 deg beams) and the ranges jump on both sides (a smooth
+// surface's steps change by less than a factor 2 from beam to beam): a mixed pixel, a blend of a
+// jamb and the room behind it in the air between them (Lms200Config::mixed_pixels, as real LMS
+// scanners do), or the tail of the grazing noise. A return with neither in-line neighbour, or
+// whose neighbours span no plane (nothing then tells a wall from far ground), is never flagged.
 
 #include <vector>
 
