@@ -7,6 +7,18 @@
 #include "loop_closer.hpp"
 
 namespace pitchlab::mapping {
+namespace {
+
+// `T` with its rotation made exactly orthonormal (the nearest unit quaternion's). Each scan's
+// prior is relative to the last merged pose, and ICP from it composes that pose's inverse back
+// onto it: a rotation R(I + S) came back as R(I + 2S), and the rounding error doubled with every
+// merge (office seed 146 reached 4e-7 after 33 merges, and its TUM trajectory was refused).
+Eigen::Isometry3d Orthonormal(Eigen::Isometry3d T) {
+  T.linear() = Eigen::Quaterniond(T.linear()).normalized().toRotationMatrix();
+  return T;
+}
+
+}  // namespace
 
 void LoopClosureConfig::Validate() const {
   const auto fail = [](const std::string& field, double value, const std::string& rule) {
@@ -140,7 +152,7 @@ Result<MergeStep> MapBuilder::Add(const PointCloud& cloud_base,
   if (!r) return tl::make_unexpected(r.error());
   step.registration = *r;
   if (!r->success) return step;  // reported, never merged
-  step.T_map_base = T_map_last * r->T_target_source;
+  step.T_map_base = Orthonormal(T_map_last * r->T_target_source);
   map_.Add(cloud_base, step.T_map_base);
   trajectory_.push_back({step.scan_index, step.T_map_base});
   last_scan_ = cloud_base;
