@@ -60,8 +60,7 @@ double SpreadTowards(const Eigen::Vector3d& beam, float range, const ScanPoint& 
 // noise (a cross product of two of them turned a grazed wall into "ground"). Empty when those
 // returns span no plane.
 std::optional<Eigen::Vector3d> SurfaceNormal(const Scan3D& scan, const OrganisedIndex& index,
-                                             std::size_t i, int side,
-                                             const GrazingConfig& config) {
+                                             std::size_t i, int side, const GrazingConfig& config) {
   const ScanPoint& p = scan.points[i];
   const std::int32_t neighbour = index(p.line, p.beam + side);
   // Ranges of the lines before and after on the same surface: lines and beams are ~0.5 deg
@@ -69,8 +68,7 @@ std::optional<Eigen::Vector3d> SurfaceNormal(const Scan3D& scan, const Organised
   // range as the neighbouring beam does, and a facing one within the noise: twice that step,
   // plus a cell for the noise.
   const double same_surface =
-      2.0 * std::abs(scan.points[std::size_t(neighbour)].range_m - p.range_m) +
-      config.max_spread_m;
+      2.0 * std::abs(scan.points[std::size_t(neighbour)].range_m - p.range_m) + config.max_spread_m;
   Eigen::Vector3d window[6];
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   int count = 0;
@@ -148,8 +146,10 @@ std::vector<bool> GrazedReturns(const Scan3D& scan, const MountConfig& mount,
       return step_out < 0.5f * step_in || step_out > 2.0f * step_in;
     };
     if (between && before != kNone && after != kNone &&
-        SpreadTowards(beam, r, scan.points[std::size_t(before)], here, config) > config.max_spread_m &&
-        SpreadTowards(beam, r, scan.points[std::size_t(after)], here, config) > config.max_spread_m &&
+        SpreadTowards(beam, r, scan.points[std::size_t(before)], here, config) >
+            config.max_spread_m &&
+        SpreadTowards(beam, r, scan.points[std::size_t(after)], here, config) >
+            config.max_spread_m &&
         jump(before, index(p.line, p.beam - 2)) && jump(after, index(p.line, p.beam + 2))) {
       grazed[i] = true;
       continue;
@@ -159,7 +159,8 @@ std::vector<bool> GrazedReturns(const Scan3D& scan, const MountConfig& mount,
     const double cos_incidence = std::abs(normal->dot(beam)) / b;
     const double sin_incidence = std::sqrt(std::max(0.0, 1.0 - cos_incidence * cos_incidence));
     // spread = r delta tan(incidence) > max, without dividing by a cosine that may be 0.
-    grazed[i] = r * config.beam_divergence_rad * sin_incidence > config.max_spread_m * cos_incidence;
+    grazed[i] =
+        r * config.beam_divergence_rad * sin_incidence > config.max_spread_m * cos_incidence;
   }
   return grazed;
 }
