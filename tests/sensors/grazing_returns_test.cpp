@@ -69,6 +69,18 @@ struct CastScan {
   std::vector<Hit> hits;  // one per point
 };
 
+// The return of beam `beam` of line `line` at `p`, `range` from the laser.
+ScanPoint Return(const Eigen::Vector3d& p, double range, int line, int beam) {
+  ScanPoint sp;
+  sp.x = float(p.x());
+  sp.y = float(p.y());
+  sp.z = float(p.z());
+  sp.range_m = float(range);
+  sp.line = std::uint16_t(line);
+  sp.beam = std::uint16_t(beam);
+  return sp;
+}
+
 // The measured LMS200 model's range noise (Lms200Config{}): 2 mm + 1.5 mm/m + 0.4 of the
 // footprint's depth r delta tan(incidence), tan held at its 85 deg value beyond.
 double MeasuredSigma(double range, const Eigen::Vector3d& beam, const Eigen::Vector3d& normal) {
@@ -97,15 +109,7 @@ CastScan CastAll(const MountConfig& mount, std::mt19937* rng = nullptr) {
       if (rng) {
         range += MeasuredSigma(range, d, hit->normal) * std::normal_distribution<double>()(*rng);
       }
-      const Eigen::Vector3d p = o + range * d;
-      ScanPoint sp;
-      sp.x = float(p.x());
-      sp.y = float(p.y());
-      sp.z = float(p.z());
-      sp.range_m = float(range);
-      sp.line = std::uint16_t(l);
-      sp.beam = std::uint16_t(b);
-      out.scan.points.push_back(sp);
+      out.scan.points.push_back(Return(o + range * d, range, l, b));
       out.hits.push_back(*hit);
     }
     out.scan.lines.push_back(line);
@@ -198,15 +202,7 @@ TEST(GrazedReturns, AMixedPixelAtADepthEdgeIsFlaggedAndTheWallsBesideItAreNot) {
       const bool edge = last_far >= 0 && far != (last_far > 0);
       last_far = far ? 1 : 0;
       if (edge) range = 0.5 * (t_near + t_far);
-      const Eigen::Vector3d q = o + range * d;
-      ScanPoint sp;
-      sp.x = float(q.x());
-      sp.y = float(q.y());
-      sp.z = float(q.z());
-      sp.range_m = float(range);
-      sp.line = std::uint16_t(l);
-      sp.beam = std::uint16_t(b);
-      scan.points.push_back(sp);
+      scan.points.push_back(Return(o + range * d, range, l, b));
       (edge ? mixed : wall) += 1;
     }
   }

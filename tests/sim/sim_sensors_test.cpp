@@ -197,9 +197,9 @@ TEST(SimRig, TheScannerSitsOffTheNominalMountByTheDrawnErrorUnknownToTheScan) {
   EXPECT_GT(moved, compared / 2);
 }
 
-// The incidence the scanner derives from its extra rays, seen through grazing dropouts whose
-// probability is the incidence / 90 deg: a level line on the wall at x = 3 m meets it at |theta|.
-TEST(SimLineScanner, IncidenceFromTheHitsIsTheWallsGeometry) {
+// A sensor whose only effect is a dropout with probability incidence / 90 deg: what the scanner
+// takes for each beam's incidence shows in how often the beam drops out.
+SimRigConfig IncidenceProbeConfig() {
   SimRigConfig config = QuietConfig();
   config.lms200.noise_sigma_m = 0.001;  // not the ideal sensor: dropouts on
   config.lms200.noise_per_m = 0.0;
@@ -207,7 +207,13 @@ TEST(SimLineScanner, IncidenceFromTheHitsIsTheWallsGeometry) {
   config.lms200.dropout_far_per_m = 0.0;
   config.lms200.dropout_grazing_deg = 0.0;
   config.lms200.dropout_grazing_at_90 = 1.0;
-  auto rig = MakeRig(config);
+  return config;
+}
+
+// The incidence the scanner derives from its extra rays, seen through grazing dropouts whose
+// probability is the incidence / 90 deg: a level line on the wall at x = 3 m meets it at |theta|.
+TEST(SimLineScanner, IncidenceFromTheHitsIsTheWallsGeometry) {
+  auto rig = MakeRig(IncidenceProbeConfig());
   ASSERT_TRUE(rig->pitch_axis().MoveTo(0.0, kTimeout));
   // The same level line again and again; per centre angle, the beams within 2 deg of it.
   const std::vector<double> centres_deg = {-40.0, 10.0, 30.0, 50.0};
@@ -246,14 +252,7 @@ TEST(SimLineScanner, ABeamNearAFacesEdgeMeetsItAtThatFacesIncidence) {
     <geom name="wall" type="box" pos="8.05 0 1" size="0.05 5 1"/>
   </worldbody>
 </mujoco>)";
-  SimRigConfig config = QuietConfig();
-  config.lms200.noise_sigma_m = 0.001;  // not the ideal sensor: dropouts on
-  config.lms200.noise_per_m = 0.0;
-  config.lms200.incidence_noise_gain = 0.0;
-  config.lms200.dropout_far_per_m = 0.0;
-  config.lms200.dropout_grazing_deg = 0.0;
-  config.lms200.dropout_grazing_at_90 = 1.0;
-  auto rig = SimRig::FromString(kPillarWorld, "/tmp", config);
+  auto rig = SimRig::FromString(kPillarWorld, "/tmp", IncidenceProbeConfig());
   ASSERT_TRUE(rig->PlaceRobot(0.0, 0.0, 0.0));
   ASSERT_TRUE(rig->pitch_axis().MoveTo(0.0, kTimeout));
   const double laser_x = rig->sim().T_world_laser().translation().x();
