@@ -267,7 +267,11 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
                         {"false_hazard_cells", score->false_hazard_cells},
                         {"false_as", KindsJson(score->false_as)},
                         {"missed_hazard_cells", score->missed_hazard_cells},
-                        {"missed_as", KindsJson(score->missed_as)}};
+                        {"missed_as", KindsJson(score->missed_as)},
+                        {"missed_too_steep_tilt",
+                         {{"map_median_deg", score->missed_steep_map_tilt_deg},
+                          {"truth_median_deg", score->missed_steep_true_tilt_deg},
+                          {"map_unsupported", score->missed_steep_tilt_unknown}}}};
     if (std::isfinite(score->closest_hazard_m)) {
       m["closest_approach_to_forbidden_m"] = score->closest_hazard_m;
       m["closest_approach_at"] = {{"x_m", score->closest_hazard_at.x()},

@@ -69,6 +69,18 @@ double ClosestHazard(const std::vector<Eigen::Vector2d>& xy, const planning::Tra
   return best;
 }
 
+// The plane tilt of cell k of a traversability grid, atan(sqrt(tan^2 phi_x + tan^2 phi_y)) [rad].
+double GridTilt(const planning::TraversabilityGrid& g, std::size_t k) {
+  return std::atan(std::hypot(std::tan(g.phi_x_rad[k]), std::tan(g.phi_y_rad[k])));
+}
+
+// The median of `v` (the upper one of an even count), 0 when empty.
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
 }  // namespace
 
 HazardVerdict CompareHazard(const planning::TraversabilityGrid& estimated,
@@ -156,18 +168,30 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
   if (!estimated.geometry.SameAs(truth.geometry)) {
     throw std::invalid_argument("score: the estimated and the true map are on different grids");
   }
+  std::vector<double> steep_map_deg, steep_true_deg;
   for (std::size_t k = 0; k < truth.blocked.size(); ++k) {
     const HazardVerdict v = CompareHazard(estimated, truth, k);
     s.map_cells_compared += v != HazardVerdict::kNotCompared;
     if (v == HazardVerdict::kMissedHazard) {
       ++s.missed_hazard_cells;
       s.missed_as.Count(truth.blocked[k]);
+      if (truth.blocked[k] == planning::Blocked::kTooSteep) {
+        steep_true_deg.push_back(GridTilt(truth, k) * kRadToDeg);
+        // The grid holds 0 for an inclination the scan did not support (and its unknown cost).
+        if (estimated.phi_x_rad[k] == 0.0f && estimated.phi_y_rad[k] == 0.0f) {
+          ++s.missed_steep_tilt_unknown;
+        } else {
+          steep_map_deg.push_back(GridTilt(estimated, k) * kRadToDeg);
+        }
+      }
     }
     if (v == HazardVerdict::kFalseHazard) {
       ++s.false_hazard_cells;
       s.false_as.Count(estimated.blocked[k]);
     }
   }
+  s.missed_steep_map_tilt_deg = Median(steep_map_deg);
+  s.missed_steep_true_tilt_deg = Median(steep_true_deg);
   return s;
 }
 

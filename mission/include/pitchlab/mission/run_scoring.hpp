@@ -59,6 +59,12 @@ struct RunScore {
   std::size_t missed_hazard_cells = 0;  ///< free in the map, truly a hazard
   /// Of those, what the truth calls them [1].
   HazardKinds missed_as;
+  /// The missed too-steep cells' plane tilt, the map's and the truth's, medians [deg] (0 when
+  /// none): whether the map reads steep ground a little or much too level. Cells whose slope the
+  /// scan did not support have no tilt in the map (counted, not in the median).
+  double missed_steep_map_tilt_deg = 0;
+  double missed_steep_true_tilt_deg = 0;
+  std::size_t missed_steep_tilt_unknown = 0;
   /// Of hazard_cells_crossed, what the truth calls them [1].
   HazardKinds crossed_as;
 };
