@@ -86,6 +86,8 @@ struct SweepSettings {
   /// The route as runs.jsonl records it ("goal", "round-trip", "via X,Y;...", ...): a resumed
   /// sweep must drive the same.
   std::string route;
+  /// --keep failed: a successful run's folder keeps only kKeptOfSuccesses.
+  bool keep_failed_only = false;
 };
 
 /// A child process running one `pitchlab run`.
@@ -117,6 +119,11 @@ CliArgs BenchArgs() {
       .Option("jobs", "J", "runs at once", "1")
       .Option("timeout-s", "S", "wall time per run before it is killed and recorded as failed",
               "600")
+      .Option("keep", "all|failed",
+              "what stays of each run's folder: everything, or for successful runs only "
+              "metrics.json, config.yaml and the trajectories (a terrain run's folder holds "
+              "~75 MB, mostly each stop's scan.pcd; failures keep all, to be looked at)",
+              "all")
       .Option("config", "FILE.yaml", "configuration passed to every run (see README)")
       .Option("via", "x,y[;x,y...]",
               "waypoints every run drives through before the goal (as `pitchlab run --via`; "
@@ -240,6 +247,11 @@ SweepSettings ParseSweepSettings(const CliArgs& args) {
   s.jobs = static_cast<int>(jobs);
   s.timeout_s = args.GetNumbers("timeout-s", 1)[0];
   if (!(s.timeout_s > 0)) throw CliError("--timeout-s must be positive");
+  const std::string keep = args.Get("keep");
+  if (keep != "all" && keep != "failed") {
+    throw CliError("--keep must be all or failed, not '" + keep + "'");
+  }
+  s.keep_failed_only = keep == "failed";
   if (args.Has("config")) s.config = CheckConfig(args.Get("config"));
   s.config_hash = ConfigHash(s.config ? mission::ReadBinaryFile(*s.config) : std::string());
   std::vector<std::string> route;
@@ -518,6 +530,31 @@ void PrintProgress(const json& record, std::size_t done, std::size_t total) {
   std::fprintf(stderr, ")\n");
 }
 
+/// What a successful run's folder keeps with --keep failed: its numbers and what it was run with,
+/// and the trajectories (small, and what trajectory-evaluation tools read).
+const char* const kKeptOfSuccesses[] = {
+    "metrics.json",         "config.yaml",         "trajectory_true.csv",
+    "trajectory_true.tum",  "trajectories.geojson", "trajectory_estimated.csv",
+    "trajectory_estimated.tum", "trajectory_estimated_live.tum"};
+
+/// Removes everything but kKeptOfSuccesses from a finished run's folder; what cannot be removed is
+/// said on stderr (the sweep goes on: its records are complete without the files).
+void PruneRun(const fs::path& dir) {
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (std::find(std::begin(kKeptOfSuccesses), std::end(kKeptOfSuccesses), name) !=
+        std::end(kKeptOfSuccesses)) {
+      continue;
+    }
+    std::error_code rm;
+    fs::remove_all(it->path(), rm);
+    if (rm) std::fprintf(stderr, "bench: cannot remove %s: %s\n", it->path().c_str(),
+                         rm.message().c_str());
+  }
+  if (ec) std::fprintf(stderr, "bench: cannot list %s: %s\n", dir.c_str(), ec.message().c_str());
+}
+
 /// A run whose folder was committed but never recorded (the bench died in between).
 json RecoveredRecord(const SweepSettings& s, const BenchRun& run) {
   const json metrics = ReadMetrics(RunDir(s.out, run));
@@ -566,6 +603,9 @@ void RunSweep(const SweepSettings& s, const std::vector<BenchRun>& pending, Reco
   std::size_t next = 0, done = 0;
   const auto finish = [&](const json& record) {
     log.Append(record);
+    if (s.keep_failed_only && record.value("success", false)) {
+      PruneRun(s.out / record["run_dir"].get<std::string>());
+    }
     ++done;
     if (!quiet) PrintProgress(record, done, pending.size());
   };

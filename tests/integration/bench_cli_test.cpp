@@ -175,6 +175,36 @@ TEST_F(BenchCli, FailingRunsAreRecordedWithTheirReasonAndTheOthersFinish) {
   EXPECT_TRUE(fs::is_empty(dir_ / "slow/runs"));
 }
 
+// --keep failed: a successful run keeps its numbers, config and trajectories; a failed one keeps
+// everything, to be looked at.
+TEST_F(BenchCli, KeepFailedLeavesSuccessesTheirMetricsAndFailuresEverything) {
+  const CliResult ok = Exec("--quiet --keep failed --worlds " + kYard.string() +
+                            " --seeds 4 --out " + (dir_ / "keep").string());
+  ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  ASSERT_TRUE(Records(dir_ / "keep").at(0)["success"].get<bool>());
+  std::set<std::string> left;
+  for (const auto& e : fs::directory_iterator(dir_ / "keep/runs/yard-s4")) {
+    left.insert(e.path().filename().string());
+  }
+  EXPECT_EQ(left, (std::set<std::string>{"config.yaml", "metrics.json", "trajectories.geojson",
+                                         "trajectory_estimated.csv", "trajectory_estimated.tum",
+                                         "trajectory_true.csv", "trajectory_true.tum"}));
+
+  std::ofstream(dir_ / "keep_budget.yaml") << "run: {time_budget_s: 1}\n";
+  const CliResult failed =
+      Exec("--quiet --keep failed --worlds " + kYard.string() + " --seeds 1 --config " +
+           (dir_ / "keep_budget.yaml").string() + " --out " + (dir_ / "keep_failed").string());
+  ASSERT_EQ(failed.exit_code, 0) << failed.err;
+  EXPECT_FALSE(Records(dir_ / "keep_failed").at(0)["success"].get<bool>());
+  EXPECT_TRUE(fs::exists(dir_ / "keep_failed/runs/yard-s1/report.html"));
+  EXPECT_TRUE(fs::exists(dir_ / "keep_failed/runs/yard-s1/stops"));
+
+  const CliResult bad = Exec("--keep some --worlds " + kYard.string() + " --seeds 1 --out " +
+                             (dir_ / "keep_bad").string());
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--keep must be all or failed"), std::string::npos) << bad.err;
+}
+
 TEST_F(BenchCli, ARoundTripSweepDrivesEveryRunToTheGoalAndBackAndResumesOnlyTheSameRoute) {
   const fs::path out = dir_ / "round_trip";
   const std::string sweep = "--quiet --worlds " + kYard.string() + " --out " + out.string();
