@@ -162,6 +162,30 @@ TEST(ElevationMap, AWallsFootInANeighbourDoesNotTiltTheFloorBesideIt) {
   }
 }
 
+// The slope of a region is the ground's, not where the scanner put its points: a mound whose flank
+// rises 35 deg from x = 1.0, the flat ground before it seen densely (2 cm lattice) and the flank
+// sparsely (one point a cell, as from behind the mound). The cell at the foot reads what the same
+// ground sampled evenly reads (one point a cell everywhere: 27.7 deg); pooled by point it read
+// 19.0 deg, the dense flat side outweighing the flank.
+TEST(ElevationMap, ARegionsSlopeCountsEachCellOnceHoweverDenselyItWasSeen) {
+  const double grade = std::tan(35.0 * M_PI / 180.0);
+  const auto ground = [&](double x, double) { return x < 1.0 ? 0.0 : grade * (x - 1.0); };
+  auto dense = Lattice(0, 1.0, 0, 2, 0.02, ground);        // the flat side, ~25 points a cell
+  const auto sparse = Lattice(1.0, 2, 0, 2, 0.1, ground);  // the flank, one a cell
+  const auto even = Lattice(0, 2, 0, 2, 0.1, ground);      // every cell alike
+  dense.insert(dense.end(), sparse.begin(), sparse.end());
+  ElevationMap seen(GridGeometry::FromArea(0, 0, 2, 2, 0.1)), evenly(seen.geometry());
+  (void)seen.InsertPoints(dense.data(), dense.size());
+  (void)evenly.InsertPoints(even.data(), even.size());
+  const ElevationLayers L = ComputeLayers(seen), E = ComputeLayers(evenly);
+  const std::size_t foot = L.geometry.Linear(L.geometry.IndexOf(1.05, 1.05));
+  ASSERT_GT(L.count[L.geometry.Linear(L.geometry.IndexOf(0.95, 1.05))], 20u);
+  ASSERT_EQ(L.count[foot], 1u);
+  EXPECT_GT(E.Tilt(foot), 16.0 * M_PI / 180.0);  // the evenly seen foot: too steep to drive
+  EXPECT_NEAR(L.Tilt(foot), E.Tilt(foot), 1.0 * M_PI / 180.0)
+      << L.Tilt(foot) * 180 / M_PI << " deg against " << E.Tilt(foot) * 180 / M_PI;
+}
+
 TEST(ElevationMap, PlaneResidualIsZeroOnATiltedPlaneAndAQuarterOfAStepInside) {
   const GridGeometry g = GridGeometry::FromArea(0, 0, 1, 1, 0.5);
   ElevationMap map(g);

@@ -2,9 +2,13 @@
 // The layers users and the planner read, derived from an ElevationMap's running statistics:
 // mean height (Eq. 2), roughness T (Eq. 3), inclination phi_x, phi_y, and what is known.
 //
-// Inclination: a least-squares plane z = a + b x + c y through all points of the cell and its
-// neighbours (the 3 x 3 cell region by default, LayerConfig::inclination_radius_cells), computed from the pooled co-moments (no point is re-read):
-// phi_x = atan(b), phi_y = atan(c). When the pooled points do not span the plane (fewer than 3, or
+// Inclination: a least-squares plane z = a + b x + c y through the points of the cell and its
+// neighbours (the 3 x 3 cell region by default, LayerConfig::inclination_radius_cells), computed
+// from the cells' co-moments (no point is re-read) with each cell counted once (its points'
+// spread scaled to one point's worth): the ground's slope, not where the scanner put its points
+// (pooled by point, a dense flat patch outweighed a mound's sparsely seen flank: 25-37 deg read
+// as 5-15, and robots tipped over there). phi_x = atan(b), phi_y = atan(c). Whether the scan
+// determined a slope at all is judged on the points pooled. When they do not span the plane (fewer than 3, or
 // all on one line, e.g. a single scan line), the same fit is made through the centres of the known
 // cells of the region at their mean heights; with fewer than 3 non-collinear known cells the
 // inclination is unknown (NaN). A neighbour whose mean differs from the cell's by more than
