@@ -5,18 +5,13 @@
 #include <utility>
 
 #include "pitchlab/mapping/elevation_layers.hpp"
+#include "upper_median.hpp"
 
 namespace pitchlab::mission {
 namespace {
 
 constexpr int kMinPointsPerCell = 3;
 constexpr double kMinInlierBand_m = 0.05;
-
-double Median(std::vector<double> v) {
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
 
 }  // namespace
 
@@ -57,10 +52,10 @@ std::optional<HeightOffset> FitHeightOffset(const mapping::ElevationMap& map,
     b = e;
   }
   if (static_cast<int>(diff.size()) < min_cells) return std::nullopt;
-  const double median = Median(diff);
+  const double median = UpperMedian(diff);
   std::vector<double> spread;
   for (const double d : diff) spread.push_back(std::abs(d - median));
-  const double band = std::max(3.0 * 1.4826 * Median(spread), kMinInlierBand_m);
+  const double band = std::max(3.0 * 1.4826 * UpperMedian(spread), kMinInlierBand_m);
   HeightOffset out;
   double sum = 0;
   for (const double d : diff) {

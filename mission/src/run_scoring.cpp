@@ -1,5 +1,6 @@
 #include "pitchlab/mission/run_scoring.hpp"
 #include "pitchlab/mission/waypoint_route.hpp"
+#include "upper_median.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -67,18 +68,6 @@ double ClosestHazard(const std::vector<Eigen::Vector2d>& xy, const planning::Tra
     }
   }
   return best;
-}
-
-// The plane tilt of cell k of a traversability grid, atan(sqrt(tan^2 phi_x + tan^2 phi_y)) [rad].
-double GridTilt(const planning::TraversabilityGrid& g, std::size_t k) {
-  return std::atan(std::hypot(std::tan(g.phi_x_rad[k]), std::tan(g.phi_y_rad[k])));
-}
-
-// The median of `v` (the upper one of an even count), 0 when empty.
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
 }
 
 }  // namespace
@@ -176,12 +165,12 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
       ++s.missed_hazard_cells;
       s.missed_as.Count(truth.blocked[k]);
       if (truth.blocked[k] == planning::Blocked::kTooSteep) {
-        steep_true_deg.push_back(GridTilt(truth, k) * kRadToDeg);
+        steep_true_deg.push_back(truth.Tilt(k) * kRadToDeg);
         // The grid holds 0 for an inclination the scan did not support (and its unknown cost).
         if (estimated.phi_x_rad[k] == 0.0f && estimated.phi_y_rad[k] == 0.0f) {
           ++s.missed_steep_tilt_unknown;
         } else {
-          steep_map_deg.push_back(GridTilt(estimated, k) * kRadToDeg);
+          steep_map_deg.push_back(estimated.Tilt(k) * kRadToDeg);
         }
       }
     }
@@ -190,8 +179,8 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
       s.false_as.Count(estimated.blocked[k]);
     }
   }
-  s.missed_steep_map_tilt_deg = Median(steep_map_deg);
-  s.missed_steep_true_tilt_deg = Median(steep_true_deg);
+  s.missed_steep_map_tilt_deg = steep_map_deg.empty() ? 0.0 : UpperMedian(steep_map_deg);
+  s.missed_steep_true_tilt_deg = steep_true_deg.empty() ? 0.0 : UpperMedian(steep_true_deg);
   return s;
 }
 

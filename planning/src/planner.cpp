@@ -69,11 +69,6 @@ std::string Where(const Eigen::Vector2d& p) {
   return os.str();
 }
 
-double TiltOf(const TraversabilityGrid& T, std::size_t k) {
-  const double tx = std::tan(T.phi_x_rad[k]), ty = std::tan(T.phi_y_rad[k]);
-  return std::atan(std::sqrt(tx * tx + ty * ty));
-}
-
 // One search's labels: tentative cost and a visited bit per cell. The costs are padded by a row
 // and a cell on either side, so that k + delta of every move of every cell k is inside the array
 // (a move off the grid costs +inf and never wins: no bounds test). No parent pointers: the path
@@ -303,7 +298,7 @@ Path Reconstruct(const TraversabilityGrid& T, const Labels& L, std::uint32_t sta
     path.cells.push_back(c);
     path.waypoints.push_back({xy.x(), xy.y(), T.z_m[ks[n]]});
     if (std::isfinite(T.z_m[ks[n]]))
-      path.max_inclination_rad = std::max(path.max_inclination_rad, TiltOf(T, ks[n]));
+      path.max_inclination_rad = std::max(path.max_inclination_rad, T.Tilt(ks[n]));
     if (n == 0) continue;
     const CellIndex p = g.FromLinear(ks[n - 1]);
     CostParts before = path.parts;

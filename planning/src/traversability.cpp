@@ -371,6 +371,10 @@ TraversabilityGrid BuildTraversability(const ElevationLayers& L, const PlannerCo
   return T;
 }
 
+double TraversabilityGrid::Tilt(std::size_t k) const {
+  return std::atan(std::hypot(std::tan(phi_x_rad[k]), std::tan(phi_y_rad[k])));
+}
+
 void BuildTraversabilityInto(const ElevationLayers& L, const PlannerConfig& config,
                              TraversabilityGrid& T) {
   config.Validate();

@@ -162,6 +162,9 @@ struct TraversabilityGrid {
   std::vector<bool> line_gap;
 
   bool Free(std::size_t k) const { return blocked[k] == Blocked::kFree; }
+  /// Plane tilt of cell k, atan(sqrt(tan^2 phi_x + tan^2 phi_y)) [rad]; 0 where the inclination
+  /// is unknown (phi held at 0).
+  double Tilt(std::size_t k) const;
 };
 
 /// Classifies every cell and precomputes its entry cost. Throws std::invalid_argument on a bad
