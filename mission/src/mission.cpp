@@ -21,6 +21,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kMinProgress_m = 0.05;   // less than this over stuck_timeout_s is no progress
+constexpr double kMinTurnProgress_rad = 0.1;  // ... and less turn than this
 constexpr double kStopTime_s = 0.5;       // braking before a scan
 constexpr double kEscapeRadius_m = 1.0;   // how far a start inside a hazard margin looks out
 constexpr double kGoalApproach_m = 2.0;   // a blocked goal farther than this: approach it
@@ -166,11 +167,13 @@ class Mission {
   Result<sensors::Scan3D> AcquireScan();
   bool Drive(const StopRecord& stop);
   bool Follow(const planning::Path& path, double length_m);
-  // Marks the ground ahead as felt (`obstacle`: the tilt came from something it ran onto), then
-  // backs off. false: the mission ends.
-  bool BackOff(const sensors::Odometry& odo, double tilt_rad, bool obstacle);
-  // Drives back kBackOff_m the way it came (or as far as it goes). false: the mission ends.
-  bool DriveBack(const sensors::Odometry& odo);
+  // Marks the ground it was driving onto as felt (`obstacle`: the tilt came from something it ran
+  // onto), then backs off. `reversing`: it was driving backwards. false: the mission ends.
+  bool BackOff(const sensors::Odometry& odo, double tilt_rad, bool obstacle,
+               bool reversing = false);
+  // Drives kBackOff_m back the way it came (or as far as it goes): in reverse, or `forwards`
+  // when it came in reverse. false: the mission ends.
+  bool DriveBack(const sensors::Odometry& odo, bool forwards = false);
   std::optional<Eigen::Vector2d> Attitude() const {
     if (!probes_.roll_pitch_rad) return std::nullopt;
     return probes_.roll_pitch_rad();
@@ -807,6 +810,7 @@ bool Mission::Follow(const planning::Path& path, double length_m) {
   sensors::Odometry odo = odo_ref_;
   if (Result<sensors::Odometry> now = base_.ReadOdometry(); now) odo = *now;
   Eigen::Vector2d progress_xy(odo.x_m, odo.y_m);
+  double progress_yaw = odo.yaw_rad;
   double progress_s = probes_.now_s();
   while (true) {
     if (OverBudget()) return false;
@@ -814,12 +818,13 @@ bool Mission::Follow(const planning::Path& path, double length_m) {
     DriveCommand cmd =
         follower.Command(T_est.translation().x(), T_est.translation().y(), Yaw(T_est));
     if (cmd.done) return true;
+    const bool reversing = follower.reversing();
     const double tilt = Tilt();
-    if (tilt > config_.caution_tilt_deg * kPi / 180) return BackOff(odo, tilt, false);
+    if (tilt > config_.caution_tilt_deg * kPi / 180) return BackOff(odo, tilt, false, reversing);
     const double arc = prefix_m - follower.remaining_m();
     // A tilt the planned ground does not explain is something the robot ran onto.
     if (tilt > std::atan(grade.Max(arc - 0.5, arc + 0.5)) + kUnexpectedTilt_rad) {
-      return BackOff(odo, tilt, true);
+      return BackOff(odo, tilt, true, reversing);
     }
     // Speed and turn rate scale together, so the robot stays on the follower's arc. Turning fast
     // while driving fast makes the skid-steer P3-AT brake its inner wheels hard and a top-heavy
@@ -844,8 +849,12 @@ bool Mission::Follow(const planning::Path& path, double length_m) {
     result_.odometry_distance_m += std::hypot(next->x_m - odo.x_m, next->y_m - odo.y_m);
     odo = *next;
     if (!RecordSample(odo)) return false;
-    if ((Eigen::Vector2d(odo.x_m, odo.y_m) - progress_xy).norm() > kMinProgress_m) {
+    // Turning on the spot is progress too: half a turn at the slope's yaw rate outlasts the
+    // stuck timeout (terrain seed 196 was "stuck" turning round on a 7 deg flank).
+    if ((Eigen::Vector2d(odo.x_m, odo.y_m) - progress_xy).norm() > kMinProgress_m ||
+        std::abs(std::remainder(odo.yaw_rad - progress_yaw, 2.0 * kPi)) > kMinTurnProgress_rad) {
       progress_xy = Eigen::Vector2d(odo.x_m, odo.y_m);
+      progress_yaw = odo.yaw_rad;
       progress_s = probes_.now_s();
     } else if (probes_.now_s() - progress_s > config_.stuck_timeout_s) {
       result_.reason = "stuck: no progress for " + std::to_string(config_.stuck_timeout_s) + " s";
@@ -854,10 +863,12 @@ bool Mission::Follow(const planning::Path& path, double length_m) {
   }
 }
 
-// Reverses straight out of a tilt beyond caution and remembers the ground ahead as too steep.
-bool Mission::BackOff(const sensors::Odometry& odo, double tilt_rad, bool obstacle) {
+// Backs straight out of a tilt beyond caution (forwards when it was reversing) and remembers the
+// ground it was driving onto as too steep.
+bool Mission::BackOff(const sensors::Odometry& odo, double tilt_rad, bool obstacle,
+                      bool reversing) {
   const Eigen::Isometry3d T = Estimate(odo);
-  const double heading = Yaw(T);
+  const double heading = Yaw(T) + (reversing ? kPi : 0.0);  // the way it was going
   FeltHazard felt;
   felt.centre_m = T.translation().head<2>() +
                   kFeltAhead_m * Eigen::Vector2d(std::cos(heading), std::sin(heading));
@@ -872,10 +883,10 @@ bool Mission::BackOff(const sensors::Odometry& odo, double tilt_rad, bool obstac
                 tilt_rad * 180 / kPi, T.translation().x(), T.translation().y(),
                 obstacle ? "ran onto something ahead" : "the ground ahead is too steep");
   Progress(line);
-  return DriveBack(odo);
+  return DriveBack(odo, reversing);
 }
 
-bool Mission::DriveBack(const sensors::Odometry& odo) {
+bool Mission::DriveBack(const sensors::Odometry& odo, bool forwards) {
   const Eigen::Vector2d from(odo.x_m, odo.y_m);
   const double start_s = probes_.now_s();
   // Reversing blind over a rim or into a hollow can tilt it more than what it backs away from:
@@ -888,7 +899,8 @@ bool Mission::DriveBack(const sensors::Odometry& odo) {
     if (OverBudget()) return false;
     if (probes_.now_s() - start_s > config_.stuck_timeout_s) break;  // as far as it goes
     if (Tilt() > stop_tilt) break;
-    Result<sensors::Odometry> next = DriveBase(-kBackOffSpeed_mps, 0.0, config_.control_period_s);
+    Result<sensors::Odometry> next =
+        DriveBase(forwards ? kBackOffSpeed_mps : -kBackOffSpeed_mps, 0.0, config_.control_period_s);
     if (!next) {
       result_.reason = "base: " + next.error().message;
       return false;

@@ -7,6 +7,9 @@
 #include <stdexcept>
 
 namespace pitchlab::mission {
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+}  // namespace
 
 void PurePursuitConfig::Validate() const {
   auto positive = [](const char* name, double v) {
@@ -79,7 +82,15 @@ DriveCommand PurePursuit::Command(double x_m, double y_m, double yaw_rad) {
   const Eigen::Vector2d target = PointAt(progress_m_ + config_.lookahead_m);
   const Eigen::Vector2d d = target - p;
   const double c = std::cos(yaw_rad), s = std::sin(yaw_rad);
-  const double dx = c * d.x() + s * d.y(), dy = -s * d.x() + c * d.y();  // in the robot frame
+  double dx = c * d.x() + s * d.y(), dy = -s * d.x() + c * d.y();  // in the robot frame
+  if (direction_ == 0) {
+    direction_ = config_.reverse && std::abs(std::atan2(dy, dx)) > kPi - config_.turn_in_place_rad
+                     ? -1
+                     : 1;
+  }
+  // Reversing, the robot is a unicycle heading yaw + pi whose forward speed is -v: steer that one.
+  dx *= direction_;
+  dy *= direction_;
   const double heading_error = std::atan2(dy, dx);
   DriveCommand cmd;
   if (std::abs(heading_error) > config_.turn_in_place_rad) {
@@ -93,7 +104,7 @@ DriveCommand PurePursuit::Command(double x_m, double y_m, double yaw_rad) {
   if (std::abs(curvature) > 1e-9) v = std::min(v, config_.max_yaw_rate_rps / std::abs(curvature));
   // Slow while the heading is off, so the robot turns onto the path before it runs.
   v *= std::max(0.0, std::cos(heading_error));
-  cmd.v_mps = v;
+  cmd.v_mps = direction_ * v;
   cmd.omega_rps = std::clamp(v * curvature, -config_.max_yaw_rate_rps, config_.max_yaw_rate_rps);
   return cmd;
 }

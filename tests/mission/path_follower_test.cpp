@@ -26,7 +26,7 @@ int Follow(PurePursuit& follower, Unicycle& robot, const PurePursuitConfig& conf
   for (int step = 0; step < 20000; ++step) {
     const DriveCommand c = follower.Command(robot.x, robot.y, robot.yaw);
     EXPECT_LE(std::abs(c.omega_rps), config.max_yaw_rate_rps + 1e-12);
-    EXPECT_GE(c.v_mps, 0.0);
+    EXPECT_EQ(c.v_mps < 0, follower.reversing()) << "drives one way all along";
     if (max_speed) *max_speed = std::max(*max_speed, c.v_mps);
     if (c.done) return step;
     robot.Apply(c);
@@ -45,15 +45,58 @@ TEST(PurePursuit, DrivesAStraightPathToItsEndWithinTolerance) {
   EXPECT_NEAR(max_speed, config.max_speed_mps, 1e-9);
 }
 
-TEST(PurePursuit, TurnsOnTheSpotWhenThePathStartsBehind) {
+TEST(PurePursuit, WithoutReverseTurnsOnTheSpotWhenThePathStartsBehind) {
   PurePursuitConfig config;
+  config.reverse = false;
   PurePursuit follower({{0, 0}, {-3, 0}}, config);
   Unicycle robot;
   const DriveCommand first = follower.Command(0, 0, 0);
   EXPECT_EQ(first.v_mps, 0.0);
   EXPECT_NEAR(std::abs(first.omega_rps), config.max_yaw_rate_rps, 1e-12);
+  EXPECT_FALSE(follower.reversing());
   ASSERT_GT(Follow(follower, robot, config), 0);
   EXPECT_NEAR(robot.x, -3.0, config.goal_tolerance_m);
+}
+
+// A skid-steer robot turning on the spot on a slope slides downhill: a path that starts behind it
+// is driven backwards, with no turn, and its bends are followed as closely as forwards.
+TEST(PurePursuit, ReversesAlongAPathThatStartsBehindWithoutTurningOnTheSpot) {
+  PurePursuitConfig config;
+  const std::vector<Eigen::Vector2d> path = {{0, 0}, {-3, 0}, {-3, -2}};
+  PurePursuit follower(path, config);
+  Unicycle robot;
+  const DriveCommand first = follower.Command(0, 0, 0);
+  EXPECT_LT(first.v_mps, 0.0);
+  EXPECT_TRUE(follower.reversing());
+  double worst_m = 0;
+  int steps = 0;
+  for (; steps < 5000; ++steps) {
+    const DriveCommand c = follower.Command(robot.x, robot.y, robot.yaw);
+    if (c.done) break;
+    EXPECT_LE(c.v_mps, 0.0);
+    robot.Apply(c);
+    const double d1 = robot.x >= -3 ? std::abs(robot.y) : std::hypot(robot.x + 3, robot.y);
+    const double d2 = robot.y <= 0 ? std::abs(robot.x + 3) : std::hypot(robot.x + 3, robot.y);
+    worst_m = std::max(worst_m, std::min(d1, d2));
+    if (robot.x > -2.5) EXPECT_NEAR(robot.yaw, 0.0, 1e-9) << "no turn on the straight";
+  }
+  ASSERT_LT(steps, 5000);
+  EXPECT_NEAR(robot.x, -3.0, config.goal_tolerance_m);
+  EXPECT_NEAR(robot.y, -2.0, config.goal_tolerance_m);
+  EXPECT_LT(worst_m, config.lookahead_m / 2);
+  // Backing round the bend to the right (-y) turns the robot's nose to the left (+yaw).
+  EXPECT_NEAR(robot.yaw, kPi / 2, 0.3);
+}
+
+// A path off to the side is still driven forwards: only one that a turn on the spot would start
+// is reversed along.
+TEST(PurePursuit, APathToTheSideIsDrivenForwards) {
+  PurePursuitConfig config;
+  PurePursuit follower({{0, 0}, {0, 3}}, config);
+  Unicycle robot;
+  ASSERT_GT(Follow(follower, robot, config), 0);
+  EXPECT_FALSE(follower.reversing());
+  EXPECT_NEAR(robot.y, 3.0, config.goal_tolerance_m);
 }
 
 TEST(PurePursuit, FollowsAnLShapedPathClosely) {

@@ -15,6 +15,13 @@ struct PurePursuitConfig {
   double max_decel_mps2 = 0.4;     ///< slow down to stop at the path's end [m/s^2]
   double turn_in_place_rad = 1.2;  ///< heading error beyond which the robot turns on the spot [rad]
   double goal_tolerance_m = 0.15;  ///< the end is reached within this distance [m]
+  /// A path that starts so far behind the robot that it would turn on the spot (heading error
+  /// beyond pi - turn_in_place_rad) is followed in reverse instead, all the way. A skid-steer
+  /// robot turning on the spot on a slope slides downhill (the simulated P3-AT: 0.12 m per quarter
+  /// turn on 10 deg; terrain seeds 205 and 219 slid 0.3 m into a crack turning round on a 7 deg
+  /// flank), and a plan that starts behind the robot is mostly the way back out of a place the
+  /// last scan showed hemmed in. The ground behind is in the map the path was planned on.
+  bool reverse = true;
 
   /// Throws std::invalid_argument naming the field and value.
   void Validate() const;
@@ -38,6 +45,8 @@ class PurePursuit {
   DriveCommand Command(double x_m, double y_m, double yaw_rad);
   /// Path length not yet passed [m].
   double remaining_m() const { return remaining_m_; }
+  /// True when the follower drives the path backwards (decided at the first command).
+  bool reversing() const { return direction_ < 0; }
 
  private:
   std::vector<Eigen::Vector2d> path_;
@@ -45,6 +54,7 @@ class PurePursuit {
   PurePursuitConfig config_;
   double progress_m_ = 0.0;    ///< arc length of the closest point so far [m]
   double remaining_m_ = 0.0;
+  int direction_ = 0;          ///< +1 forwards, -1 in reverse, 0 before the first command
 
   Eigen::Vector2d PointAt(double arc_m) const;
   double ClosestArc(const Eigen::Vector2d& p, double from_arc_m, double window_m) const;
