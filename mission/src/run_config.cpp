@@ -116,6 +116,9 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
       } else if (key == "set_lines_right") {
         // MissionConfig::set_lines_right; off by default, as every figure was measured.
         m.set_lines_right = kv.second.as<bool>();
+      } else if (key == "reverse") {
+        // PurePursuitConfig::reverse: a path that starts behind is driven backwards; on by default.
+        m.follower.reverse = kv.second.as<bool>();
       } else if (key == "algorithm") {
         m.algorithm = planning::ParseAlgorithm(kv.second.as<std::string>());
       } else if (auto it = numbers.find(key); it != numbers.end()) {
@@ -254,6 +257,7 @@ std::string RunSettingsToYaml(const RunSettings& s) {
      << "  lookahead_m: " << m.follower.lookahead_m << "\n"
      << "  max_speed_mps: " << m.follower.max_speed_mps << "\n"
      << "  max_yaw_rate_rps: " << m.follower.max_yaw_rate_rps << "\n"
+     << "  reverse: " << (m.follower.reverse ? "true" : "false") << "\n"
      << "planner:\n"
      << "  robot: " << p.robot.name << "\n"
      << "  step_max_m: " << p.robot.step_max_m << "\n"

@@ -186,6 +186,16 @@ TEST(RunSettings, TheMountIsCalibratedUnlessTheRunSectionSaysNo) {
                std::invalid_argument);
 }
 
+TEST(RunSettings, APathBehindIsDrivenInReverseUnlessTheRunSectionSaysNo) {
+  EXPECT_TRUE(ParseRunSettings("", "f.yaml", sim::P3Model::kP3AT).mission.follower.reverse);
+  const RunSettings off = ParseRunSettings("run: {reverse: false}\n", "f.yaml", sim::P3Model::kP3AT);
+  EXPECT_FALSE(off.mission.follower.reverse);
+  EXPECT_FALSE(
+      ParseRunSettings(RunSettingsToYaml(off), "back", sim::P3Model::kP3AT).mission.follower.reverse);
+  EXPECT_THROW(ParseRunSettings("run: {reverse: 1m}\n", "f.yaml", sim::P3Model::kP3AT),
+               std::invalid_argument);
+}
+
 TEST(RunSettings, WrittenYamlReadsBackTheSame) {
   const RunSettings s = ParseRunSettings(
       "run: {goal_tolerance_m: 0.3, odometry_error_m: 0.2, tilt_tolerance_deg: 0.8}\n"

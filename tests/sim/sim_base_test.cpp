@@ -82,6 +82,27 @@ TEST(SimBase, P3AtSkidSteerTurnsRoughlyNinetyDegrees) {
   EXPECT_NEAR(odo->yaw_rad, turned, 0.1 * turned);  // skid-steer slip: a looser bound
 }
 
+// Turning on the spot, every wheel of a skid-steer base slips sideways, so friction no longer
+// holds the robot against the slope's pull: it slides downhill as it turns. Coulomb friction
+// (mu ~ 1) and a wheel 0.13 m from the axle's centre give a few centimetres per quarter turn on
+// 10 deg; the simulator's soft contacts slide more. The follower reverses along a path behind the
+// robot rather than turn round (path_follower.hpp) because of this.
+TEST(SimBase, P3AtTurningOnTheSpotOnASlopeSlidesDownhill) {
+  RobotConfig robot;
+  robot.model = P3Model::kP3AT;
+  auto sim = Simulation::FromString(testing::kBoxFloorWorld, "/tmp", robot);
+  Result<Eigen::Isometry3d> pose = sim->PlaceRobot(-5.0, 0.0, 1.0);  // the 10 deg ramp, across it
+  ASSERT_TRUE(pose) << pose.error().message;
+  SimBase base(*sim);
+  ASSERT_TRUE(base.Drive(0.0, 0.0, 1.0));
+  const Eigen::Vector3d before = sim->T_world_base().translation();
+  ASSERT_TRUE(base.Drive(0.0, 0.3, M_PI / 2 / 0.3));
+  const Eigen::Vector3d moved = sim->T_world_base().translation() - before;
+  EXPECT_GT(moved.x(), 0.03) << "downhill is +x on the ramp";
+  EXPECT_LT(moved.x(), 0.3);
+  EXPECT_LT(std::abs(moved.y()), 0.5 * moved.x()) << "mostly straight down the slope";
+}
+
 TEST(SimBase, ClampsToTheP3Limits) {
   Rig s = Make(P3Model::kP3AT);
   Result<sensors::Odometry> odo = s.base->Drive(5.0, 0.0, 2.5);
