@@ -822,8 +822,13 @@ bool Mission::Follow(const planning::Path& path, double length_m) {
     const double tilt = Tilt();
     if (tilt > config_.caution_tilt_deg * kPi / 180) return BackOff(odo, tilt, false, reversing);
     const double arc = prefix_m - follower.remaining_m();
-    // A tilt the planned ground does not explain is something the robot ran onto.
-    if (tilt > std::atan(grade.Max(arc - 0.5, arc + 0.5)) + kUnexpectedTilt_rad) {
+    // A tilt the planned ground does not explain is something the robot ran onto. The ground
+    // explains its grade along the path and its cells' tilt across it: on a side slope the path
+    // is level and the robot rolls by the slope (terrain seed 7 rolled 15.7 deg on a 16 deg flank
+    // it had planned along, "ran onto something", and the obstacle it marked closed the way).
+    const double explained = std::max(std::atan(grade.Max(arc - 0.5, arc + 0.5)),
+                                      grade.MaxTilt(grid_, arc - 0.5, arc + 0.5));
+    if (tilt > explained + kUnexpectedTilt_rad) {
       return BackOff(odo, tilt, true, reversing);
     }
     // Speed and turn rate scale together, so the robot stays on the follower's arc. Turning fast

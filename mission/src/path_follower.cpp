@@ -50,8 +50,7 @@ Eigen::Vector2d PurePursuit::PointAt(double arc_m) const {
 
 // Arc length of the path point closest to p, searched in [from, from + window] so that a path
 // passing near itself does not make the robot jump ahead or back.
-double PurePursuit::ClosestArc(const Eigen::Vector2d& p, double from_arc_m,
-                               double window_m) const {
+double PurePursuit::ClosestArc(const Eigen::Vector2d& p, double from_arc_m, double window_m) const {
   double best_arc = from_arc_m, best_d2 = std::numeric_limits<double>::infinity();
   for (std::size_t i = 1; i < path_.size(); ++i) {
     if (arc_m_[i] < from_arc_m || arc_m_[i - 1] > from_arc_m + window_m) continue;
@@ -84,9 +83,8 @@ DriveCommand PurePursuit::Command(double x_m, double y_m, double yaw_rad) {
   const double c = std::cos(yaw_rad), s = std::sin(yaw_rad);
   double dx = c * d.x() + s * d.y(), dy = -s * d.x() + c * d.y();  // in the robot frame
   if (direction_ == 0) {
-    direction_ = config_.reverse && std::abs(std::atan2(dy, dx)) > kPi - config_.turn_in_place_rad
-                     ? -1
-                     : 1;
+    direction_ =
+        config_.reverse && std::abs(std::atan2(dy, dx)) > kPi - config_.turn_in_place_rad ? -1 : 1;
   }
   // Reversing, the robot is a unicycle heading yaw + pi whose forward speed is -v: steer that one.
   dx *= direction_;

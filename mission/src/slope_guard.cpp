@@ -34,6 +34,20 @@ double PathGrade::Max(double from_m, double to_m) const {
   return grade;
 }
 
+double PathGrade::MaxTilt(const planning::TraversabilityGrid& grid, double from_m,
+                          double to_m) const {
+  const std::vector<planning::Waypoint>& w = path_.waypoints;
+  double tilt = 0;
+  for (std::size_t i = 0; i < arc_m_.size() && arc_m_[i] <= to_m; ++i) {
+    if (arc_m_[i] < from_m) continue;
+    const mapping::CellIndex c = grid.geometry.IndexOf(w[i].x_m, w[i].y_m);
+    if (!grid.geometry.Contains(c)) continue;
+    const double t = grid.Tilt(grid.geometry.Linear(c));
+    if (std::isfinite(t)) tilt = std::max(tilt, t);
+  }
+  return tilt;
+}
+
 double MaxGrade(const planning::Path& path, double from_m, double to_m, double baseline_m) {
   return PathGrade(path, baseline_m).Max(from_m, to_m);
 }

@@ -169,8 +169,8 @@ TEST(RunSettings, LinesAreSetRightOnlyWhenTheRunSectionAsks) {
   const RunSettings on =
       ParseRunSettings("run: {set_lines_right: true}\n", "f.yaml", sim::P3Model::kP3DX);
   EXPECT_TRUE(on.mission.set_lines_right);
-  EXPECT_TRUE(ParseRunSettings(RunSettingsToYaml(on), "back", sim::P3Model::kP3DX)
-                  .mission.set_lines_right);
+  EXPECT_TRUE(
+      ParseRunSettings(RunSettingsToYaml(on), "back", sim::P3Model::kP3DX).mission.set_lines_right);
   EXPECT_THROW(ParseRunSettings("run: {set_lines_right: 2deg}\n", "f.yaml", sim::P3Model::kP3DX),
                std::invalid_argument);
 }
@@ -180,18 +180,19 @@ TEST(RunSettings, TheMountIsCalibratedUnlessTheRunSectionSaysNo) {
   const RunSettings off =
       ParseRunSettings("run: {calibrate_mount: false}\n", "f.yaml", sim::P3Model::kP3AT);
   EXPECT_FALSE(off.mission.calibrate_mount);
-  EXPECT_FALSE(
-      ParseRunSettings(RunSettingsToYaml(off), "back", sim::P3Model::kP3AT).mission.calibrate_mount);
+  EXPECT_FALSE(ParseRunSettings(RunSettingsToYaml(off), "back", sim::P3Model::kP3AT)
+                   .mission.calibrate_mount);
   EXPECT_THROW(ParseRunSettings("run: {calibrate_mount: often}\n", "f.yaml", sim::P3Model::kP3AT),
                std::invalid_argument);
 }
 
 TEST(RunSettings, APathBehindIsDrivenInReverseUnlessTheRunSectionSaysNo) {
   EXPECT_TRUE(ParseRunSettings("", "f.yaml", sim::P3Model::kP3AT).mission.follower.reverse);
-  const RunSettings off = ParseRunSettings("run: {reverse: false}\n", "f.yaml", sim::P3Model::kP3AT);
+  const RunSettings off =
+      ParseRunSettings("run: {reverse: false}\n", "f.yaml", sim::P3Model::kP3AT);
   EXPECT_FALSE(off.mission.follower.reverse);
-  EXPECT_FALSE(
-      ParseRunSettings(RunSettingsToYaml(off), "back", sim::P3Model::kP3AT).mission.follower.reverse);
+  EXPECT_FALSE(ParseRunSettings(RunSettingsToYaml(off), "back", sim::P3Model::kP3AT)
+                   .mission.follower.reverse);
   EXPECT_THROW(ParseRunSettings("run: {reverse: 1m}\n", "f.yaml", sim::P3Model::kP3AT),
                std::invalid_argument);
 }

@@ -71,6 +71,27 @@ planning::Blocked BlockedAt(const mapping::ElevationLayers& L, double x, double 
   return grid.blocked[L.geometry.Linear(L.geometry.IndexOf(x, y))];
 }
 
+// Along the contour of a side slope the path is level, yet the robot rolls by the slope's tilt:
+// the map's cell tilt explains that, the path's grade does not.
+TEST(PathGrade, ASideSlopesTiltComesFromTheCellsNotTheLevelPath) {
+  mapping::ElevationLayers L = FlatLayers();
+  const float side = static_cast<float>(15.0 * kPi / 180);
+  for (int j = 0; j < L.geometry.size_y; ++j) {
+    for (int i = 20; i < 25; ++i) L.phi_y[L.geometry.Linear({i, j})] = side;  // x in [2.0, 2.5)
+  }
+  const planning::TraversabilityGrid grid = planning::BuildTraversability(L, {});
+  planning::Path p;
+  for (int i = 0; i <= 35; ++i) p.waypoints.push_back({0.05 + 0.1 * i, 1.05, 0.0});  // level
+  const PathGrade grade(p);
+  EXPECT_EQ(grade.Max(0.0, 4.0), 0.0);
+  EXPECT_NEAR(grade.MaxTilt(grid, 1.5, 2.5), side, 1e-6);
+  EXPECT_NEAR(grade.MaxTilt(grid, 0.0, 1.9), 0.0, 1e-9);  // before the slope
+  EXPECT_NEAR(grade.MaxTilt(grid, 2.5, 3.5), 0.0, 1e-9);  // after it, and over the unknown column
+  // A path that leaves the grid has no tilt there.
+  p.waypoints.push_back({5.0, 1.05, 0.0});
+  EXPECT_NEAR(PathGrade(p).MaxTilt(grid, 3.0, 10.0), 0.0, 1e-9);
+}
+
 TEST(MarkFelt, ATiltBeyondTheLimitForbidsTheDiscAndNothingElse) {
   mapping::ElevationLayers L = FlatLayers();
   FeltHazard f;

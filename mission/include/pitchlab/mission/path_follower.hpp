@@ -52,9 +52,9 @@ class PurePursuit {
   std::vector<Eigen::Vector2d> path_;
   std::vector<double> arc_m_;  ///< arc length at each vertex [m]
   PurePursuitConfig config_;
-  double progress_m_ = 0.0;    ///< arc length of the closest point so far [m]
+  double progress_m_ = 0.0;  ///< arc length of the closest point so far [m]
   double remaining_m_ = 0.0;
-  int direction_ = 0;          ///< +1 forwards, -1 in reverse, 0 before the first command
+  int direction_ = 0;  ///< +1 forwards, -1 in reverse, 0 before the first command
 
   Eigen::Vector2d PointAt(double arc_m) const;
   double ClosestArc(const Eigen::Vector2d& p, double from_arc_m, double window_m) const;

@@ -10,6 +10,7 @@
 
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/planning/planner.hpp"
+#include "pitchlab/planning/traversability.hpp"
 
 namespace pitchlab::mission {
 
@@ -21,6 +22,10 @@ class PathGrade {
   explicit PathGrade(const planning::Path& path, double baseline_m = 0.3);
   /// The steepest grade |dz| / ds between arc lengths from_m and to_m [m] [1].
   double Max(double from_m, double to_m) const;
+  /// The steepest plane tilt `grid` gives the cells of the waypoints between arc lengths from_m
+  /// and to_m [m] [rad]: across a slope the path is level and the robot still rolls by the
+  /// slope's tilt. 0 where the map knows no tilt (and off the grid).
+  double MaxTilt(const planning::TraversabilityGrid& grid, double from_m, double to_m) const;
 
  private:
   const planning::Path& path_;
