@@ -28,6 +28,12 @@ constexpr double kGoalApproach_m = 2.0;   // a blocked goal farther than this: a
 constexpr double kFarDoubt_m = 6.0;       // beyond this a hazard may be a sparse view (recovery)
 constexpr double kHeadingTolerance_rad = 3.0 * kPi / 180;  // turning in place ends within this
 constexpr double kTurnGain_per_s = 2.0;                    // yaw rate per radian of heading error
+// The laser sees 180 deg ahead (the LMS200's field of view): a path within this of the heading
+// lies in the next scan with 30 deg to spare, so the robot does not turn on the spot to face it.
+// Such a turn buys little, and on a slope it slides a skid-steer base downhill (path_follower.hpp,
+// `reverse`): terrain seeds 11 and 234 turned 55 and 47 deg at the end of a drive and slid 0.27 m
+// into a crack's edge.
+constexpr double kInView_rad = 60.0 * kPi / 180;
 constexpr double kMinDrive_m = 0.1;  // a drive shorter than this is no progress
 constexpr double kBackOff_m = 0.6;   // reverse this far from a tilt beyond caution
 constexpr double kBackOffSpeed_mps = 0.2;
@@ -194,6 +200,8 @@ class Mission {
     return a ? std::acos(std::clamp(std::cos(a->x()) * std::cos(a->y()), -1.0, 1.0)) : 0.0;
   }
   bool TurnTo(double yaw_rad);
+  // Turns to yaw_rad only when that heading lies outside the laser's view (kInView_rad).
+  bool FacePath(double yaw_rad);
   bool Rebase();  // the map frame = base_link where the robot is now (before the first scan)
   bool RecordSample(const sensors::Odometry& odo);  // false: tipping over (reason set)
   Eigen::Isometry3d Estimate(const sensors::Odometry& odo) const {
@@ -733,7 +741,7 @@ bool Mission::Drive(const StopRecord& stop) {
   backed_off_ = false;
   if (!turn_only && !Follow(path, length)) return false;
   // After backing off, the next scan looks at the slope from where the robot stands.
-  if (!backed_off_ && !TurnTo(PathHeading(path, turn_only ? 0.0 : length))) return false;
+  if (!backed_off_ && !FacePath(PathHeading(path, turn_only ? 0.0 : length))) return false;
   // Never scan standing steeply: back off the way it came (once) and mark what it stood on.
   if (!backed_off_ && Tilt() > config_.scan_tilt_deg * kPi / 180) {
     Result<sensors::Odometry> odo = base_.ReadOdometry();
@@ -760,6 +768,16 @@ bool Mission::Rebase() {
   T_world_map_ = T_world_base_ = Propagate(T_world_base_, odo_ref_, *odo, StillAttitude());
   odo_ref_ = *odo;
   return true;
+}
+
+bool Mission::FacePath(double yaw_rad) {
+  Result<sensors::Odometry> odo = base_.ReadOdometry();
+  if (!odo) {
+    result_.reason = "base: " + odo.error().message;
+    return false;
+  }
+  if (std::abs(std::remainder(yaw_rad - Yaw(Estimate(*odo)), 2.0 * kPi)) <= kInView_rad) return true;
+  return TurnTo(yaw_rad);
 }
 
 bool Mission::TurnTo(double yaw_rad) {
