@@ -776,8 +776,8 @@ bool Mission::FacePath(double yaw_rad) {
     result_.reason = "base: " + odo.error().message;
     return false;
   }
-  if (std::abs(std::remainder(yaw_rad - Yaw(Estimate(*odo)), 2.0 * kPi)) <= kInView_rad) return true;
-  return TurnTo(yaw_rad);
+  const double off_rad = std::remainder(yaw_rad - Yaw(Estimate(*odo)), 2.0 * kPi);
+  return std::abs(off_rad) <= kInView_rad || TurnTo(yaw_rad);
 }
 
 bool Mission::TurnTo(double yaw_rad) {
@@ -904,7 +904,9 @@ bool Mission::BackOff(const sensors::Odometry& odo, double tilt_rad, bool obstac
   char line[160];
   std::snprintf(line, sizeof(line), "tilt %.1f deg at (%.2f, %.2f): backing off, %s",
                 tilt_rad * 180 / kPi, T.translation().x(), T.translation().y(),
-                obstacle ? "ran onto something ahead" : "the ground ahead is too steep");
+                obstacle ? (reversing ? "ran onto something behind" : "ran onto something ahead")
+                         : (reversing ? "the ground behind is too steep"
+                                      : "the ground ahead is too steep"));
   Progress(line);
   return DriveBack(odo, reversing);
 }
