@@ -89,6 +89,7 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
       {"map_range_m", &m.map_range_m},
       {"odometry_error_m", &m.odometry_error_m},
       {"odometry_error_per_m", &m.odometry_error_per_m},
+      {"odometry_error_level_per_m", &m.odometry_error_level_per_m},
       {"odometry_error_deg", &m.odometry_error_deg},
       {"odometry_error_dps", &m.odometry_error_dps},
       {"tilt_tolerance_deg", &m.tilt_tolerance_deg},
@@ -138,6 +139,7 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
   }
   for (const auto& [name, value] : {std::pair{"odometry_error_m", m.odometry_error_m},
                                     {"odometry_error_per_m", m.odometry_error_per_m},
+                                    {"odometry_error_level_per_m", m.odometry_error_level_per_m},
                                     {"odometry_error_deg", m.odometry_error_deg},
                                     {"odometry_error_dps", m.odometry_error_dps}}) {
     if (!(value >= 0 && std::isfinite(value))) {
@@ -250,6 +252,7 @@ std::string RunSettingsToYaml(const RunSettings& s) {
      << "  calibrate_mount: " << (m.calibrate_mount ? "true" : "false") << "\n"
      << "  odometry_error_m: " << m.odometry_error_m << "\n"
      << "  odometry_error_per_m: " << m.odometry_error_per_m << "\n"
+     << "  odometry_error_level_per_m: " << m.odometry_error_level_per_m << "\n"
      << "  odometry_error_deg: " << m.odometry_error_deg << "\n"
      << "  odometry_error_dps: " << m.odometry_error_dps << "\n"
      << "  tilt_tolerance_deg: " << m.tilt_tolerance_deg << "\n"

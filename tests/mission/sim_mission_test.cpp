@@ -136,6 +136,35 @@ TEST(RunSimMission, ItsStageBreakdownAddsUpToTheRunWithOtherAsTheRest) {
   fs::remove_all(dir);
 }
 
+// Wheels on a level floor barely slip, so the registration prior's bound grows with the distance
+// at the level rate there (the office's corridors let a scan slide 0.84 m along the axis within
+// the terrain's rate, and called it success). The floor world reads level throughout.
+TEST(RunSimMission, OnALevelFloorTheOdometryBoundGrowsAtTheLevelRate) {
+  const fs::path dir = Scratch();
+  SimMissionSpec spec = LoadSimMissionSpec(std::nullopt);
+  spec.world_file = WriteFloorWorld(dir);
+  spec.goal_m = Eigen::Vector2d(-2.0, 0.0);  // 2 m ahead of the default start (-4, 0)
+  const SimMissionOutcome run = RunSimMission(spec, dir / "run");
+  ASSERT_TRUE(run.result.success) << run.result.reason;
+  const std::vector<StopRecord>& stops = run.result.stops;
+  ASSERT_GE(stops.size(), 2u);
+  // Every stop merged, and the run ended at its last: each metre driven is in one stop's bound.
+  const MissionConfig& m = spec.settings.mission;
+  double grown_m = 0;
+  for (std::size_t k = 1; k < stops.size(); ++k) {
+    ASSERT_TRUE(stops[k].merge.merged) << k;
+    grown_m += stops[k].prior_bound.translation_m - m.odometry_error_m;
+  }
+  const double driven_m = run.result.odometry_distance_m;
+  EXPECT_GT(driven_m, 1.5);
+  EXPECT_NEAR(grown_m, m.odometry_error_level_per_m * driven_m, 1e-9);
+  std::ifstream file(run.folder / "stops" / "001" / "registration.json");
+  const nlohmann::json reg = nlohmann::json::parse(file);
+  EXPECT_DOUBLE_EQ(reg["prior_bound"]["translation_m"].get<double>(),
+                   stops[1].prior_bound.translation_m);
+  fs::remove_all(dir);
+}
+
 TEST(RunSimMission, NoWorldFileIsABadSpec) {
   const fs::path dir = Scratch();
   EXPECT_THROW(RunSimMission(LoadSimMissionSpec(std::nullopt), dir / "run"), std::invalid_argument);
