@@ -413,19 +413,28 @@ TEST(Register, NarfFeaturesAlignAKnownTransformOnRealScans) {
   // Table 1's alternative descriptor: NARF keypoints on range images of the dense scans, then the
   // same consensus and ICP as FPFH. Without a prior the features alone must find the motion.
   // (In the office, walls and desk tops give too few range-image borders: see mapping/README.md.)
+  // Its agreeing matches sit around sac_min_inliers (7-15 here), so whether one noise draw of the
+  // moved copy aligns is a coin's toss (9-10 of 16 draws in each world): over 12 draws it aligns
+  // some, each to the truth, and reports the others as failures, never a wrong pose.
   const Eigen::Isometry3d truth = PoseFromXyzRpyDeg(0.6, -0.3, 0, 0, 0, 10);
+  constexpr int kDraws = 12, kMinAligned = 3;
   for (const KnownMotion m :
        {KnownMotion{"urban", 0, 0, 0}, KnownMotion{"cluttered", -4.5, -3.8, 0}}) {
     const PointCloud cloud = CloudFromScan(SimulatedScan(m.world, m.x_m, m.y_m, m.yaw_deg));
     RegistrationConfig config;
     config.features = FeatureKind::kNarf;
-    Result<RegistrationResult> r =
-        RegisterScans(EveryOther(cloud), MovedCopy(cloud, truth, 13), {}, config);
-    ASSERT_TRUE(r) << r.error().message;
-    EXPECT_TRUE(r->success) << m.world << ": " << r->reason;
-    EXPECT_EQ(r->path, RegistrationPath::kFeatures) << m.world << ": " << r->reason;
-    EXPECT_GT(r->timings.features_s, 0.0);
-    ExpectNear(*r, truth);
+    int aligned = 0;
+    for (int draw = 1; draw <= kDraws; ++draw) {
+      Result<RegistrationResult> r =
+          RegisterScans(EveryOther(cloud), MovedCopy(cloud, truth, draw), {}, config);
+      ASSERT_TRUE(r) << r.error().message;
+      EXPECT_GT(r->timings.features_s, 0.0);
+      if (!r->success) continue;
+      ++aligned;
+      EXPECT_EQ(r->path, RegistrationPath::kFeatures) << m.world << ": " << r->reason;
+      ExpectNear(*r, truth);
+    }
+    EXPECT_GE(aligned, kMinAligned) << m.world;
   }
 }
 
