@@ -96,15 +96,21 @@ TEST(RunSimMission, NoGoalGivenAndNoneInTheWorldIsABadSpec) {
   EXPECT_FALSE(fs::exists(dir / "run"));
 }
 
+// The default mission on the flat floor world written into `dir`, to `goal`.
+SimMissionSpec FloorSpec(const fs::path& dir, const Eigen::Vector2d& goal) {
+  SimMissionSpec spec = LoadSimMissionSpec(std::nullopt);
+  spec.world_file = WriteFloorWorld(dir);
+  spec.goal_m = goal;
+  return spec;
+}
+
 // A real run, 2 m across the floor: its breakdown in metrics.json covers every stage, each a
 // part of the run, and "other" is what they leave of it.
 TEST(RunSimMission, ItsStageBreakdownAddsUpToTheRunWithOtherAsTheRest) {
   // Sums of up to a dozen clock readings in seconds: rounding far below the clocks' nanosecond.
   constexpr double kSumTolerance_s = 1e-9;
   const fs::path dir = Scratch();
-  SimMissionSpec spec = LoadSimMissionSpec(std::nullopt);
-  spec.world_file = WriteFloorWorld(dir);
-  spec.goal_m = Eigen::Vector2d(-2.0, 0.0);  // 2 m ahead of the default start (-4, 0)
+  const SimMissionSpec spec = FloorSpec(dir, {-2.0, 0.0});  // 2 m ahead of the start (-4, 0)
   const SimMissionOutcome run = RunSimMission(spec, dir / "run");
   ASSERT_TRUE(run.result.success) << run.result.reason;
   std::ifstream file(run.folder / "metrics.json");
@@ -141,9 +147,7 @@ TEST(RunSimMission, ItsStageBreakdownAddsUpToTheRunWithOtherAsTheRest) {
 // the terrain's rate, and called it success). The floor world reads level throughout.
 TEST(RunSimMission, OnALevelFloorTheOdometryBoundGrowsAtTheLevelRate) {
   const fs::path dir = Scratch();
-  SimMissionSpec spec = LoadSimMissionSpec(std::nullopt);
-  spec.world_file = WriteFloorWorld(dir);
-  spec.goal_m = Eigen::Vector2d(-2.0, 0.0);  // 2 m ahead of the default start (-4, 0)
+  const SimMissionSpec spec = FloorSpec(dir, {-2.0, 0.0});  // 2 m ahead of the start (-4, 0)
   const SimMissionOutcome run = RunSimMission(spec, dir / "run");
   ASSERT_TRUE(run.result.success) << run.result.reason;
   const std::vector<StopRecord>& stops = run.result.stops;
@@ -170,9 +174,7 @@ TEST(RunSimMission, OnALevelFloorTheOdometryBoundGrowsAtTheLevelRate) {
 // of a degree, and every map started 0.2-0.4 deg off in yaw: 0.1-0.2 m at 30 m.
 TEST(RunSimMission, TheFirstScansPoseHasTheTurnToTheGoalToATenthOfADegree) {
   const fs::path dir = Scratch();
-  SimMissionSpec spec = LoadSimMissionSpec(std::nullopt);
-  spec.world_file = WriteFloorWorld(dir);
-  spec.goal_m = Eigen::Vector2d(-4.0, 2.5);  // 90 deg left of the default start (-4, 0), yaw 0
+  SimMissionSpec spec = FloorSpec(dir, {-4.0, 2.5});  // 90 deg left of the start (-4, 0), yaw 0
   spec.settings.mission.max_stops = 1;
   const SimMissionOutcome run = RunSimMission(spec, dir / "run");
   ASSERT_EQ(run.result.stops.size(), 1u) << run.result.reason;
