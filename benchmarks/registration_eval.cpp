@@ -35,6 +35,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pitchlab/mapping/map_builder.hpp"
+#include "pitchlab/mapping/mount_from_floor.hpp"
 #include "pitchlab/mapping/registration.hpp"
 #include "pitchlab/sensors/sensor_config.hpp"
 #include "pitchlab/sim/robot_model.hpp"
@@ -189,9 +190,24 @@ class ScanFactory {
     rig_ = std::make_unique<sim::SimRig>(std::string(PITCHLAB_WORLDS_DIR) + "/" + world + ".xml",
                                          config);
     keep_out_ = FootprintKeepOut(rig_->config());
-    if (Result<Eigen::Isometry3d> start = rig_->PlaceAtDefaultStart())
+    if (Result<Eigen::Isometry3d> start = rig_->PlaceAtDefaultStart()) {
       start_z_ = start->translation().z();
+      CalibrateMount();
+    }
   }
+  // As a mission does at its first stop (mission/README.md, "The mount calibrated by the floor"):
+  // the scan plane's roll, pitch and yaw off the nominal mount, found by the floor at the default
+  // start, and every scan re-assembled on it. The LMS200 draws a mount error per rig (0.25 deg
+  // per axis); uncalibrated, it bends each line differently from different poses, and the
+  // terrain's long ranges turn it into 3-7 cm of registration error.
+  void CalibrateMount() {
+    Result<sensors::Scan3D> scan = rig_->Acquire();
+    if (!scan) return;
+    Result<mapping::MountFromFloor> found =
+        mapping::CalibrateMountFromFloor(*scan, rig_->config().robot.mount);
+    if (found) calibrated_mount_ = found->mount;
+  }
+  bool mount_calibrated() const { return calibrated_mount_.has_value(); }
   // A scan from (x, y, yaw), or nothing when the robot cannot stand there, would not stop there, or
   // moved during the sweep (then the single ground-truth pose would not describe the scan).
   std::optional<SimScan> At(double x, double y, double yaw_rad) {
@@ -205,6 +221,7 @@ class ScanFactory {
     }
     Result<sensors::Scan3D> scan = rig_->Acquire();
     if (!scan) return std::nullopt;
+    if (calibrated_mount_) sensors::ReassembleScan(*scan, rig_->config().robot.mount, *calibrated_mount_);
     const mapping::PoseError drift =
         mapping::ComparePoses(rig_->sim().T_world_base(), scan->T_world_base);
     if (drift.rotation_deg > kMaxTruthDrift_deg || drift.translation_m > kMaxTruthDrift_m) {
@@ -241,6 +258,7 @@ class ScanFactory {
   std::unique_ptr<sim::SimRig> rig_;
   KeepOut keep_out_;
   std::optional<double> start_z_;  // ground height at the world's default start [m]
+  std::optional<sensors::MountConfig> calibrated_mount_;  // CalibrateMount's, when it found one
   int drifted_ = 0, unreachable_ = 0, obstructed_ = 0;
 };
 
@@ -318,6 +336,7 @@ std::vector<Pair> MakePairs(const Options& o, const std::string& world, double n
   stats["drifted_scans_resampled"] = factory.drifted();
   stats["unreachable_poses_resampled"] = factory.unreachable();
   stats["obstructed_poses_resampled"] = factory.obstructed();
+  stats["mount_calibrated_by_the_floor"] = factory.mount_calibrated();
   return pairs;
 }
 
@@ -329,7 +348,8 @@ std::string CachePath(const Options& o, const std::string& world, double noise_m
   std::ostringstream key;
   key << rng << " " << world << " " << noise_m << " " << o.targets << " "
       << (o.near_start.count(world) ? o.near_start_radius_m : 0.0) << " climb " << kMaxClimb_m
-      << " keep-out disc " << kPlannerSafetyMargin_m << " " << kObstacleMin_m << " sensor "
+      << " keep-out disc " << kPlannerSafetyMargin_m << " " << kObstacleMin_m
+      << " mount calibrated by the floor sensor "
       << sensors::SensorConfigToYaml({SensorModel(o), {}, {}, {}});
   std::ostringstream name;
   name << o.pair_cache << "/" << world << "_" << noise_m << "_" << std::hex
