@@ -221,7 +221,8 @@ class ScanFactory {
     }
     Result<sensors::Scan3D> scan = rig_->Acquire();
     if (!scan) return std::nullopt;
-    if (calibrated_mount_) sensors::ReassembleScan(*scan, rig_->config().robot.mount, *calibrated_mount_);
+    if (calibrated_mount_)
+      sensors::ReassembleScan(*scan, rig_->config().robot.mount, *calibrated_mount_);
     const mapping::PoseError drift =
         mapping::ComparePoses(rig_->sim().T_world_base(), scan->T_world_base);
     if (drift.rotation_deg > kMaxTruthDrift_deg || drift.translation_m > kMaxTruthDrift_m) {

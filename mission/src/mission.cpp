@@ -767,12 +767,7 @@ bool Mission::Drive(const StopRecord& stop) {
     }
     if (!BackOff(*odo, Tilt(), false)) return false;
   }
-  Result<sensors::Odometry> stopped = DriveBase(0.0, 0.0, kStopTime_s);
-  if (!stopped) {
-    result_.reason = "base: " + stopped.error().message;
-    return false;
-  }
-  return true;
+  return Brake();
 }
 
 bool Mission::Brake() {

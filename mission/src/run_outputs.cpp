@@ -100,9 +100,10 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
       {"line_pitch", stop.line_pitch ? LinePitchJson(*stop.line_pitch) : nlohmann::json()},
       {"deskewed", stop.scan.deskewed},
       {"deskew_deg", stop.scan.deskew_max_rad * kRadToDeg},
-      {"prior_bound", stop.index == 0 ? nlohmann::json()
-                                      : nlohmann::json{{"translation_m", stop.prior_bound.translation_m},
-                                                       {"rotation_deg", stop.prior_bound.rotation_deg}}},
+      {"prior_bound", stop.index == 0
+                          ? nlohmann::json()
+                          : nlohmann::json{{"translation_m", stop.prior_bound.translation_m},
+                                           {"rotation_deg", stop.prior_bound.rotation_deg}}},
       {"success", reg.success},
       {"reason", reg.reason},
       {"path", mapping::ToString(reg.path)},
