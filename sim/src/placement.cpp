@@ -114,6 +114,7 @@ Eigen::Quaterniond OnPlane(const Eigen::Vector3d& coeffs, double yaw_rad) {
 
 Result<Eigen::Isometry3d> Simulation::PlaceRobot(double x_m, double y_m, double yaw_rad,
                                                  const PlacementConfig& config) {
+  Release();  // a placed robot settles under full physics
   Impl& s = *impl_;
   const P3Params& p = params();
   if (world_.bounds) {

@@ -120,6 +120,9 @@ Result<sensors::Odometry> SimBase::Stop(double timeout_s) {
 
 // Firmware: acceleration ramp, (v, omega) -> wheel speeds, PI on wheel speed.
 void SimBase::BeforeStep() {
+  // Held (Simulation::HoldStill), the wheels cannot turn: the loop pauses, or its integral would
+  // wind up against a wheel held off its hold angle and jolt the robot on release.
+  if (sim_.held()) return;
   const P3Params& p = sim_.params();
   const double dt = sim_.timestep_s();
   command_[0] = Ramp(command_[0], target_[0], p.max_accel_mps2 * dt);

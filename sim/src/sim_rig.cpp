@@ -68,6 +68,14 @@ Result<sensors::Scan3D> SimRig::Acquire() {
     return Fail(stopped.error().code, "before the scan: " + stopped.error().message);
   }
   const Eigen::Isometry3d T_world_base = sim_->T_world_base();
+  // Standing still only the pitch joint moves: the contact solve that kept the robot where it stood
+  // was 90 % of a scan's physics (terrain seed 1: 0.54 s CPU per stop, held 0.05 s). Released on
+  // every way out.
+  struct Held {
+    Simulation& sim;
+    ~Held() { sim.Release(); }
+  } held{*sim_};
+  sim_->HoldStill();
   Result<sensors::Scan3D> scan = source_->Acquire();
   if (!scan) return scan;
   scan->has_truth = true;

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -20,6 +21,13 @@ namespace {
 
 constexpr double kImpRatio = 10.0;
 constexpr int kNoslipIterations = 10;  // MuJoCo's noslip pass, iterations per step
+// HoldStill: a free body (the base, a loose box) is at rest below these, as SimBase::Stop's still
+// base.
+constexpr double kStillSpeed_mps = 0.005;
+constexpr double kStillRate_rps = 0.01;
+// The held joints' armature: against the laser's few kg at a decimetre's lever, a base that weighs
+// 1e9 (kg, kg m^2) is immovable to within 1e-9 of its coupling to the pitch joint.
+constexpr double kHeldArmature = 1e9;
 
 std::string ReadFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -100,7 +108,36 @@ WorldInfo ReadWorldInfo(const mjModel* m, const std::string& source) {
   return info;
 }
 
+// Whether joint `j` is at rest for HoldStill; its position and dof counts. Only free bodies must
+// be at rest: a joint within one (a wheel) is held wherever it is, since a wheel that still turns
+// (0.06-0.1 rad/s seen) inside a base that stands still is its tyre's contact settling, not motion.
+bool AtRest(const mjModel* m, const mjData* d, int j, int& nq, int& nv) {
+  const mjtNum* v = d->qvel + m->jnt_dofadr[j];
+  const auto norm3 = [](const mjtNum* x) {
+    return std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+  };
+  switch (m->jnt_type[j]) {
+    case mjJNT_FREE:
+      nq = 7, nv = 6;
+      return norm3(v) < kStillSpeed_mps && norm3(v + 3) < kStillRate_rps;
+    case mjJNT_BALL:
+      nq = 4, nv = 3;
+      return true;
+    default:  // hinge, slide
+      nq = 1, nv = 1;
+      return true;
+  }
+}
+
 }  // namespace
+
+void Simulation::Impl::KeepHeld() {
+  std::size_t k = 0;
+  for (const auto& [adr, count] : hold->joints) {
+    for (int i = 0; i < count; ++i) d->qpos[adr + i] = hold->qpos[k++];
+  }
+  for (const int dof : hold->dofs) d->qvel[dof] = 0.0;
+}
 
 Simulation::Simulation(const std::string& world_path, const RobotConfig& robot)
     : Simulation(ReadFile(world_path), DirOf(world_path), world_path, robot) {}
@@ -186,12 +223,51 @@ void Simulation::Step(int n) {
                                servo.kv_nms_per_rad * pitch_setpoint_rate_rps_) /
                                   servo.kp_nm_per_rad;
     mj_step2(s.m, s.d);
+    if (s.hold) s.KeepHeld();
     for (auto& [id, hook] : s.hooks) {
       if (hook.second) hook.second();
     }
   }
   mj_kinematics(s.m, s.d);  // fresh xpos/site/geom poses for ground truth and the ray casters
 }
+
+bool Simulation::HoldStill() {
+  Impl& s = *impl_;
+  if (s.hold) return true;
+  Impl::Hold h;
+  const int pitch_joint = s.m->dof_jntid[s.pitch_dof];
+  for (int j = 0; j < s.m->njnt; ++j) {
+    if (j == pitch_joint) continue;
+    int nq = 0, nv = 0;
+    if (!AtRest(s.m, s.d, j, nq, nv)) return false;
+    h.joints.emplace_back(s.m->jnt_qposadr[j], nq);
+    for (int i = 0; i < nq; ++i) h.qpos.push_back(s.d->qpos[s.m->jnt_qposadr[j] + i]);
+    for (int i = 0; i < nv; ++i) h.dofs.push_back(s.m->jnt_dofadr[j] + i);
+  }
+  for (const int dof : h.dofs) {
+    h.armature.push_back(s.m->dof_armature[dof]);
+    s.m->dof_armature[dof] = kHeldArmature;
+  }
+  h.qacc_warmstart.assign(s.d->qacc_warmstart, s.d->qacc_warmstart + s.m->nv);
+  h.disableflags = s.m->opt.disableflags;
+  s.m->opt.disableflags |= mjDSBL_CONTACT;
+  s.hold = std::move(h);
+  s.KeepHeld();
+  return true;
+}
+
+void Simulation::Release() {
+  Impl& s = *impl_;
+  if (!s.hold) return;
+  const Impl::Hold& h = *s.hold;
+  for (std::size_t i = 0; i < h.dofs.size(); ++i) s.m->dof_armature[h.dofs[i]] = h.armature[i];
+  std::copy(h.qacc_warmstart.begin(), h.qacc_warmstart.end(), s.d->qacc_warmstart);
+  s.m->opt.disableflags = h.disableflags;
+  s.KeepHeld();
+  s.hold.reset();
+}
+
+bool Simulation::held() const { return impl_->hold.has_value(); }
 
 void Simulation::StepFor(double duration_s) {
   if (!(duration_s > 0.0)) return;

@@ -2,6 +2,7 @@
 // Private: the MuJoCo side of Simulation, shared by simulation.cpp and placement.cpp.
 
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -23,6 +24,16 @@ struct Simulation::Impl {
     bool left;
   };
   std::vector<Wheel> wheels;
+  // Simulation::HoldBase's saved state: the held joints' positions, their dofs' armature, the
+  // solver's warm start and the disable flags.
+  struct Hold {
+    std::vector<std::pair<int, int>> joints;  // (qpos address, position count)
+    std::vector<int> dofs;
+    std::vector<mjtNum> qpos, armature, qacc_warmstart;
+    int disableflags = 0;
+  };
+  std::optional<Hold> hold;
+  void KeepHeld();  // the held joints back where HoldStill found them, still
   std::map<int, std::pair<StepHook, StepHook>> hooks;
   int next_hook = 0;
 

@@ -446,21 +446,21 @@ TEST(Register, TheCorridorWithoutAFallbackIsAReportedFailure) {
   EXPECT_NE(r->reason.find("ambiguous"), std::string::npos) << r->reason;
 }
 
-// registration_eval's urban pair 105 and terrain pair 160: the features find the truth, but the
-// weakest direction (along the street; the heading on the slope) is constrained below
+// registration_eval's urban pair 105: the features find the truth, but the
+// weakest direction (along the street) is constrained below
 // degeneracy_ratio and ICP restarted 1 m / 10 deg off does not come back, ending where it fits
 // clearly worse. Fits alone cannot call that determined (the corridor's wrong pose fits better
 // than its truth); free space can: the probes' ends put facades or ground where the target's scan
 // saw through. Without the target's view (an empty scan says nothing) the same pair is ambiguous.
+// (Terrain pair 160, the heading on a slope, showed the same until the robot stood held for its
+// scans (Simulation::HoldStill): without the millimetres and tenths of a degree it moved during
+// each scan under soft contacts (up to 1.4 mm, 0.14 deg in a terrain run), the probes
+// come back to the truth on their own, seeds 1-8.)
 class WeakButSeen : public ::testing::TestWithParam<std::pair<ScanPair (*)(), const char*>> {};
 
 ScanPair StreetPair() {
   return Pair(SimulatedScan("urban", 6.6524, -23.9394, 85.995, 1),
               SimulatedScan("urban", 6.5100, -23.6405, 68.992, 2));
-}
-ScanPair SlopePair() {
-  return Pair(SimulatedScan("terrain", -2.1443, -2.8961, 13.512, 1),
-              SimulatedScan("terrain", -1.3906, -2.6424, 10.555, 2));
 }
 
 TEST_P(WeakButSeen, FreeSpaceRefutesTheProbesAndTheFeaturesPoseStands) {
@@ -482,8 +482,7 @@ TEST_P(WeakButSeen, FreeSpaceRefutesTheProbesAndTheFeaturesPoseStands) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, WeakButSeen,
-                         ::testing::Values(std::pair{&StreetPair, "street"},
-                                           std::pair{&SlopePair, "slope"}),
+                         ::testing::Values(std::pair{&StreetPair, "street"}),
                          [](const auto& info) { return std::string(info.param.second); });
 
 TEST(Register, ThePclBackendAlsoRecoversAKnownTransform) {

@@ -69,6 +69,17 @@ class Simulation {
   double pitch_setpoint_rad() const { return pitch_setpoint_rad_; }
   /// Wheel velocity servo setpoints, left and right side [rad/s].
   void SetWheelSpeeds(double left_rps, double right_rps);
+  /// For a robot standing still to scan: holds every joint but the pitch joint (the base, its
+  /// wheels, a world's loose bodies) where it is. While held, each step keeps their positions and
+  /// zero velocities, skips collision detection and the contact solve (most of a step's cost),
+  /// and moves only the pitch joint, whose dynamics are then a fixed base's under gravity (the
+  /// held joints weigh as if immovable). Holds nothing and returns false while a free body (the
+  /// base, a loose box) still moves at 5 mm/s or turns at 0.01 rad/s, so what is still settling
+  /// or sliding keeps its physics. Release puts the contact model and its solver's
+  /// warm start back as they were.
+  bool HoldStill();
+  void Release();
+  bool held() const;
   /// Mean wheel joint angle of the left / right side [rad] (the encoders' truth).
   Eigen::Vector2d WheelAngles() const;
   /// Mean wheel joint speed of the left / right side [rad/s].
