@@ -75,14 +75,13 @@ std::string DefaultOut(const std::string& world, std::uint64_t seed) {
   return "runs/" + name + "-s" + std::to_string(seed) + "-" + stamp;
 }
 
-// Progress on stderr as the run goes: set-up steps, the true map by quarters, then the mission's
-// lines with the simulated and the wall clock.
+// Progress on stderr as the run goes: set-up steps, then the mission's lines with the simulated
+// and the wall clock (the true map is made beside the mission).
 mission::SimMissionObserver ProgressLines(std::chrono::steady_clock::time_point wall_start) {
   mission::SimMissionObserver observer;
   observer.on_setup = [](const std::string& text) {
     std::fprintf(stderr, "run: %s\n", text.c_str());
   };
-  observer.on_truth_rows = QuarterProgress("run: ground truth", "rows", false);
   observer.on_progress = [wall_start](const std::string& text, double sim_s) {
     const double wall =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

@@ -1,16 +1,14 @@
 #include "pitchlab/mapping/per_scan_elevation_map.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <future>
 #include <limits>
 #include <string>
-#include <system_error>
 #include <thread>
 #include <utility>
 
 #include "elevation_insert.hpp"
+#include "parallel_for.hpp"
 
 namespace pitchlab::mapping {
 namespace {
@@ -110,18 +108,12 @@ void PerScanElevationMap::Contribute(Scan& scan) const {
 // Each scan's contribution depends on that scan alone and lands in its own Scan: the threads
 // take scans in any order and the result is the same.
 void PerScanElevationMap::ContributeAll(const std::vector<Scan*>& scans) const {
-  const unsigned threads = static_cast<unsigned>(std::min<std::size_t>(scans.size(), threads_));
-  std::atomic<std::size_t> next{0};
-  const auto work = [&] {
-    for (std::size_t k = next++; k < scans.size(); k = next++) Contribute(*scans[k]);
-  };
-  std::vector<std::future<void>> helpers;
-  try {
-    for (unsigned t = 1; t < threads; ++t) helpers.push_back(std::async(std::launch::async, work));
-  } catch (const std::system_error&) {  // no thread to be had: the calling one does the rest
-  }
-  work();
-  for (std::future<void>& h : helpers) h.get();  // rethrows a helper's exception
+  internal::ParallelFor(
+      scans.size(), 1,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t k = begin; k < end; ++k) Contribute(*scans[k]);
+      },
+      threads_);
 }
 
 // The map from the contributions: every scan's clearance first, then the points in id order,

@@ -49,9 +49,9 @@ const char* StageLabel(Stage stage) {
     case Stage::kPlanning:
       return "planning";
     case Stage::kOutputs:
-      return "outputs (the run folder's files)";
+      return "outputs (the run folder's files; each stop's beside the mission)";
     case Stage::kGroundTruth:
-      return "ground truth (set-up)";
+      return "ground truth (beside the mission)";
     case Stage::kScoring:
       return "scoring against the truth";
   }

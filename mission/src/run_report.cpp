@@ -138,7 +138,9 @@ std::string RenderRunReport(const RunReportInput& in, const Result<ThreeJs>& thr
     page.Heading("Where the run's time went", "stages");
     page.Paragraph(
         "Wall-clock and CPU time (all the process's threads) per stage, up to writing "
-        "metrics.json and this page; shares of the whole run.");
+        "metrics.json and this page; shares of the whole run. The ground truth and each stop's "
+        "files are made on a thread beside the mission: their CPU time is that thread's, their "
+        "wall time only what the run waited for them.");
     page.Table(StageHeader(), rows);
   }
 

@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <stdexcept>
 
+#include "background_jobs.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/elevation_truth.hpp"
 #include "pitchlab/mission/run_folder.hpp"
@@ -76,16 +78,12 @@ struct Truth {
   planning::Path optimum;
 };
 
-Truth ComputeTruth(sim::SimRig& rig, const MissionConfig& mission, const Eigen::Vector2d& start,
-                   const SimMissionObserver& observer) {
-  mapping::TruthConfig truth_config;
-  truth_config.progress = observer.on_truth_rows;
-  const mapping::ElevationMap map =
-      mapping::ComputeTrueElevationMap(rig.caster(), mission.map_area, truth_config);
+Truth ComputeTruth(const sensors::RayCaster& caster, const MissionConfig& mission,
+                   const Eigen::Vector2d& start) {
+  const mapping::ElevationMap map = mapping::ComputeTrueElevationMap(caster, mission.map_area);
   Truth truth;
   truth.layers = mapping::ComputeLayers(map, mission.layers);
   truth.grid = planning::BuildTraversability(truth.layers, mission.planner);
-  if (observer.on_setup) observer.on_setup("ground truth: the best path on the true map");
   auto optimum = PlanRoute(truth.grid, start, mission.via_m, mission.goal_m, mission.algorithm);
   if (!optimum) {
     throw std::runtime_error(std::string(mission.via_m.empty() ? "the goal" : "the route") +
@@ -94,6 +92,27 @@ Truth ComputeTruth(sim::SimRig& rig, const MissionConfig& mission, const Eigen::
   truth.optimum = std::move(*optimum);
   return truth;
 }
+
+// The world as placed, for the ground truth's ray caster on another thread: a copy of the
+// simulation's state (the simulation steps on meanwhile) and a caster of its own.
+struct TruthScene {
+  explicit TruthScene(sim::SimRig& rig)
+      : data(mj_makeData(rig.sim().model()), &mj_deleteData) {
+    if (!data) throw std::runtime_error("ground truth: mj_makeData failed");
+    mj_copyData(data.get(), rig.sim().model(), rig.sim().data());
+    sensors::RayCasterOptions options;
+    options.exclude_subtree_of_body = sim::kRobotBody;
+    caster = sensors::MakeEmbreeRayCaster(rig.sim().model(), data.get(), options);
+  }
+  std::unique_ptr<mjData, void (*)(mjData*)> data;
+  std::unique_ptr<sensors::RayCaster> caster;
+};
+
+// What a stop's files are made from, copied when the stop ends: the mission goes on meanwhile.
+struct StopSnapshot {
+  StopRecord stop;
+  MissionResult so_far;  // its elevation map and trajectory (all a stop's pictures show)
+};
 
 // The probes of a simulated run: its clock, its ground truth and its attitude sensor, the
 // inclinometer's roll and pitch (truth plus a seeded bias and noise); the laser's line time for
@@ -192,7 +211,7 @@ worlds::WorldMetadata LoadWorldMetadata(const std::filesystem::path& world_file)
 
 SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesystem::path& out,
                                 const SimMissionObserver& observer) {
-  const sensors::Stopwatch run_clock;
+  const sensors::Stopwatch run_clock(sensors::CpuOf::kProcess);  // the side thread's too
   StageTimes stages;  // the run's own; the loop's come with its result
   if (spec.world_file.empty()) throw std::invalid_argument("mission: no world file given");
   const worlds::WorldMetadata meta = LoadWorldMetadata(spec.world_file);
@@ -227,18 +246,36 @@ SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesyste
     observer.on_setup("ground truth of " +
                       (spec.world_name.empty() ? world_stem : spec.world_name) +
                       ": true surface on " + std::to_string(mission.map_area.size_x) + " x " +
-                      std::to_string(mission.map_area.size_y) + " cells");
+                      std::to_string(mission.map_area.size_y) + " cells, beside the mission");
   }
-  const Truth truth = [&] {
+  // The ground truth and each stop's files are made on a thread beside the mission (their CPU
+  // time is theirs, their wall time what the run waits for them at the end).
+  const auto truth_scene = [&] {
     const sensors::ScopedTime timing(stages[Stage::kGroundTruth]);
-    return ComputeTruth(rig, mission, start.head<2>(), observer);
+    return std::make_shared<TruthScene>(rig);
   }();
+  std::optional<Truth> truth;
+  double truth_cpu_s = 0, outputs_cpu_s = 0;  // the jobs' own, read once they are done
+  BackgroundJobs side;  // declared after what its jobs use: it ends first
+  side.Post([&, truth_scene] {
+    const double cpu0 = sensors::ThreadCpuSeconds();
+    truth = ComputeTruth(*truth_scene->caster, mission, start.head<2>());
+    truth_cpu_s = sensors::ThreadCpuSeconds() - cpu0;
+  });
 
   sim::Simulation& sim = rig.sim();
   MissionObserver mission_observer;
   mission_observer.on_stop = [&](const StopRecord& stop, const MissionResult& so_far) {
     const sensors::ScopedTime timing(stages[Stage::kOutputs]);
-    WriteStopOutputs(folder, stop, so_far, origin, world_stem);
+    auto snapshot = std::make_shared<StopSnapshot>();
+    snapshot->stop = stop;
+    snapshot->so_far.elevation = so_far.elevation;
+    snapshot->so_far.trajectory = so_far.trajectory;
+    side.Post([&, snapshot] {
+      const double cpu0 = sensors::ThreadCpuSeconds();
+      WriteStopOutputs(folder, snapshot->stop, snapshot->so_far, origin, world_stem);
+      outputs_cpu_s += sensors::ThreadCpuSeconds() - cpu0;
+    });
   };
   if (observer.on_progress) {
     mission_observer.on_progress = [&](const std::string& text) {
@@ -249,17 +286,23 @@ SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesyste
   run.result = RunMission(rig, rig.base(), *placed, mission, SimProbes(rig, spec.config.seed),
                           mission_observer);
   {
+    const sensors::ScopedTime timing(stages[Stage::kOutputs]);
+    side.Wait();
+  }
+  stages[Stage::kGroundTruth].cpu_s += truth_cpu_s;
+  stages[Stage::kOutputs].cpu_s += outputs_cpu_s;
+  {
     const sensors::ScopedTime timing(stages[Stage::kScoring]);
     const planning::TraversabilityGrid final_grid = planning::BuildTraversability(
         mapping::ComputeLayers(run.result.elevation, mission.layers), mission.planner);
     run.score =
-        ScoreRun(run.result, truth.grid, final_grid, start.head<2>(), goal, mission.algorithm, via);
+        ScoreRun(run.result, truth->grid, final_grid, start.head<2>(), goal, mission.algorithm, via);
   }
 
   run.context = SimContext(spec, settings, start, origin, rig);
   const mapping::ElevationLayers layers = [&] {
     const sensors::ScopedTime timing(stages[Stage::kOutputs]);
-    return WriteFinalData(folder, run.context, run.result, &truth.layers, truth.optimum);
+    return WriteFinalData(folder, run.context, run.result, &truth->layers, truth->optimum);
   }();
   // The run's time up to its summary, which holds it (metrics.json, report.html).
   const sensors::Elapsed run_time = run_clock.Read();

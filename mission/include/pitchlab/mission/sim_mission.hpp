@@ -58,7 +58,6 @@ worlds::WorldMetadata LoadWorldMetadata(const std::filesystem::path& world_file)
 /// Progress of a simulated run, for a person watching; every callback may be empty.
 struct SimMissionObserver {
   std::function<void(const std::string& text)> on_setup;   ///< set-up steps (the ground truth)
-  std::function<void(int done, int total)> on_truth_rows;  ///< rows of the true map computed
   /// The mission's progress (mission.hpp) with the simulated clock then [s].
   std::function<void(const std::string& text, double sim_time_s)> on_progress;
 };

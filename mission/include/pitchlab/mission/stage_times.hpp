@@ -15,7 +15,10 @@ namespace pitchlab::mission {
 
 /// The stages of a simulated run. Each is timed over disjoint spans of the run, so they add up to
 /// at most the run's own time; what no stage covers (loading the world, building the ray caster's
-/// scene, placing the robot, the loop's own bookkeeping) is the breakdown's "other".
+/// scene, placing the robot, the loop's own bookkeeping) is the breakdown's "other". The ground
+/// truth and each stop's files are made on a thread beside the mission: their CPU time is that
+/// thread's (sensors::BackgroundThread keeps it out of the other stages), their wall time what
+/// the run waited for them.
 enum class Stage : std::size_t {
   kPhysicsDriving,   ///< the base's drive commands: physics stepped while moving (and braking)
   kPhysicsStanding,  ///< a scan minus its lines: the pitch servo's physics while standing still
@@ -24,8 +27,8 @@ enum class Stage : std::size_t {
   kMapUpdate,        ///< the scan into the elevation map, and the map's layers for planning
   kTraversability,   ///< planning::BuildTraversability (recoveries' relaxed grids included)
   kPlanning,         ///< graph search (Algorithm 2) and the mission's path checks
-  kOutputs,          ///< the run folder's files: per stop and at the end (PCD, PNG, CSV)
-  kGroundTruth,      ///< set-up: the true elevation map, its traversability and optimum
+  kOutputs,          ///< the run folder's files: per stop (beside the mission) and at the end
+  kGroundTruth,      ///< the true elevation map, its traversability and optimum (beside it)
   kScoring,          ///< the final map's traversability and the score against the truth
 };
 inline constexpr std::size_t kStageCount = 10;

@@ -1,0 +1,18 @@
+#pragma once
+// Private: a loop whose iterations are independent, run on the machine's cores.
+
+#include <cstddef>
+#include <functional>
+
+namespace pitchlab::mapping::internal {
+
+/// Calls `body(begin, end)` over [0, n) in blocks of `block` items, the blocks taken in turn by up
+/// to `max_threads` threads (the caller's included; 0: one per core, at most 8). Each item must
+/// depend on nothing another item writes, so the result is a plain loop's whatever the threads.
+/// With one block, one core, or no thread to be had, the caller runs it all. A body's exception
+/// reaches the caller once every thread has stopped.
+void ParallelFor(std::size_t n, std::size_t block,
+                 const std::function<void(std::size_t begin, std::size_t end)>& body,
+                 unsigned max_threads = 0);
+
+}  // namespace pitchlab::mapping::internal

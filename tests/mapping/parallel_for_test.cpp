@@ -1,0 +1,83 @@
+#include "parallel_for.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <mutex>
+#include <set>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+namespace pitchlab::mapping::internal {
+namespace {
+
+// Every item is visited exactly once, whatever the block size and thread count.
+TEST(ParallelFor, VisitsEveryItemOnce) {
+  for (const std::size_t n : {0u, 1u, 7u, 256u, 1000u}) {
+    for (const std::size_t block : {1u, 3u, 256u, 5000u}) {
+      for (const unsigned threads : {0u, 1u, 2u, 8u}) {
+        std::vector<std::atomic<int>> visits(n);
+        ParallelFor(
+            n, block,
+            [&](std::size_t begin, std::size_t end) {
+              ASSERT_LE(end - begin, block);
+              for (std::size_t i = begin; i < end; ++i) ++visits[i];
+            },
+            threads);
+        for (std::size_t i = 0; i < n; ++i) {
+          ASSERT_EQ(visits[i].load(), 1) << "n " << n << " block " << block << " item " << i;
+        }
+      }
+    }
+  }
+}
+
+TEST(ParallelFor, OneThreadIsTheCallerAlone) {
+  std::set<std::thread::id> ids;
+  ParallelFor(
+      100, 1, [&](std::size_t, std::size_t) { ids.insert(std::this_thread::get_id()); }, 1);
+  EXPECT_EQ(ids, std::set<std::thread::id>{std::this_thread::get_id()});
+}
+
+TEST(ParallelFor, UsesMoreThanOneThreadWhereTheMachineHasThem) {
+  if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "one core";
+  std::mutex mutex;
+  std::set<std::thread::id> ids;
+  std::atomic<int> arrived{0};
+  // Each of the two blocks waits (bounded) until the other started: only two threads pass.
+  ParallelFor(
+      2, 1,
+      [&](std::size_t, std::size_t) {
+        {
+          std::lock_guard<std::mutex> lock(mutex);
+          ids.insert(std::this_thread::get_id());
+        }
+        ++arrived;
+        for (int i = 0; i < 2000 && arrived.load() < 2; ++i) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+      },
+      2);
+  EXPECT_EQ(ids.size(), 2u);
+}
+
+// A block's exception reaches the caller, after every thread stopped (none touches `visits`
+// once ParallelFor returned: it would be a use after scope under ASan).
+TEST(ParallelFor, ABodysExceptionReachesTheCaller) {
+  for (const unsigned threads : {1u, 2u, 4u}) {
+    std::vector<int> visits(64, 0);
+    EXPECT_THROW(ParallelFor(
+                     64, 1,
+                     [&](std::size_t begin, std::size_t) {
+                       visits[begin] = 1;
+                       if (begin == 5) throw std::runtime_error("item 5");
+                     },
+                     threads),
+                 std::runtime_error);
+    EXPECT_EQ(visits[5], 1);
+  }
+}
+
+}  // namespace
+}  // namespace pitchlab::mapping::internal
