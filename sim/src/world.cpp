@@ -1,5 +1,7 @@
 #include "pitchlab/sim/world.hpp"
 
+#include <mujoco/mujoco.h>
+
 #include <regex>
 #include <stdexcept>
 
@@ -8,6 +10,12 @@ namespace {
 
 [[noreturn]] void Bad(const std::string& source, const std::string& what) {
   throw std::runtime_error("world " + source + ": " + what);
+}
+
+int CountOf(const std::string& text, const std::string& what) {
+  int n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
 }
 
 bool IsAbsolute(const std::string& path) { return !path.empty() && path.front() == '/'; }
@@ -87,10 +95,17 @@ std::string ComposeWorldXml(const std::string& world_xml, const std::string& wor
   } else {
     Bad(source_name, "has no <worldbody> element");
   }
-  // The robot's wheels add contacts (cylinders on heightfields give several each): raise MuJoCo
-  // 2.2's default contact buffer unless the world sizes it itself.
-  const std::string size =
-      xml.find("nconmax") == std::string::npos ? "<size nconmax=\"1000\" njmax=\"4000\"/>\n" : "";
+  // The robot's wheels add contacts (cylinders on heightfields give several each): size MuJoCo
+  // 2.2's contact buffer for the robot unless the world sizes it itself: at most mjMAXCONPAIR
+  // (50) contacts for each of the robot's geoms (a P3-AT has 9), at most 4 constraint rows each
+  // (a pyramidal cone of condim 3). No more: 2.2 sizes its solver stack as 5 njmax^2 numbers,
+  // cleared when a model's data is made (the former njmax 4000 made it 640 MB, 1.0 s for each
+  // Simulation; the terrain world's most was 20 contacts, 60 rows).
+  const int contacts = mjMAXCONPAIR * CountOf(parts.body, "<geom ");
+  const std::string size = xml.find("nconmax") == std::string::npos
+                               ? "<size nconmax=\"" + std::to_string(contacts) + "\" njmax=\"" +
+                                     std::to_string(4 * contacts) + "\"/>\n"
+                               : "";
   const std::size_t close = xml.rfind("</mujoco>");
   xml.insert(close, size + parts.defaults + parts.actuators + parts.sensors);
   return xml;

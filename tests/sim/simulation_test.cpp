@@ -380,6 +380,29 @@ TEST(ComposeWorldXml, MakesRelativeAssetPathsAbsoluteAndKeepsAbsoluteOnes) {
                std::runtime_error);
 }
 
+// The contact buffer holds the most contacts the robot's geoms can make (mjMAXCONPAIR each, 4
+// pyramidal rows per contact), and no more: MuJoCo 2.2 clears 5 njmax^2 numbers of solver stack
+// for every mjData made. A world that sizes the buffer itself keeps its own.
+TEST_P(RobotModels, TheContactBufferIsSizedForTheRobotsGeoms) {
+  const auto sim = Simulation::FromString(kFlatWorld, "/tmp", Robot(GetParam()));
+  const mjModel* m = sim->model();
+  const int robot = mj_name2id(m, mjOBJ_BODY, kRobotBody);
+  int robot_geoms = 0;
+  for (int g = 0; g < m->ngeom; ++g) {
+    int b = m->geom_bodyid[g];
+    while (b != 0 && b != robot) b = m->body_parentid[b];
+    robot_geoms += b == robot ? 1 : 0;
+  }
+  EXPECT_GE(robot_geoms, 6);  // tyres or wheels, caster, chassis, laser
+  EXPECT_EQ(m->nconmax, mjMAXCONPAIR * robot_geoms);
+  EXPECT_EQ(m->njmax, 4 * m->nconmax);
+  std::string own(kFlatWorld);
+  own.insert(own.rfind("</mujoco>"), "<size nconmax=\"77\" njmax=\"300\"/>\n");
+  const auto sized = Simulation::FromString(own, "/tmp", Robot(GetParam()));
+  EXPECT_EQ(sized->model()->nconmax, 77);
+  EXPECT_EQ(sized->model()->njmax, 300);
+}
+
 }  // namespace
 }  // namespace pitchlab::sim
 
