@@ -1,5 +1,7 @@
 #include "parallel_for.hpp"
 
+#include <sched.h>
+
 #include <algorithm>
 #include <atomic>
 #include <future>
@@ -12,6 +14,14 @@ namespace {
 
 constexpr unsigned kMaxThreads = 8;  // beyond the 2-8 cores this runs on, blocks get too few
 
+// The cores this process may run on: its CPU affinity (taskset, a cluster job's cpuset), which
+// hardware_concurrency ignores: a run given one core of 64 would start 8 threads on it.
+unsigned Cores() {
+  cpu_set_t set;
+  if (sched_getaffinity(0, sizeof set, &set) == 0) return std::max(1, CPU_COUNT(&set));
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
 }  // namespace
 
 void ParallelFor(std::size_t n, std::size_t block,
@@ -20,7 +30,7 @@ void ParallelFor(std::size_t n, std::size_t block,
   if (n == 0) return;
   block = std::max<std::size_t>(block, 1);
   const std::size_t blocks = (n + block - 1) / block;
-  const unsigned cores = std::clamp(std::thread::hardware_concurrency(), 1u, kMaxThreads);
+  const unsigned cores = std::min(Cores(), kMaxThreads);
   const unsigned threads = static_cast<unsigned>(
       std::min<std::size_t>(blocks, max_threads > 0 ? std::min(max_threads, cores) : cores));
   std::atomic<std::size_t> next{0};

@@ -97,7 +97,7 @@ std::string ComposeWorldXml(const std::string& world_xml, const std::string& wor
   }
   // The robot's wheels add contacts (cylinders on heightfields give several each): size MuJoCo
   // 2.2's contact buffer for the robot unless the world sizes it itself: at most mjMAXCONPAIR
-  // (50) contacts for each of the robot's geoms (a P3-AT has 9), at most 4 constraint rows each
+  // (50) contacts for each of the robot's geoms (a P3-AT has 8), at most 4 constraint rows each
   // (a pyramidal cone of condim 3). No more: 2.2 sizes its solver stack as 5 njmax^2 numbers,
   // cleared when a model's data is made (the former njmax 4000 made it 640 MB, 1.0 s for each
   // Simulation; the terrain world's most was 20 contacts, 60 rows).

@@ -1,6 +1,7 @@
 #include "parallel_for.hpp"
 
 #include <gtest/gtest.h>
+#include <sched.h>
 
 #include <atomic>
 #include <mutex>
@@ -40,8 +41,13 @@ TEST(ParallelFor, OneThreadIsTheCallerAlone) {
   EXPECT_EQ(ids, std::set<std::thread::id>{std::this_thread::get_id()});
 }
 
+int AllowedCores() {
+  cpu_set_t set;
+  return sched_getaffinity(0, sizeof set, &set) == 0 ? CPU_COUNT(&set) : 1;
+}
+
 TEST(ParallelFor, UsesMoreThanOneThreadWhereTheMachineHasThem) {
-  if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "one core";
+  if (AllowedCores() < 2) GTEST_SKIP() << "one core";
   std::mutex mutex;
   std::set<std::thread::id> ids;
   std::atomic<int> arrived{0};
@@ -60,6 +66,23 @@ TEST(ParallelFor, UsesMoreThanOneThreadWhereTheMachineHasThem) {
       },
       2);
   EXPECT_EQ(ids.size(), 2u);
+}
+
+// A process allowed one core (taskset, a cluster job's cpuset) runs its loops on the caller alone,
+// however many cores the machine has.
+TEST(ParallelFor, KeepsToTheCoresTheProcessIsAllowed) {
+  cpu_set_t before;
+  ASSERT_EQ(sched_getaffinity(0, sizeof before, &before), 0);
+  int first = 0;
+  while (!CPU_ISSET(first, &before)) ++first;
+  cpu_set_t one;
+  CPU_ZERO(&one);
+  CPU_SET(first, &one);
+  ASSERT_EQ(sched_setaffinity(0, sizeof one, &one), 0);
+  std::set<std::thread::id> ids;
+  ParallelFor(64, 1, [&](std::size_t, std::size_t) { ids.insert(std::this_thread::get_id()); });
+  ASSERT_EQ(sched_setaffinity(0, sizeof before, &before), 0);
+  EXPECT_EQ(ids, std::set<std::thread::id>{std::this_thread::get_id()});
 }
 
 // A block's exception reaches the caller, after every thread stopped (none touches `visits`
