@@ -21,9 +21,6 @@ constexpr int kBarWidth_px = 22;
 constexpr int kMinBarHeight_px = 240;  // room for at least three labelled ticks
 // The whole picture is rendered before cropping: this bounds its memory (3 bytes a pixel).
 constexpr int kMaxRenderSide_px = 3000;
-// Keeps the start and goal markers (kMarkerRadius_px at ~0.05 m/px) and half a robot width clear
-// of the border.
-constexpr double kWindowMargin_m = 1.0;
 
 using Rgb = std::array<std::uint8_t, 3>;
 constexpr Rgb kBlack{0, 0, 0}, kWhite{255, 255, 255};
@@ -208,8 +205,8 @@ MapWindow ExploredWindow(const mapping::ElevationLayers& layers,
     hi = hi.cwiseMax(p);
   }
   if (!std::isfinite(lo.x())) return {{g.x_min_m, g.y_min_m}, {g.x_max_m(), g.y_max_m()}};
-  return {lo - Eigen::Vector2d::Constant(kWindowMargin_m),
-          hi + Eigen::Vector2d::Constant(kWindowMargin_m)};
+  return {lo - Eigen::Vector2d::Constant(kPictureWindowMargin_m),
+          hi + Eigen::Vector2d::Constant(kPictureWindowMargin_m)};
 }
 
 int FigurePixelsPerCell(const mapping::GridGeometry& g, const MapWindow& w, int target_px) {

@@ -8,6 +8,8 @@
 
 #include "axis_ticks.hpp"
 #include "bitmap_font.hpp"
+#include "pitchlab/mapping/elevation_layers.hpp"
+#include "pitchlab/planning/path_io.hpp"
 
 namespace pitchlab::mission {
 namespace {
@@ -126,6 +128,64 @@ TEST_F(MapFigure, ColourBarRunsFromLowAtTheBottomToHighAtTheTop) {
   EXPECT_GT(bar.x0, Find(fig, {128, 128, 128}).x1);  // right of the map
   EXPECT_GT(top_red, 250);
   EXPECT_GT(bottom_blue, 250);
+}
+
+// A stop's picture is made from the part of the map it shows (PictureRegion): pixel for pixel the
+// picture the whole map gives, whatever the seen patch's offset against the unknown cells'
+// checkerboard, with drops seen only by rays passing below, and a plan that runs off the seen
+// ground to a goal far across the map.
+TEST(StopPicture, IsThePictureOfTheWholeMap) {
+  const mapping::GridGeometry g = mapping::GridGeometry::FromArea(-20, -20, 40, 40, 0.1);
+  for (const Eigen::Vector2d& offset : {Eigen::Vector2d(3.33, -7.71), Eigen::Vector2d(-6.05, 4.4)}) {
+    MissionResult so_far;
+    so_far.elevation = mapping::ElevationMap(g);
+    std::vector<Eigen::Vector3f> points;
+    for (double x = 0; x < 5; x += 0.05) {
+      for (double y = 0; y < 4; y += 0.05) {
+        // a tilted plane with a 0.3 m wall across it, and a pit 1 m deep from x = 3.5 to 4.2
+        // whose floor shows only at its far end: its near part is seen by rays passing below the
+        // rim (a drop)
+        double z = 0.1 * x + 0.05 * y + (y > 2 && y < 2.3 ? 0.3 : 0.0);
+        if (x > 3.5 && x < 4.2) {
+          if (x < 4.0) continue;
+          z = -1.0;
+        }
+        points.emplace_back(offset.x() + x, offset.y() + y, z);
+      }
+    }
+    const Eigen::Vector3f sensor(offset.x() - 0.5, offset.y() + 2, 1.0);
+    so_far.elevation.InsertScan(points.data(), points.size(), sensor);
+    for (int k = 0; k < 3; ++k) {
+      TrajectorySample s;
+      s.T_world_base_est.translation() = Eigen::Vector3d(offset.x() + 0.5 * k, offset.y() + 1, 0);
+      so_far.trajectory.push_back(s);
+    }
+    planning::Path plan;
+    for (const Eigen::Vector2d w : std::array<Eigen::Vector2d, 3>{
+             offset + Eigen::Vector2d(1, 1), offset + Eigen::Vector2d(8, 3), {15, 12}}) {
+      plan.waypoints.push_back({w.x(), w.y(), 0});
+    }
+    const mapping::RgbImage picture = StopPicture(so_far, plan);
+
+    const mapping::ElevationLayers layers = mapping::ComputeLayers(so_far.elevation);
+    std::vector<Eigen::Vector2d> keep = TrajectoryXy(so_far, false);
+    for (const planning::Waypoint& w : plan.waypoints) keep.emplace_back(w.x_m, w.y_m);
+    const MapWindow window = ExploredWindow(layers, keep);
+    mapping::ImageOptions options;
+    options.pixels_per_cell = FigurePixelsPerCell(g, window);
+    mapping::RgbImage image = mapping::RenderElevationImage(layers, options);
+    planning::DrawPath(plan, g, image);
+    FigureMarks marks;
+    marks.start_m = keep.front();
+    marks.goal_m = keep.back();
+    marks.colour_bar = HeightBar(layers);
+    const mapping::RgbImage whole = ComposeMapFigure(image, g, window, marks);
+
+    ASSERT_EQ(picture.width, whole.width);
+    ASSERT_EQ(picture.height, whole.height);
+    EXPECT_TRUE(picture.rgb == whole.rgb) << "offset " << offset.transpose();
+    EXPECT_GT(Find(whole, {220, 0, 220}).count, 0) << "no drop drawn: the test lost its pit";
+  }
 }
 
 TEST(Downscale, AveragesWholeBlocks) {

@@ -19,6 +19,10 @@ struct MapWindow {
   Eigen::Vector2d lo_m{0, 0}, hi_m{0, 0};
 };
 
+/// ExploredWindow's margin around what it holds: keeps the start and goal markers (kMarkerRadius_px
+/// at ~0.05 m/px) and half a robot width clear of the border [m].
+inline constexpr double kPictureWindowMargin_m = 1.0;
+
 /// The bounding box of the cells the map knows (observed or drop), grown to hold `points_m`
 /// (start, goal, trajectories) and a margin that keeps the markers and the robot's footprint at
 /// the border inside; the whole grid when no cell is known.
