@@ -96,20 +96,25 @@ void FindPairs(const IcpTarget& target, const PointCloud& source, const Eigen::I
   pairs.clear();
   const Eigen::Isometry3f Tf = T.cast<float>();
   const VoxelHashIndex& index = IndexFor(target, gate_m);
-  thread_local std::vector<int> buffer;  // the caller's, kept between iterations
-  std::vector<int>& nearest = buffer;      // (the helpers must write the caller's, not theirs)
+  // The caller's buffers, kept between iterations (the helpers write the caller's, not theirs).
+  thread_local std::vector<int> nearest_buffer;
+  thread_local PointCloud moved_buffer;
+  std::vector<int>& nearest = nearest_buffer;
+  PointCloud& moved = moved_buffer;
   nearest.resize(source.size());
+  moved.resize(source.size());
   internal::ParallelFor(source.size(), kPointsPerBlock, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
+      moved[i] = Tf * source[i];
       float d2 = 0;
-      const int j = index.Nearest(Tf * source[i], gate_m, d2);
+      const int j = index.Nearest(moved[i], gate_m, d2);
       nearest[i] = j >= 0 && target.normals[j].allFinite() ? j : -1;
     }
   });
   for (std::size_t i = 0; i < source.size(); ++i) {
     const int j = nearest[i];
     if (j < 0) continue;
-    pairs.push_back({(Tf * source[i]).cast<double>(), target.points[j].cast<double>(),
+    pairs.push_back({moved[i].cast<double>(), target.points[j].cast<double>(),
                      target.normals[j].cast<double>()});
   }
 }

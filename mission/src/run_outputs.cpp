@@ -165,6 +165,12 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
 void WriteStopOutputs(RunFolder& folder, const StopRecord& stop, const MissionResult& so_far,
                       const std::optional<mapping::GeodeticOrigin>& origin,
                       const std::string& world) {
+  WriteStopOutputs(folder, stop, ViewOfStop(so_far, stop.plan), origin, world);
+}
+
+void WriteStopOutputs(RunFolder& folder, const StopRecord& stop, const StopView& view,
+                      const std::optional<mapping::GeodeticOrigin>& origin,
+                      const std::string& world) {
   char dir[32];
   std::snprintf(dir, sizeof(dir), "stops/%03d/", stop.index);
   const std::string d = dir;
@@ -179,7 +185,7 @@ void WriteStopOutputs(RunFolder& folder, const StopRecord& stop, const MissionRe
           planning::WritePathGeoJson(*stop.plan, origin, folder.File(d + "path.geojson").string()));
     }
   }
-  WriteStopPictures(folder, d, so_far, stop.plan);
+  WriteStopPictures(folder, d, view);
 }
 
 namespace {

@@ -166,29 +166,46 @@ mapping::RgbImage Downscale(const mapping::RgbImage& image, int max_width_px) {
   return out;
 }
 
-void WriteStopPictures(RunFolder& folder, const std::string& dir, const MissionResult& so_far,
-                       const std::optional<planning::Path>& plan) {
-  const mapping::RgbImage picture = StopPicture(so_far, plan);
+void WriteStopPictures(RunFolder& folder, const std::string& dir, const StopView& view) {
+  const mapping::RgbImage picture = StopPicture(view);
   Write(picture, folder.File(dir + "map.png"));
   Write(Downscale(picture, kThumbnailWidth_px), folder.File(dir + "map_small.png"));
 }
 
-mapping::RgbImage StopPicture(const MissionResult& so_far,
-                              const std::optional<planning::Path>& plan) {
-  std::vector<Eigen::Vector2d> keep = TrajectoryXy(so_far, false);
-  FigureMarks marks;
-  if (!keep.empty()) marks.start_m = keep.front();
-  if (plan && !plan->waypoints.empty()) {
-    for (const planning::Waypoint& w : plan->waypoints) keep.emplace_back(w.x_m, w.y_m);
-    marks.goal_m = keep.back();
+namespace {
+
+// The points a stop's picture holds: the estimated trajectory, then the plan's waypoints.
+std::vector<Eigen::Vector2d> PicturePoints(const StopView& view) {
+  std::vector<Eigen::Vector2d> points = view.trajectory_m;
+  if (view.plan) {
+    for (const planning::Waypoint& w : view.plan->waypoints) points.emplace_back(w.x_m, w.y_m);
   }
-  const mapping::ElevationLayers layers = mapping::ComputeLayers(PictureRegion(so_far.elevation, keep));
+  return points;
+}
+
+}  // namespace
+
+StopView ViewOfStop(const MissionResult& so_far, const std::optional<planning::Path>& plan) {
+  StopView view;
+  view.whole = so_far.elevation.geometry();
+  view.trajectory_m = TrajectoryXy(so_far, false);
+  view.plan = plan;
+  view.region = PictureRegion(so_far.elevation, PicturePoints(view));
+  return view;
+}
+
+mapping::RgbImage StopPicture(const StopView& view) {
+  const std::vector<Eigen::Vector2d> keep = PicturePoints(view);
+  FigureMarks marks;
+  if (!view.trajectory_m.empty()) marks.start_m = view.trajectory_m.front();
+  if (view.plan && !view.plan->waypoints.empty()) marks.goal_m = keep.back();
+  const mapping::ElevationLayers layers = mapping::ComputeLayers(view.region);
   const mapping::GridGeometry& g = layers.geometry;
   const MapWindow window = ExploredWindow(layers, keep);
   mapping::ImageOptions options;
-  options.pixels_per_cell = FigurePixelsPerCell(so_far.elevation.geometry(), window);
+  options.pixels_per_cell = FigurePixelsPerCell(view.whole, window);
   mapping::RgbImage image = mapping::RenderElevationImage(layers, options);
-  if (plan) planning::DrawPath(*plan, g, image);
+  if (view.plan) planning::DrawPath(*view.plan, g, image);
   marks.colour_bar = HeightBar(layers);
   return ComposeMapFigure(image, g, window, marks);
 }

@@ -27,10 +27,21 @@ void WriteRunPictures(RunFolder& folder, const RunContext& context, const Missio
                       const mapping::ElevationLayers& layers, const mapping::ElevationLayers* truth,
                       const std::optional<planning::Path>& truth_optimum);
 
+/// What a stop's picture needs of the run so far, and no more: the part of the map it shows with
+/// what the layers there read (a few percent of a large map's cells: a copy the thread beside the
+/// mission can draw from while the mission goes on), the whole map's grid (it sets the picture's
+/// scale), the estimated trajectory and the stop's plan.
+struct StopView {
+  mapping::ElevationMap region;
+  mapping::GridGeometry whole;
+  std::vector<Eigen::Vector2d> trajectory_m;  ///< estimated x, y of every sample [m]
+  std::optional<planning::Path> plan;
+};
+StopView ViewOfStop(const MissionResult& so_far, const std::optional<planning::Path>& plan);
+
 /// A stop's map.png: the map so far with the stop's plan, cropped to what is known, the start
-/// (the first trajectory sample) and the plan's goal marked.
-mapping::RgbImage StopPicture(const MissionResult& so_far,
-                              const std::optional<planning::Path>& plan);
+/// (the first trajectory sample) and the plan's goal marked. The same pixels as the whole map's.
+mapping::RgbImage StopPicture(const StopView& view);
 
 /// The report's thumbnails are this wide [px]: twice the 240 px they are shown at, sharp on a
 /// high-density screen. Measured on the default terrain run: 66 KB a thumbnail, so the default
@@ -43,7 +54,12 @@ mapping::RgbImage Downscale(const mapping::RgbImage& image, int max_width_px);
 
 /// Writes `dir`map.png (StopPicture) and `dir`map_small.png (its thumbnail). Throws
 /// std::runtime_error naming the file on a write failure.
-void WriteStopPictures(RunFolder& folder, const std::string& dir, const MissionResult& so_far,
-                       const std::optional<planning::Path>& plan);
+void WriteStopPictures(RunFolder& folder, const std::string& dir, const StopView& view);
+
+/// WriteStopOutputs (run_outputs.hpp) with the stop's picture drawn from `view`, for a caller that
+/// writes them on another thread while the mission goes on.
+void WriteStopOutputs(RunFolder& folder, const StopRecord& stop, const StopView& view,
+                      const std::optional<mapping::GeodeticOrigin>& origin,
+                      const std::string& world);
 
 }  // namespace pitchlab::mission

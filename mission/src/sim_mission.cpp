@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "background_jobs.hpp"
+#include "run_pictures.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/elevation_truth.hpp"
 #include "pitchlab/mission/run_folder.hpp"
@@ -111,7 +112,7 @@ struct TruthScene {
 // What a stop's files are made from, copied when the stop ends: the mission goes on meanwhile.
 struct StopSnapshot {
   StopRecord stop;
-  MissionResult so_far;  // its elevation map and trajectory (all a stop's pictures show)
+  StopView view;  // what the stop's picture shows of the map so far
 };
 
 // The probes of a simulated run: its clock, its ground truth and its attitude sensor, the
@@ -269,11 +270,10 @@ SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesyste
     const sensors::ScopedTime timing(stages[Stage::kOutputs]);
     auto snapshot = std::make_shared<StopSnapshot>();
     snapshot->stop = stop;
-    snapshot->so_far.elevation = so_far.elevation;
-    snapshot->so_far.trajectory = so_far.trajectory;
+    snapshot->view = ViewOfStop(so_far, stop.plan);
     side.Post([&, snapshot] {
       const double cpu0 = sensors::ThreadCpuSeconds();
-      WriteStopOutputs(folder, snapshot->stop, snapshot->so_far, origin, world_stem);
+      WriteStopOutputs(folder, snapshot->stop, snapshot->view, origin, world_stem);
       outputs_cpu_s += sensors::ThreadCpuSeconds() - cpu0;
     });
   };

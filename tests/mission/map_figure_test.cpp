@@ -165,7 +165,7 @@ TEST(StopPicture, IsThePictureOfTheWholeMap) {
              offset + Eigen::Vector2d(1, 1), offset + Eigen::Vector2d(8, 3), {15, 12}}) {
       plan.waypoints.push_back({w.x(), w.y(), 0});
     }
-    const mapping::RgbImage picture = StopPicture(so_far, plan);
+    const mapping::RgbImage picture = StopPicture(ViewOfStop(so_far, plan));
 
     const mapping::ElevationLayers layers = mapping::ComputeLayers(so_far.elevation);
     std::vector<Eigen::Vector2d> keep = TrajectoryXy(so_far, false);
