@@ -21,13 +21,26 @@ double DenseLinesRadius(const sensors::Scan3D& scan, double laser_height_m, doub
       std::max(0.0, cell_m * laser_height_m / dtheta - laser_height_m * laser_height_m));
 }
 
-std::size_t RefuteLineGaps(const planning::TraversabilityGrid& grid,
-                           const mapping::ElevationLayers& layers, const Eigen::Vector2d& laser_xy,
-                           double heading_rad, double radius_m, std::vector<RefutedGap>& refuted) {
+double NearestGroundAhead(const sensors::Scan3D& scan, const sensors::MountConfig& mount) {
+  double steepest = -std::numeric_limits<double>::infinity();
+  for (const sensors::LaserLine& line : scan.lines) steepest = std::max(steepest, line.pitch_rad);
+  if (!std::isfinite(steepest)) return std::numeric_limits<double>::infinity();
+  // Positive pitch turns the scan plane's forward beam down (R_y).
+  const Eigen::Isometry3d T = mount.BaseToLaser(steepest);
+  const Eigen::Vector3d o = T.translation(), d = T.linear() * Eigen::Vector3d::UnitX();
+  if (!(d.z() < 0.0) || !(o.z() > 0.0)) return std::numeric_limits<double>::infinity();
+  const double hit_x = o.x() - o.z() / d.z() * d.x();
+  return std::max(0.0, hit_x - mount.BaseToLaser(0.0).translation().x());
+}
+
+std::size_t RefuteBridges(const planning::TraversabilityGrid& grid,
+                          const mapping::ElevationLayers& layers, const Eigen::Vector2d& laser_xy,
+                          double heading_rad, double near_m, double radius_m,
+                          std::vector<RefutedGap>& refuted) {
   const mapping::GridGeometry& g = grid.geometry;
   refuted.resize(g.cell_count(), RefutedGap::kNone);
-  if (!(radius_m > 0.0) || grid.line_gap.size() != g.cell_count() ||
-      layers.clearance_z.size() != g.cell_count()) {
+  if (!(radius_m > 0.0) || grid.z_m.size() != g.cell_count() ||
+      layers.state.size() != g.cell_count() || layers.clearance_z.size() != g.cell_count()) {
     return 0;
   }
   const Eigen::Vector2d ahead(std::cos(heading_rad), std::sin(heading_rad));
@@ -38,9 +51,11 @@ std::size_t RefuteLineGaps(const planning::TraversabilityGrid& grid,
     for (int i = c.i - reach; i <= c.i + reach; ++i) {
       if (!g.Contains({i, j})) continue;
       const std::size_t k = g.Linear({i, j});
-      if (!grid.line_gap[k] || refuted[k] != RefutedGap::kNone) continue;
+      const bool bridged =
+          layers.state[k] == mapping::CellState::kUnknown && std::isfinite(grid.z_m[k]);
+      if (!bridged || refuted[k] != RefutedGap::kNone) continue;
       const Eigen::Vector2d to = g.CenterOf({i, j}) - laser_xy;
-      if (to.norm() > radius_m || to.dot(ahead) <= 0.0) continue;
+      if (to.norm() > radius_m || !(to.dot(ahead) >= near_m) || to.dot(ahead) <= 0.0) continue;
       refuted[k] = layers.clearance_z[k] < grid.z_m[k] - kBelowGround_m ? RefutedGap::kDepression
                                                                         : RefutedGap::kUnseen;
       ++marked;

@@ -13,6 +13,7 @@
 #include "pitchlab/mission/elevation_scan.hpp"
 #include "pitchlab/mission/slope_guard.hpp"
 
+#include "drive_length.hpp"
 #include "line_gaps.hpp"
 #include "optimised_elevation.hpp"
 
@@ -252,7 +253,7 @@ class Mission {
   // recovery doubts only what was never seen from close: doubt measured from where the robot
   // stands made it walk back and forth between two routes, each far from the other's end.
   std::vector<float> nearest_view_m_;
-  // Per map cell, what a line gap that stayed a gap when seen from close is (line_gaps.hpp).
+  // Per map cell, what a bridged gap that stayed a gap when seen from close is (line_gaps.hpp).
   std::vector<RefutedGap> refuted_gaps_;
   // With calibrate_mount: the mount the first scan's floor says the laser is on
   // (mapping::CalibrateMountFromFloor), every scan re-assembled on it.
@@ -626,7 +627,7 @@ void Mission::Plan(StopRecord& stop) {
   stop.felt_hazards = static_cast<int>(felt_.size());
   const planning::PlannerConfig planner = MissionPlanner(config_);
   Traversability(layers, planner, grid_);
-  // The line gaps this stop's laser saw from where its lines are denser than the cells, still
+  // The bridged gaps this stop's laser saw from where its lines are denser than the cells, still
   // gaps: not ground the lines skipped (line_gaps.hpp). Only at a registered pose: at an
   // odometry pose the scan only filled the map's unknown cells, a metre off at worst.
   if (!stop.elevation_from_odometry) {
@@ -635,8 +636,8 @@ void Mission::Plan(StopRecord& stop) {
     const Eigen::Matrix3d R = stop.T_world_base.linear();
     const double radius_m =
         DenseLinesRadius(stop.scan, laser_base.translation().z(), config_.map_area.cell_m);
-    if (RefuteLineGaps(grid_, layers_, laser.translation().head<2>(),
-                       std::atan2(R(1, 0), R(0, 0)), radius_m, refuted_gaps_) > 0) {
+    if (RefuteBridges(grid_, layers_, laser.translation().head<2>(), std::atan2(R(1, 0), R(0, 0)),
+                      NearestGroundAhead(stop.scan, config_.mount), radius_m, refuted_gaps_) > 0) {
       MarkRefutedGaps(layers_, refuted_gaps_);
       Traversability(layers, planner, grid_);
     }
@@ -736,22 +737,21 @@ double PathHeading(const planning::Path& path, double arc_m) {
 
 bool Mission::Drive(const StopRecord& stop) {
   const planning::Path& path = *stop.plan;
-  // Drive over what was seen, stopping short of the first unobserved cell; when that is too
-  // close, only turn to face the path so the next scan sees it (once: then drive a little).
-  double length = std::min(config_.drive_per_stop_m, stop.plan_known_m - config_.unknown_margin_m);
-  const bool turn_only = length < config_.unknown_margin_m && !last_stop_turned_only_;
-  // After a turn that showed nothing new, the unknown ground is in the laser's blind zone just
-  // ahead: drive a little onto it, but never up to a cell the map took for a drop.
-  if (!turn_only) {
-    length = std::max(length, std::min(config_.drive_per_stop_m, 1.0));
-    if (stop.look_closer)
-      length = std::min(length, stop.plan_to_doubt_m - config_.unknown_margin_m);
-    if (length < kMinDrive_m) {
-      // Looked from as close as it may go: the hazards stand, so there is no way on.
-      result_.reason = "no path at stop " + std::to_string(stop.index) +
-                       ": the hazards that block the way stay hazards seen from close by";
-      return false;
-    }
+  double plan_m = 0;  // as plan_known_m adds it up
+  for (std::size_t i = 1; i < path.waypoints.size(); ++i) {
+    const planning::Waypoint &v = path.waypoints[i - 1], &w = path.waypoints[i];
+    plan_m += std::hypot(w.x_m - v.x_m, w.y_m - v.y_m);
+  }
+  const DriveLength drive = PlanDriveLength(
+      config_.drive_per_stop_m, config_.unknown_margin_m, plan_m, stop.plan_known_m,
+      last_stop_turned_only_, stop.look_closer ? std::optional(stop.plan_to_doubt_m) : std::nullopt);
+  const bool turn_only = drive.turn_only;
+  const double length = drive.length_m;
+  if (stop.look_closer && !turn_only && length < kMinDrive_m) {
+    // Looked from as close as it may go: the hazards stand, so there is no way on.
+    result_.reason = "no path at stop " + std::to_string(stop.index) +
+                     ": the hazards that block the way stay hazards seen from close by";
+    return false;
   }
   last_stop_turned_only_ = turn_only;
   backed_off_ = false;

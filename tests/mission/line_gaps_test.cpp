@@ -1,5 +1,6 @@
-// Line gaps checked from close by (mission/src/line_gaps.hpp): the radius within which a nodding
-// scan's lines lie closer than a cell, and the bridged gaps a scan from there refutes.
+// Bridged gaps checked from close by (mission/src/line_gaps.hpp): the radius within which a
+// nodding scan's lines lie closer than a cell, where they begin to meet the ground, and the
+// bridged gaps a scan from there refutes.
 
 #include "line_gaps.hpp"
 
@@ -74,10 +75,10 @@ TEST(LineGaps, OnlyGapsAheadAndWithinTheRadiusAreRefuted) {
 
   std::vector<RefutedGap> refuted;
   const Eigen::Vector2d laser(1.5, 1.5);
-  EXPECT_EQ(RefuteLineGaps(T, L, laser, M_PI, 2.0, refuted), 0u);  // behind the laser
-  EXPECT_EQ(RefuteLineGaps(T, L, laser, 0.0, 0.4, refuted), 0u);   // nearest 0.5 m off
+  EXPECT_EQ(RefuteBridges(T, L, laser, M_PI, 0.0, 2.0, refuted), 0u);  // behind the laser
+  EXPECT_EQ(RefuteBridges(T, L, laser, 0.0, 0.0, 0.4, refuted), 0u);   // nearest 0.5 m off
   // Facing it from 0.5-0.65 m, within a radius of 1 m: the cells within 1 m of the laser.
-  const std::size_t marked = RefuteLineGaps(T, L, laser, 0.0, 1.0, refuted);
+  const std::size_t marked = RefuteBridges(T, L, laser, 0.0, 0.0, 1.0, refuted);
   std::size_t expected = 0;
   for (int j = 0; j < kSizeY; ++j)
     for (int i = 20; i <= 21; ++i) expected += (T.geometry.CenterOf({i, j}) - laser).norm() <= 1.0;
@@ -85,7 +86,64 @@ TEST(LineGaps, OnlyGapsAheadAndWithinTheRadiusAreRefuted) {
   EXPECT_GT(marked, 20u);
   EXPECT_EQ(refuted[k], RefutedGap::kUnseen);                         // rays 3 cm above the floor
   EXPECT_EQ(refuted[T.geometry.Linear({20, 0})], RefutedGap::kNone);  // 1.5 m to the side
-  EXPECT_EQ(RefuteLineGaps(T, L, laser, 0.0, 1.0, refuted), 0u);      // each cell once
+  EXPECT_EQ(RefuteBridges(T, L, laser, 0.0, 0.0, 1.0, refuted), 0u);      // each cell once
+}
+
+TEST(LineGaps, NothingNearerThanTheScanMeetsTheGroundIsRefuted) {
+  const mapping::ElevationLayers L = FloorWithStripe(0.03f);
+  const planning::TraversabilityGrid T =
+      planning::BuildTraversability(L, planning::PlannerConfig{});
+  // The stripe's cells lie 0.5-0.7 m ahead of the laser: a scan whose lines meet the ground from
+  // 0.75 m on saw none of them, one from 0.6 m on the second column (centres 0.55 and 0.65 m).
+  const Eigen::Vector2d laser(1.5, 1.5);
+  std::vector<RefutedGap> refuted;
+  EXPECT_EQ(RefuteBridges(T, L, laser, 0.0, 0.75, 2.0, refuted), 0u);
+  EXPECT_EQ(RefuteBridges(T, L, laser, 0.0, 0.6, 2.0, refuted), std::size_t{kSizeY});
+  EXPECT_EQ(refuted[T.geometry.Linear({20, 15})], RefutedGap::kNone);
+  EXPECT_EQ(refuted[T.geometry.Linear({21, 15})], RefutedGap::kUnseen);
+}
+
+// A one-cell gap, narrower than the P3-AT's wheels span (0.21 m), is a bridge too, and a scan
+// from close by that still shows it refutes it: its width was measured between points that may
+// lie on a crack's walls, below its rims.
+TEST(LineGaps, AGapTheWheelsSpanIsRefutedToo) {
+  mapping::ElevationMap map(mapping::GridGeometry{0, 0, kCell, kSizeX, kSizeY});
+  std::vector<Eigen::Vector3f> pts;
+  for (int j = 0; j < kSizeY; ++j)
+    for (int i = 0; i < kSizeX; ++i)
+      if (i != 20)
+        for (const double dx : {-0.015, 0.015})
+          for (const double dy : {-0.015, 0.015})
+            pts.emplace_back((i + 0.5) * kCell + dx, (j + 0.5) * kCell + dy, 0.0f);
+  (void)map.InsertPoints(pts.data(), pts.size());
+  mapping::ElevationLayers L = mapping::ComputeLayers(map);
+  for (int j = 0; j < kSizeY; ++j) L.clearance_z[L.geometry.Linear({20, j})] = -0.02f;
+  const planning::TraversabilityGrid T =
+      planning::BuildTraversability(L, planning::PlannerConfig{});
+  const std::size_t k = T.geometry.Linear({20, 15});
+  ASSERT_TRUE(std::isfinite(T.z_m[k]));  // bridged
+  ASSERT_FALSE(T.line_gap[k]);           // as a gap the wheels span
+  std::vector<RefutedGap> refuted;
+  // Column 20's centres lie 0.55 m ahead: 16 of them within 1 m (|dy| <= 0.75 m).
+  EXPECT_EQ(RefuteBridges(T, L, {1.5, 1.5}, 0.0, 0.0, 1.0, refuted), 16u);
+  EXPECT_EQ(refuted[k], RefutedGap::kDepression);  // the ray passed 2 cm below the floor
+  MarkRefutedGaps(L, refuted);
+  EXPECT_EQ(L.state[k], mapping::CellState::kDrop);
+}
+
+// Where the steepest line's forward beam meets level ground: the LMS200 on the P3's mount (pitch
+// axis 0.45 m up and 0.1 m ahead, mirror 0.09 m above it) looking 40 deg down meets the ground
+// at x = 0.1 + 0.09 sin 40 + (0.45 + 0.09 cos 40) / tan 40 in base_link; from the laser at pitch 0
+// (x = 0.1) that is 0.09 sin 40 + (0.45 + 0.09 cos 40) / tan 40.
+TEST(LineGaps, TheScanMeetsTheGroundWhereItsSteepestLineDoes) {
+  const sensors::MountConfig mount;
+  const double t = 40 * kDeg;
+  sensors::Scan3D scan = LinesEvery(0.5 * kDeg, 3);  // -0.3 rad up to -0.2826 rad: all up
+  EXPECT_TRUE(std::isinf(NearestGroundAhead(scan, mount)));
+  scan.lines[1].pitch_rad = t;
+  const double expected = 0.09 * std::sin(t) + (0.45 + 0.09 * std::cos(t)) / std::tan(t);
+  EXPECT_NEAR(NearestGroundAhead(scan, mount), expected, 1e-9);
+  EXPECT_TRUE(std::isinf(NearestGroundAhead(sensors::Scan3D{}, mount)));
 }
 
 TEST(LineGaps, ARefutedGapIsUnknownAboveTheGroundAndADropBelowIt) {
@@ -95,7 +153,7 @@ TEST(LineGaps, ARefutedGapIsUnknownAboveTheGroundAndADropBelowIt) {
     mapping::ElevationLayers L = FloorWithStripe(ray_m);
     const planning::TraversabilityGrid T = planning::BuildTraversability(L, config);
     std::vector<RefutedGap> refuted;
-    EXPECT_EQ(RefuteLineGaps(T, L, laser, 0.0, 2.0, refuted), 2u * kSizeY);  // the whole stripe
+    EXPECT_EQ(RefuteBridges(T, L, laser, 0.0, 0.0, 2.0, refuted), 2u * kSizeY);  // the whole stripe
     refuted[T.geometry.Linear({5, 5})] = RefutedGap::kDepression;  // seen: keeps what it is
     MarkRefutedGaps(L, refuted);
     EXPECT_EQ(L.state[T.geometry.Linear({5, 5})], mapping::CellState::kObserved);
