@@ -36,7 +36,55 @@ double ViewOverlap(const PointCloud& target, const PointCloud& source,
   return source.empty() ? 0.0 : static_cast<double>(shared) / source.size();
 }
 
+// T moved by the perturbation p = (omega [rad], v [m]) in the target frame: Exp(p) T, as the
+// registration's information and covariance are defined.
+Eigen::Isometry3d Perturbed(const Eigen::Isometry3d& T, const Eigen::Matrix<double, 6, 1>& p) {
+  Eigen::Isometry3d D = Eigen::Isometry3d::Identity();
+  const Eigen::Vector3d omega = p.head<3>();
+  if (omega.norm() > 0) D.linear() = Eigen::AngleAxisd(omega.norm(), omega.normalized()).matrix();
+  D.translation() = p.tail<3>();
+  return D * T;
+}
+
+// (omega, v) of B relative to A in the target frame: B = Exp(d) A, to first order.
+Eigen::Matrix<double, 6, 1> Difference(const Eigen::Isometry3d& A, const Eigen::Isometry3d& B) {
+  const Eigen::Isometry3d D = B * A.inverse();
+  const Eigen::AngleAxisd aa(D.linear());
+  Eigen::Matrix<double, 6, 1> d;
+  d << aa.angle() * aa.axis(), D.translation();
+  return d;
+}
+
 }  // namespace
+
+Result<bool> SameMinimumFromAside(const PointCloud& target, const PointCloud& source,
+                                  const RegistrationPrior& prior, const RegistrationConfig& config,
+                                  const RegistrationResult& found, double bound_m,
+                                  double bound_deg) {
+  // The step: the graph's bounds, no smaller than an ICP voxel and a degree (the accuracy a loop
+  // edge must have to be right: issue 20 counts one 0.1 m or 1 deg off as wrong).
+  const double step_m = std::max(bound_m, found.settings.icp_voxel_m);  // the resolved voxel
+  const double step_rad = std::max(bound_deg, 1.0) / kRadToDeg;
+  Eigen::Matrix<double, 6, 1> scale;
+  scale << step_rad, step_rad, step_rad, step_m, step_m, step_m;
+  // The direction the fit holds weakest, counted in steps.
+  const Matrix6d normalised = scale.asDiagonal() * found.information * scale.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(0.5 * (normalised + normalised.transpose()));
+  const Eigen::Matrix<double, 6, 1> p = scale.cwiseProduct(eigen.eigenvectors().col(0));
+  for (const double sign : {-1.0, 1.0}) {
+    RegistrationPrior aside = prior;
+    aside.odometry = Perturbed(found.T_target_source, sign * p);
+    const Result<RegistrationResult> r = Register(target, source, aside, config);
+    if (!r) return tl::make_unexpected(r.error());
+    if (!r->success) return false;
+    // Half a step back is what a fit that holds the direction does at once (it returns to
+    // within its noise, millimetres); one that does not stays where it started, a step off.
+    const Eigen::Matrix<double, 6, 1> d =
+        Difference(found.T_target_source, r->T_target_source).cwiseQuotient(scale);
+    if (!(d.norm() <= 0.5)) return false;
+  }
+  return true;
+}
 
 Result<Matrix6d> EdgeInformation(const RegistrationResult& registration, double scale) {
   const Matrix6d C = 0.5 * (registration.covariance + registration.covariance.transpose());
@@ -170,6 +218,21 @@ Result<void> LoopCloser::TryLoop(int node, const LoopCandidate& candidate, Merge
     ++counts_.registration_failed;
     step.loop_attempts.push_back(std::move(attempt));
     return {};
+  }
+  if (r->path == RegistrationPath::kOdometry) {
+    const Result<bool> held = SameMinimumFromAside(scans_[target], scans_[node], prior,
+                                                   registration_, *r, candidate.uncertainty_m,
+                                                   RotationBoundDeg(target, node));
+    if (!held) return tl::make_unexpected(held.error());
+    if (!*held) {
+      attempt.registration.success = false;
+      attempt.registration.reason +=
+          "; refused as a loop: ICP started half the graph's bound aside along the fit's weakest "
+          "direction ends elsewhere, so the pose repeats the graph's guess";
+      ++counts_.registration_failed;
+      step.loop_attempts.push_back(std::move(attempt));
+      return {};
+    }
   }
   const Result<Matrix6d> information = EdgeInformation(*r, config_.information_scale);
   if (!information) return tl::make_unexpected(information.error());

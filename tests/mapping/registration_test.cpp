@@ -104,6 +104,38 @@ INSTANTIATE_TEST_SUITE_P(Worlds, KnownTransformOnRealScans,
                                            KnownMotion{"terrain", 0, 0, 0}),
                          [](const auto& info) { return std::string(info.param.world); });
 
+// A loop registration from its guess (no features) is a measurement only where the fit has a
+// minimum of its own: started aside along its weakest direction, ICP comes back to it. The office
+// pair from a guess 5 cm and 1 deg off: ICP finds the true pose, and from a step either side
+// returns to it. A pose that is no minimum (the truth 0.3 m off, what ICP left near a guess along
+// a weak axis) is refused: from either side ICP goes to the true minimum instead.
+TEST(SameMinimumFromAside, HoldsAtTheFitsMinimumAndNotAwayFromIt) {
+  const ScanPair office = OfficePair();
+  RegistrationConfig config = LoopRegistrationConfig(RegistrationConfig{});
+  config.features = FeatureKind::kNone;
+  RegistrationPrior prior;
+  prior.odometry = PoseFromXyzRpyDeg(0.05, 0.0, 0.0, 0.0, 0.0, 1.0) * office.truth;
+  prior.odometry_uncertainty = GuessUncertainty{0.2, 3.0};
+  prior.source_sensor = prior.target_sensor =
+      sensors::MountConfig{}.BaseToLaser(0.0).translation().cast<float>();
+  const Result<RegistrationResult> found = Register(office.target, office.source, prior, config);
+  ASSERT_TRUE(found) << found.error().message;
+  ASSERT_TRUE(found->success) << found->reason;
+  ASSERT_EQ(found->path, RegistrationPath::kOdometry);
+  ExpectNear(*found, office.truth);
+  const Result<bool> held =
+      SameMinimumFromAside(office.target, office.source, prior, config, *found, 0.2, 3.0);
+  ASSERT_TRUE(held) << held.error().message;
+  EXPECT_TRUE(*held);
+
+  RegistrationResult off = *found;
+  off.T_target_source = PoseFromXyzRpyDeg(0.3, 0.0, 0.0, 0.0, 0.0, 0.0) * found->T_target_source;
+  const Result<bool> moved =
+      SameMinimumFromAside(office.target, office.source, prior, config, off, 0.2, 3.0);
+  ASSERT_TRUE(moved) << moved.error().message;
+  EXPECT_FALSE(*moved);
+}
+
 TEST(Register, TwoRealScansFromDifferentPosesMatchGroundTruth) {
   const sensors::Scan3D a = SimulatedScan("office", -8, 0, 0, 1);
   const sensors::Scan3D b = SimulatedScan("office", -7.2, 0.3, 12, 2);
