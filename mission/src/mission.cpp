@@ -147,6 +147,9 @@ class Mission {
 
  private:
   bool Stop(int k);  // false: the mission ends (result_.reason says why)
+  // Back where the first scan was taken, with loop closure on: turn to where it looked and scan
+  // once more as stop k (ClosingLook says why).
+  void ClosingLook(int k);
   // Inserts the scan (within map_range_m) at stop.T_world_base; at an odometry pose (registration
   // failed) the pose's height is first taken from the map's ground (FitHeightOffset), and the scan
   // fills only the cells the map has not seen (FillUnknown).
@@ -247,6 +250,7 @@ class Mission {
   // at the last merged scan [m].
   double level_distance_m_ = 0, merged_level_m_ = 0;
   bool last_stop_turned_only_ = false;  // the previous stop only turned to look ahead
+  bool closing_look_ = false;           // ClosingLook's stop is under way
   bool backed_off_ = false;             // the last drive ended backing off from a tilt
   std::vector<FeltHazard> felt_;
   // Per map cell, the shortest range a registered scan saw it from [m] (+inf: never so). A
@@ -283,8 +287,9 @@ MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
     // the turn, the base still turned a fraction of a degree as it braked, and every map started
     // 0.2-0.4 deg off in yaw (terrain seeds 1..8, stop 0), 0.1-0.2 m at 30 m.
     if (TurnTo(std::atan2(to_goal.y(), to_goal.x())) && Brake() && Rebase()) {
-      for (int k = 0; k < config_.max_stops && Stop(k); ++k) {
-      }
+      int k = 0;
+      while (k < config_.max_stops && Stop(k)) ++k;
+      if (result_.success) ClosingLook(k + 1);
     }
   }
   result_.end_s = probes_.now_s();
@@ -293,6 +298,37 @@ MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
   result_.loop_closures = builder_.accepted_loops();
   SetFinalPoses();
   return std::move(result_);
+}
+
+// A round trip ends where it began, but its last scans look back the way the robot came: the
+// first scans' view (the start room, the corridor ahead) is behind it. An error a corridor's axis
+// let in on the way back stays in the last pose (office round trips: 0.1 m along the corridor at
+// the arrival), and with loop closure on the loops found are to stops that carried the same error.
+// So, back within the goal tolerance of the first scan's place and facing more than kInView_rad
+// away from its heading, the robot turns to that heading and scans once more, registered and
+// merged like any stop (the stop limit does not count it): scan-to-map registration then meets the
+// view the map was started from and re-localises the robot in it, and the loop search finds the
+// first scans. A look that fails leaves the arrival as it was.
+void Mission::ClosingLook(int k) {
+  if (result_.stops.size() < 2) return;
+  const StopRecord& first = result_.stops.front();
+  const StopRecord& last = result_.stops.back();
+  const Eigen::Vector2d start = first.T_world_base.translation().head<2>();
+  if ((last.T_world_base.translation().head<2>() - start).norm() > config_.goal_tolerance_m) {
+    return;
+  }
+  const double yaw = Yaw(first.T_world_base);
+  if (std::abs(std::remainder(yaw - Yaw(last.T_world_base), 2.0 * kPi)) <= kInView_rad) return;
+  const std::string reason = result_.reason;
+  const std::size_t stops = result_.stops.size();
+  Progress("back at the start: turning to the first scan's heading to close the loop");
+  closing_look_ = true;
+  if (!(TurnTo(yaw) && Brake() && !Stop(k) && result_.stops.size() > stops)) {
+    Progress("the closing look failed (" + result_.reason + "); the run ends at its arrival");
+  }
+  closing_look_ = false;
+  result_.success = true;
+  result_.reason = reason;
 }
 
 Result<sensors::Scan3D> Mission::AcquireScan() {
@@ -397,7 +433,7 @@ bool Mission::Stop(int k) {
   }
   T_world_base_ = stop.T_world_base;
   odo_ref_ = *odo;
-  const bool arrived = Arrived(stop);
+  const bool arrived = Arrived(stop) || closing_look_;  // the closing look plans nothing
   if (!arrived) Plan(stop);
   result_.stops.push_back(std::move(stop));
   const StopRecord& s = result_.stops.back();

@@ -188,6 +188,35 @@ TEST(RunSimMission, TheFirstScansPoseHasTheTurnToTheGoalToATenthOfADegree) {
   fs::remove_all(dir);
 }
 
+// A round trip ends back at the start facing the way it came; its last stop turns to the first
+// scan's heading and scans again (Mission::ClosingLook), so the last registration meets the view
+// the map was started from. On the floor: 2 m east and back, the first scans face east.
+TEST(RunSimMission, ARoundTripEndsLookingWhereItsFirstScanLooked) {
+  const fs::path dir = Scratch();
+  SimMissionSpec spec = FloorSpec(dir, {-2.0, 0.0});
+  spec.round_trip = true;
+  const SimMissionOutcome run = RunSimMission(spec, dir / "run");
+  ASSERT_TRUE(run.result.success) << run.result.reason;
+  EXPECT_EQ(run.result.reason, "goal reached");
+  const std::vector<StopRecord>& stops = run.result.stops;
+  ASSERT_GE(stops.size(), 3u);
+  const auto yaw_deg = [](const Eigen::Isometry3d& T) {
+    return std::atan2(T.linear()(1, 0), T.linear()(0, 0)) * 180.0 / M_PI;
+  };
+  const auto off_deg = [&](const StopRecord& a, const StopRecord& b) {
+    return std::abs(std::remainder(yaw_deg(a.T_world_base) - yaw_deg(b.T_world_base), 360.0));
+  };
+  const StopRecord &first = stops.front(), &arrival = stops[stops.size() - 2],
+                   &closing = stops.back();
+  EXPECT_GT(off_deg(arrival, first), 90.0);  // it came back facing west
+  EXPECT_LT(off_deg(closing, first), 3.0);   // TurnTo's tolerance
+  EXPECT_TRUE(closing.merge.merged) << closing.merge.registration.reason;
+  EXPECT_FALSE(closing.plan.has_value());
+  EXPECT_LT((closing.T_world_base.translation() - first.T_world_base.translation()).head<2>().norm(),
+            spec.settings.mission.goal_tolerance_m);
+  fs::remove_all(dir);
+}
+
 TEST(RunSimMission, NoWorldFileIsABadSpec) {
   const fs::path dir = Scratch();
   EXPECT_THROW(RunSimMission(LoadSimMissionSpec(std::nullopt), dir / "run"), std::invalid_argument);
