@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include "parallel_for.hpp"
+#include "se3_perturbation.hpp"
 
 namespace pitchlab::mapping {
 namespace {
@@ -42,15 +43,6 @@ bool PairFeatures(const Eigen::Vector3f& p1, const Eigen::Vector3f& n1, const Ei
 }
 
 int Bin(float unit) { return std::clamp(static_cast<int>(std::floor(unit * kBins)), 0, kBins - 1); }
-
-Eigen::Isometry3d Exp(const Eigen::Matrix<double, 6, 1>& delta) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  const Eigen::Vector3d w = delta.head<3>();
-  const double angle = w.norm();
-  if (angle > 1e-12) T.linear() = Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
-  T.translation() = delta.tail<3>();
-  return T;
-}
 
 // Rigid fit of source onto target points (Umeyama, no scale).
 Eigen::Isometry3d FitRigid(const PointCloud& source, const PointCloud& target,

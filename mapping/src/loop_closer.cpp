@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "chi_square.hpp"
+#include "se3_perturbation.hpp"
 #include "voxel_hash.hpp"
 
 namespace pitchlab::mapping {
@@ -36,25 +37,6 @@ double ViewOverlap(const PointCloud& target, const PointCloud& source,
   return source.empty() ? 0.0 : static_cast<double>(shared) / source.size();
 }
 
-// T moved by the perturbation p = (omega [rad], v [m]) in the target frame: Exp(p) T, as the
-// registration's information and covariance are defined.
-Eigen::Isometry3d Perturbed(const Eigen::Isometry3d& T, const Eigen::Matrix<double, 6, 1>& p) {
-  Eigen::Isometry3d D = Eigen::Isometry3d::Identity();
-  const Eigen::Vector3d omega = p.head<3>();
-  if (omega.norm() > 0) D.linear() = Eigen::AngleAxisd(omega.norm(), omega.normalized()).matrix();
-  D.translation() = p.tail<3>();
-  return D * T;
-}
-
-// (omega, v) of B relative to A in the target frame: B = Exp(d) A, to first order.
-Eigen::Matrix<double, 6, 1> Difference(const Eigen::Isometry3d& A, const Eigen::Isometry3d& B) {
-  const Eigen::Isometry3d D = B * A.inverse();
-  const Eigen::AngleAxisd aa(D.linear());
-  Eigen::Matrix<double, 6, 1> d;
-  d << aa.angle() * aa.axis(), D.translation();
-  return d;
-}
-
 }  // namespace
 
 Result<bool> SameMinimumFromAside(const PointCloud& target, const PointCloud& source,
@@ -73,14 +55,14 @@ Result<bool> SameMinimumFromAside(const PointCloud& target, const PointCloud& so
   const Eigen::Matrix<double, 6, 1> p = scale.cwiseProduct(eigen.eigenvectors().col(0));
   for (const double sign : {-1.0, 1.0}) {
     RegistrationPrior aside = prior;
-    aside.odometry = Perturbed(found.T_target_source, sign * p);
+    aside.odometry = Exp(sign * p) * found.T_target_source;
     const Result<RegistrationResult> r = Register(target, source, aside, config);
     if (!r) return tl::make_unexpected(r.error());
     if (!r->success) return false;
     // Half a step back is what a fit that holds the direction does at once (it returns to
     // within its noise, millimetres); one that does not stays where it started, a step off.
     const Eigen::Matrix<double, 6, 1> d =
-        Difference(found.T_target_source, r->T_target_source).cwiseQuotient(scale);
+        Log(r->T_target_source * found.T_target_source.inverse()).cwiseQuotient(scale);
     if (!(d.norm() <= 0.5)) return false;
   }
   return true;

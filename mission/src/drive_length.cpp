@@ -4,14 +4,12 @@
 
 namespace pitchlab::mission {
 
-DriveLength PlanDriveLength(double drive_per_stop_m, double unknown_margin_m, double plan_m,
-                            double plan_known_m, bool last_turned_only,
+DriveLength PlanDriveLength(double drive_per_stop_m, double unknown_margin_m, double plan_known_m,
+                            bool seen_to_the_end, bool last_turned_only,
                             std::optional<double> plan_to_doubt_m) {
   DriveLength drive;
-  // Lengths summed over the same waypoints in another order may differ in the last bits.
-  constexpr double kSeenToTheEnd_m = 1e-6;
-  const bool seen_to_the_end = plan_known_m >= plan_m - kSeenToTheEnd_m;
-  drive.length_m = std::min(drive_per_stop_m, seen_to_the_end ? plan_m : plan_known_m - unknown_margin_m);
+  drive.length_m = std::min(drive_per_stop_m, seen_to_the_end ? plan_known_m
+                                                              : plan_known_m - unknown_margin_m);
   if (seen_to_the_end && !plan_to_doubt_m) return drive;
   drive.turn_only = drive.length_m < unknown_margin_m && !last_turned_only;
   if (drive.turn_only) return drive;

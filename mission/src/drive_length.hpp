@@ -12,9 +12,9 @@ struct DriveLength {
   bool turn_only = false;  ///< only turn to face the path, so the next scan sees it
 };
 
-/// The drive of one stop along a plan `plan_m` long. The robot drives at most `drive_per_stop_m`,
-/// and stops `unknown_margin_m` short of the plan's first unobserved cell (`plan_known_m` along
-/// it); a plan seen to its end is driven to its end. When
+/// The drive of one stop. The robot drives at most `drive_per_stop_m`, and stops
+/// `unknown_margin_m` short of the plan's first unobserved cell (`plan_known_m` along it); a plan
+/// seen to its end (`seen_to_the_end`: plan_known_m is its whole length) is driven to its end. When
 /// that leaves less than the margin, it only turns to face the path; after a stop that only
 /// turned (`last_turned_only`), what it did not see is in the laser's blind zone just ahead, and it
 /// drives a metre (at most a stop's drive) onto it. The metre is for that case only: taken at every
@@ -22,8 +22,8 @@ struct DriveLength {
 /// rolled 30 deg turning on the rim (terrain seed 18). A recovery that plans through doubted cells
 /// (`plan_to_doubt_m`, along the plan to the first of them) stops the margin short of them, also
 /// after a turn. A length below `min_drive_m` is no progress: the caller ends the run.
-DriveLength PlanDriveLength(double drive_per_stop_m, double unknown_margin_m, double plan_m,
-                            double plan_known_m, bool last_turned_only,
+DriveLength PlanDriveLength(double drive_per_stop_m, double unknown_margin_m, double plan_known_m,
+                            bool seen_to_the_end, bool last_turned_only,
                             std::optional<double> plan_to_doubt_m);
 
 }  // namespace pitchlab::mission

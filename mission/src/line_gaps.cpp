@@ -55,7 +55,8 @@ std::size_t RefuteBridges(const planning::TraversabilityGrid& grid,
           layers.state[k] == mapping::CellState::kUnknown && std::isfinite(grid.z_m[k]);
       if (!bridged || refuted[k] != RefutedGap::kNone) continue;
       const Eigen::Vector2d to = g.CenterOf({i, j}) - laser_xy;
-      if (to.norm() > radius_m || !(to.dot(ahead) >= near_m) || to.dot(ahead) <= 0.0) continue;
+      const double ahead_m = to.dot(ahead);
+      if (to.norm() > radius_m || ahead_m <= 0.0 || ahead_m < near_m) continue;
       refuted[k] = layers.clearance_z[k] < grid.z_m[k] - kBelowGround_m ? RefutedGap::kDepression
                                                                         : RefutedGap::kUnseen;
       ++marked;

@@ -147,8 +147,8 @@ class Mission {
 
  private:
   bool Stop(int k);  // false: the mission ends (result_.reason says why)
-  // Back where the first scan was taken, with loop closure on: turn to where it looked and scan
-  // once more as stop k (ClosingLook says why).
+  // Back where the first scan was taken: turn to where it looked and scan once more as stop k
+  // (ClosingLook says why).
   void ClosingLook(int k);
   // Inserts the scan (within map_range_m) at stop.T_world_base; at an odometry pose (registration
   // failed) the pose's height is first taken from the map's ground (FitHeightOffset), and the scan
@@ -749,6 +749,7 @@ void Mission::Plan(StopRecord& stop) {
   }
   // How far the plan runs over ground the laser has seen (the robot's own cells count).
   stop.plan_known_m = 0;
+  stop.plan_seen_to_end = path->waypoints.size() <= 1;
   for (std::size_t i = 1; i < path->waypoints.size(); ++i) {
     const planning::Waypoint& w = path->waypoints[i];
     const mapping::CellIndex c = grid.geometry.IndexOf(w.x_m, w.y_m);
@@ -757,6 +758,7 @@ void Mission::Plan(StopRecord& stop) {
     if (!std::isfinite(grid.z_m[k]) || grid.line_gap[k]) break;
     const planning::Waypoint& v = path->waypoints[i - 1];
     stop.plan_known_m += std::hypot(w.x_m - v.x_m, w.y_m - v.y_m);
+    stop.plan_seen_to_end = i + 1 == path->waypoints.size();
   }
   stop.plan = std::move(*path);
 }
@@ -773,13 +775,8 @@ double PathHeading(const planning::Path& path, double arc_m) {
 
 bool Mission::Drive(const StopRecord& stop) {
   const planning::Path& path = *stop.plan;
-  double plan_m = 0;  // as plan_known_m adds it up
-  for (std::size_t i = 1; i < path.waypoints.size(); ++i) {
-    const planning::Waypoint &v = path.waypoints[i - 1], &w = path.waypoints[i];
-    plan_m += std::hypot(w.x_m - v.x_m, w.y_m - v.y_m);
-  }
   const DriveLength drive = PlanDriveLength(
-      config_.drive_per_stop_m, config_.unknown_margin_m, plan_m, stop.plan_known_m,
+      config_.drive_per_stop_m, config_.unknown_margin_m, stop.plan_known_m, stop.plan_seen_to_end,
       last_stop_turned_only_, stop.look_closer ? std::optional(stop.plan_to_doubt_m) : std::nullopt);
   const bool turn_only = drive.turn_only;
   const double length = drive.length_m;

@@ -8,53 +8,53 @@
 namespace pitchlab::mission {
 namespace {
 
-constexpr double kDrive_m = 4.0, kMargin_m = 0.5, kPlan_m = 20.0;
+constexpr double kDrive_m = 4.0, kMargin_m = 0.5;
 
 TEST(PlanDriveLength, StopsTheMarginShortOfTheFirstUnseenCell) {
-  const DriveLength far = PlanDriveLength(kDrive_m, kMargin_m, kPlan_m, 10.0, false, std::nullopt);
+  const DriveLength far = PlanDriveLength(kDrive_m, kMargin_m, 10.0, false, false, std::nullopt);
   EXPECT_FALSE(far.turn_only);
   EXPECT_DOUBLE_EQ(far.length_m, kDrive_m);  // a stop's drive at most
-  const DriveLength near = PlanDriveLength(kDrive_m, kMargin_m, kPlan_m, 2.0, false, std::nullopt);
+  const DriveLength near = PlanDriveLength(kDrive_m, kMargin_m, 2.0, false, false, std::nullopt);
   EXPECT_DOUBLE_EQ(near.length_m, 1.5);
 }
 
 // Terrain seed 18: the plan's seen part ended 1.05 m on, at a crack's unseen cells. The robot
 // drives 0.55 m, not a metre that would take it 0.05 m from them.
 TEST(PlanDriveLength, LessThanAMetreOfSeenGroundIsNotStretchedToAMetre) {
-  const DriveLength drive = PlanDriveLength(kDrive_m, kMargin_m, kPlan_m, 1.05, false, std::nullopt);
+  const DriveLength drive = PlanDriveLength(kDrive_m, kMargin_m, 1.05, false, false, std::nullopt);
   EXPECT_FALSE(drive.turn_only);
   EXPECT_NEAR(drive.length_m, 0.55, 1e-12);
 }
 
 TEST(PlanDriveLength, TooCloseToTheUnseenItTurnsOnceThenDrivesAMetre) {
-  EXPECT_TRUE(PlanDriveLength(kDrive_m, kMargin_m, kPlan_m, 0.8, false, std::nullopt).turn_only);
-  const DriveLength after_turn = PlanDriveLength(kDrive_m, kMargin_m, kPlan_m, 0.8, true, std::nullopt);
+  EXPECT_TRUE(PlanDriveLength(kDrive_m, kMargin_m, 0.8, false, false, std::nullopt).turn_only);
+  const DriveLength after_turn = PlanDriveLength(kDrive_m, kMargin_m, 0.8, false, true, std::nullopt);
   EXPECT_FALSE(after_turn.turn_only);
   EXPECT_DOUBLE_EQ(after_turn.length_m, 1.0);
   // More seen ground than a metre after a turn: all of it, as at any stop.
-  EXPECT_DOUBLE_EQ(PlanDriveLength(kDrive_m, kMargin_m, kPlan_m, 3.0, true, std::nullopt).length_m, 2.5);
+  EXPECT_DOUBLE_EQ(PlanDriveLength(kDrive_m, kMargin_m, 3.0, false, true, std::nullopt).length_m, 2.5);
   // A stop's drive shorter than a metre caps the blind-zone drive too.
-  EXPECT_DOUBLE_EQ(PlanDriveLength(0.6, kMargin_m, kPlan_m, 0.8, true, std::nullopt).length_m, 0.6);
+  EXPECT_DOUBLE_EQ(PlanDriveLength(0.6, kMargin_m, 0.8, false, true, std::nullopt).length_m, 0.6);
 }
 
 // The floor test's third stop: the goal 1.14 m along a plan seen to its end. The margin is for
 // unseen ground; there is none, so the robot drives to the goal.
 TEST(PlanDriveLength, APlanSeenToItsEndIsDrivenToItsEnd) {
-  const DriveLength drive = PlanDriveLength(kDrive_m, kMargin_m, 1.14, 1.14, false, std::nullopt);
+  const DriveLength drive = PlanDriveLength(kDrive_m, kMargin_m, 1.14, true, false, std::nullopt);
   EXPECT_FALSE(drive.turn_only);
   EXPECT_DOUBLE_EQ(drive.length_m, 1.14);
-  EXPECT_DOUBLE_EQ(PlanDriveLength(kDrive_m, kMargin_m, 9.0, 9.0, false, std::nullopt).length_m,
+  EXPECT_DOUBLE_EQ(PlanDriveLength(kDrive_m, kMargin_m, 9.0, true, false, std::nullopt).length_m,
                    kDrive_m);  // a stop's drive at most
   // A few waypoints short of the end: the margin again.
-  EXPECT_NEAR(PlanDriveLength(kDrive_m, kMargin_m, 1.14, 1.0, false, std::nullopt).length_m, 0.5,
+  EXPECT_NEAR(PlanDriveLength(kDrive_m, kMargin_m, 1.0, false, false, std::nullopt).length_m, 0.5,
               1e-12);
 }
 
 TEST(PlanDriveLength, ARecoveryStopsTheMarginShortOfTheDoubtedCellsEvenAfterATurn) {
-  const DriveLength drive = PlanDriveLength(kDrive_m, kMargin_m, kPlan_m, 0.8, true, 0.9);
+  const DriveLength drive = PlanDriveLength(kDrive_m, kMargin_m, 0.8, false, true, 0.9);
   EXPECT_FALSE(drive.turn_only);
   EXPECT_NEAR(drive.length_m, 0.4, 1e-12);
-  EXPECT_LT(PlanDriveLength(kDrive_m, kMargin_m, kPlan_m, 5.0, false, 0.5).length_m, 0.1);  // no way on
+  EXPECT_LT(PlanDriveLength(kDrive_m, kMargin_m, 5.0, false, false, 0.5).length_m, 0.1);  // no way on
 }
 
 }  // namespace

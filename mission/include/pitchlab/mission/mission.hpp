@@ -160,6 +160,7 @@ struct StopRecord {
   bool look_closer = false;
   double plan_to_doubt_m = 0;  ///< with look_closer: plan length before the first such cell [m]
   double plan_known_m = 0;     ///< length of the plan over observed cells [m]
+  bool plan_seen_to_end = false;  ///< every cell of the plan observed: plan_known_m is its length
   int felt_hazards = 0;        ///< places marked too steep by the tilt so far
   bool elevation_from_odometry = false;  ///< registration failed: the scan entered the elevation
                                          ///< map at the odometry pose
