@@ -28,6 +28,10 @@ constexpr double kStillRate_rps = 0.01;
 // The held joints' armature: against the laser's few kg at a decimetre's lever, a base that weighs
 // 1e9 (kg, kg m^2) is immovable to within 1e-9 of its coupling to the pitch joint.
 constexpr double kHeldArmature = 1e9;
+constexpr double kMujocoDefaultTimestep = 0.002;  // <option timestep> when a world sets none
+// The laser locks on the base once its servo holds a fixed setpoint to within this, at rest (well
+// inside the pitch encoder's half count, 0.005 deg = 8.7e-5 rad).
+constexpr double kPitchLockTolerance_rad = 2e-5;
 
 std::string ReadFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -131,6 +135,20 @@ bool AtRest(const mjModel* m, const mjData* d, int j, int& nq, int& nv) {
 
 }  // namespace
 
+void Simulation::Impl::LockPitch() {
+  pitch_lock = PitchLock{d->qpos[pitch_qpos], m->dof_armature[pitch_dof]};
+  m->dof_armature[pitch_dof] = kHeldArmature;
+  d->qvel[pitch_dof] = 0.0;
+  m->opt.timestep = locked_timestep_s;
+}
+
+void Simulation::Impl::UnlockPitch() {
+  if (!pitch_lock) return;
+  m->dof_armature[pitch_dof] = pitch_lock->armature;
+  pitch_lock.reset();
+  m->opt.timestep = world_timestep_s;
+}
+
 void Simulation::Impl::KeepHeld() {
   std::size_t k = 0;
   for (const auto& [adr, count] : hold->joints) {
@@ -198,6 +216,11 @@ Simulation::Simulation(const std::string& world_xml, const std::string& base_dir
                              std::to_string(robot_.pitch_servo.kv_nms_per_rad) +
                              " (kv * timestep / inertia = " + std::to_string(courant) + " > 1.5)");
   }
+  // MuJoCo's default step, 2 ms, is the world's unless it chose its own; while the laser is
+  // locked the robot's own drive step applies (P3Params::locked_timestep_s says why).
+  s.world_timestep_s = s.m->opt.timestep;
+  s.locked_timestep_s =
+      s.m->opt.timestep == kMujocoDefaultTimestep ? params().locked_timestep_s : s.m->opt.timestep;
   mj_forward(s.m, s.d);
 }
 
@@ -208,9 +231,20 @@ const mjData_* Simulation::data() const { return impl_->d; }
 double Simulation::time_s() const { return impl_->d->time; }
 double Simulation::timestep_s() const { return impl_->m->opt.timestep; }
 
+// The pitch servo is stiff (kp 4000 N m/rad on the laser's 0.08 kg m^2: a 37 Hz loop, explicit
+// in MuJoCo's Euler step) and needs the world's 2 ms step; the robot on its tyres does not. So
+// while the servo holds a fixed setpoint, the robot not held and the laser at rest on it, the
+// pitch joint is locked (immovable, as the held joints of HoldStill) and the physics steps at
+// P3Params::locked_timestep_s; a new setpoint or HoldStill unlocks it.
 void Simulation::Step(int n) {
   Impl& s = *impl_;
   for (int i = 0; i < n; ++i) {
+    if (!s.pitch_lock && !s.hold && s.locked_timestep_s > s.world_timestep_s &&
+        pitch_setpoint_rate_rps_ == 0.0 &&
+        std::abs(s.d->qvel[s.pitch_dof]) < kStillRate_rps &&
+        std::abs(s.d->qpos[s.pitch_qpos] - pitch_setpoint_rad_) < kPitchLockTolerance_rad) {
+      s.LockPitch();
+    }
     mj_step1(s.m, s.d);
     for (auto& [id, hook] : s.hooks) {
       if (hook.first) hook.first();
@@ -224,6 +258,10 @@ void Simulation::Step(int n) {
                                   servo.kp_nm_per_rad;
     mj_step2(s.m, s.d);
     if (s.hold) s.KeepHeld();
+    if (s.pitch_lock) {
+      s.d->qpos[s.pitch_qpos] = s.pitch_lock->qpos;
+      s.d->qvel[s.pitch_dof] = 0.0;
+    }
     for (auto& [id, hook] : s.hooks) {
       if (hook.second) hook.second();
     }
@@ -234,6 +272,7 @@ void Simulation::Step(int n) {
 bool Simulation::HoldStill() {
   Impl& s = *impl_;
   if (s.hold) return true;
+  s.UnlockPitch();  // held, the pitch joint is what moves
   Impl::Hold h;
   const int pitch_joint = s.m->dof_jntid[s.pitch_dof];
   for (int j = 0; j < s.m->njnt; ++j) {
@@ -271,7 +310,11 @@ bool Simulation::held() const { return impl_->hold.has_value(); }
 
 void Simulation::StepFor(double duration_s) {
   if (!(duration_s > 0.0)) return;
-  Step(std::max(1, static_cast<int>(std::lround(duration_s / timestep_s()))));
+  // The step may change on the way (the laser locking): steps until the nearest step to the end.
+  const double end_s = time_s() + duration_s;
+  do {
+    Step(1);
+  } while (time_s() + 0.5 * timestep_s() < end_s);
 }
 
 Eigen::Isometry3d Simulation::T_world_base() const {
@@ -297,6 +340,7 @@ Eigen::Isometry3d Simulation::T_world_laser() const {
 double Simulation::pitch_rad() const { return impl_->d->qpos[impl_->pitch_qpos]; }
 double Simulation::pitch_rate_rps() const { return impl_->d->qvel[impl_->pitch_dof]; }
 void Simulation::SetPitchSetpoint(double pitch_rad, double rate_rps) {
+  if (pitch_rad != pitch_setpoint_rad_ || rate_rps != 0.0) impl_->UnlockPitch();
   pitch_setpoint_rad_ = pitch_rad;
   pitch_setpoint_rate_rps_ = rate_rps;
 }

@@ -34,6 +34,16 @@ struct Simulation::Impl {
   };
   std::optional<Hold> hold;
   void KeepHeld();  // the held joints back where HoldStill found them, still
+  // The laser locked on the base while its servo holds a fixed setpoint (Simulation::Step says
+  // why): the pitch where it was locked and its dof's own armature.
+  struct PitchLock {
+    mjtNum qpos, armature;
+  };
+  std::optional<PitchLock> pitch_lock;
+  double world_timestep_s = 0.0;  // the world's step: the pitch servo's, scanning
+  double locked_timestep_s = 0.0;  // the step while the laser is locked (driving)
+  void LockPitch();
+  void UnlockPitch();
   std::map<int, std::pair<StepHook, StepHook>> hooks;
   int next_hook = 0;
 

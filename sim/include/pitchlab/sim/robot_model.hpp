@@ -69,6 +69,9 @@ struct P3Params {
   double wheel_torque_nm = 0;      ///< motor torque limit at the wheel [N m]
   double wheel_kv = 0;             ///< velocity servo gain [N m s/rad]
   double wheel_armature_kgm2 = 0;  ///< reflected gearbox inertia [kg m^2]
+  /// Physics step while the laser is locked on the base (driving; Simulation::Step; the world's
+  /// own step when it sets one) [s].
+  double locked_timestep_s = 0.002;
   /// Effective track / geometric track: skid-steer turns need a wider virtual track (the ICR
   /// model of Mandow et al. 2007); 1.85 measured on this simulated P3-AT on a friction-1 floor
   /// over 0.3-2 rad/s (spread 1.8-2.0); 1 for the DX.

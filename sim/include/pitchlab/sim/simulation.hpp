@@ -53,10 +53,17 @@ class Simulation {
   const std::string& composed_xml() const { return composed_xml_; }  ///< what was loaded
 
   double time_s() const;      ///< simulated time [s]
-  double timestep_s() const;  ///< physics step (the world's <option timestep>, default 2 ms) [s]
-  /// Advances `n` physics steps, running the pre/post step hooks around each.
+  /// The physics step now: the world's <option timestep> (default 2 ms), or the robot's
+  /// P3Params::locked_timestep_s while the laser is locked (Step says when) [s].
+  double timestep_s() const;
+  /// Advances `n` physics steps, running the pre/post step hooks around each. Before each, the
+  /// laser locks on the base when its servo holds a fixed setpoint at rest and nothing is held
+  /// (sim/README.md, Invariants): the pitch joint stops moving and the step becomes
+  /// P3Params::locked_timestep_s. SetPitchSetpoint with a new setpoint or a rate, and HoldStill,
+  /// unlock it.
   void Step(int n = 1);
-  /// Advances round(duration / timestep) steps (at least one when duration > 0) [s].
+  /// Steps until simulated time is within half a step of now + duration (at least one step when
+  /// duration > 0; the step may change on the way) [s].
   void StepFor(double duration_s);
 
   Eigen::Isometry3d T_world_base() const;   ///< ground truth base_link pose
