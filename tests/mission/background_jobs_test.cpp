@@ -1,8 +1,13 @@
 #include "background_jobs.hpp"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <stdexcept>
 #include <thread>
@@ -28,6 +33,24 @@ TEST(BackgroundJobs, RunsJobsInOrderOnAnotherThread) {
   EXPECT_EQ(order, (std::vector<int>{0, 1, 2, 3, 4}));
   EXPECT_NE(ran_on, std::this_thread::get_id());
   jobs.Wait();  // nothing queued: returns at once
+}
+
+int ThisThreadsNice() {
+  errno = 0;
+  return getpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)));
+}
+
+// The side work yields the cores to the mission (background_jobs.cpp): its thread runs nicer than
+// the one that posts, which keeps its own priority.
+TEST(BackgroundJobs, JobsRunAtALowerPriorityThanTheMission) {
+  const int mission_nice = ThisThreadsNice();
+  if (mission_nice >= 19) GTEST_SKIP() << "the test runs at the lowest priority already";
+  int job_nice = mission_nice;
+  BackgroundJobs jobs;
+  jobs.Post([&job_nice] { job_nice = ThisThreadsNice(); });
+  jobs.Wait();
+  EXPECT_GT(job_nice, mission_nice);
+  EXPECT_EQ(ThisThreadsNice(), mission_nice);
 }
 
 TEST(BackgroundJobs, AFailureReachesWaitAndLaterPostsAndDropsTheRest) {
