@@ -102,5 +102,29 @@ TEST(ParallelFor, ABodysExceptionReachesTheCaller) {
   }
 }
 
+// Loops from several threads at once, and a loop inside a loop's body, share the helper threads
+// and each visits its own items once (none waits on a helper busy with another's).
+TEST(ParallelFor, ConcurrentAndNestedLoopsEachFinish) {
+  constexpr std::size_t kOuter = 16, kInner = 300;
+  std::vector<std::thread> callers;
+  std::vector<std::vector<std::atomic<int>>> visits(4);
+  for (auto& v : visits) v = std::vector<std::atomic<int>>(kOuter * kInner);
+  for (std::size_t c = 0; c < visits.size(); ++c) {
+    callers.emplace_back([&visits, c] {
+      ParallelFor(kOuter, 1, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t o = begin; o < end; ++o) {
+          ParallelFor(kInner, 7, [&](std::size_t b, std::size_t e) {
+            for (std::size_t i = b; i < e; ++i) ++visits[c][o * kInner + i];
+          });
+        }
+      });
+    });
+  }
+  for (std::thread& t : callers) t.join();
+  for (const auto& v : visits) {
+    for (const auto& x : v) ASSERT_EQ(x.load(), 1);
+  }
+}
+
 }  // namespace
 }  // namespace pitchlab::mapping::internal
