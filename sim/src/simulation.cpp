@@ -135,26 +135,46 @@ bool AtRest(const mjModel* m, const mjData* d, int j, int& nq, int& nv) {
 
 }  // namespace
 
+void Simulation::Impl::HeldJoints::Add(const mjModel* m, const mjData* d, int joint, int nq,
+                                       int nv) {
+  joints.emplace_back(m->jnt_qposadr[joint], nq);
+  for (int i = 0; i < nq; ++i) qpos.push_back(d->qpos[m->jnt_qposadr[joint] + i]);
+  for (int i = 0; i < nv; ++i) dofs.push_back(m->jnt_dofadr[joint] + i);
+}
+
+void Simulation::Impl::HeldJoints::Freeze(mjModel* m) {
+  for (const int dof : dofs) {
+    armature.push_back(m->dof_armature[dof]);
+    m->dof_armature[dof] = kHeldArmature;
+  }
+}
+
+void Simulation::Impl::HeldJoints::Keep(mjData* d) const {
+  std::size_t k = 0;
+  for (const auto& [adr, count] : joints) {
+    for (int i = 0; i < count; ++i) d->qpos[adr + i] = qpos[k++];
+  }
+  for (const int dof : dofs) d->qvel[dof] = 0.0;
+}
+
+void Simulation::Impl::HeldJoints::Restore(mjModel* m) const {
+  for (std::size_t i = 0; i < dofs.size(); ++i) m->dof_armature[dofs[i]] = armature[i];
+}
+
 void Simulation::Impl::LockPitch() {
-  pitch_lock = PitchLock{d->qpos[pitch_qpos], m->dof_armature[pitch_dof]};
-  m->dof_armature[pitch_dof] = kHeldArmature;
-  d->qvel[pitch_dof] = 0.0;
+  HeldJoints lock;
+  lock.Add(m, d, m->dof_jntid[pitch_dof], 1, 1);
+  lock.Freeze(m);
+  lock.Keep(d);
+  pitch_lock = std::move(lock);
   m->opt.timestep = locked_timestep_s;
 }
 
 void Simulation::Impl::UnlockPitch() {
   if (!pitch_lock) return;
-  m->dof_armature[pitch_dof] = pitch_lock->armature;
+  pitch_lock->Restore(m);
   pitch_lock.reset();
   m->opt.timestep = world_timestep_s;
-}
-
-void Simulation::Impl::KeepHeld() {
-  std::size_t k = 0;
-  for (const auto& [adr, count] : hold->joints) {
-    for (int i = 0; i < count; ++i) d->qpos[adr + i] = hold->qpos[k++];
-  }
-  for (const int dof : hold->dofs) d->qvel[dof] = 0.0;
 }
 
 Simulation::Simulation(const std::string& world_path, const RobotConfig& robot)
@@ -257,11 +277,8 @@ void Simulation::Step(int n) {
                                servo.kv_nms_per_rad * pitch_setpoint_rate_rps_) /
                                   servo.kp_nm_per_rad;
     mj_step2(s.m, s.d);
-    if (s.hold) s.KeepHeld();
-    if (s.pitch_lock) {
-      s.d->qpos[s.pitch_qpos] = s.pitch_lock->qpos;
-      s.d->qvel[s.pitch_dof] = 0.0;
-    }
+    if (s.hold) s.hold->held.Keep(s.d);
+    if (s.pitch_lock) s.pitch_lock->Keep(s.d);
     for (auto& [id, hook] : s.hooks) {
       if (hook.second) hook.second();
     }
@@ -279,19 +296,14 @@ bool Simulation::HoldStill() {
     if (j == pitch_joint) continue;
     int nq = 0, nv = 0;
     if (!AtRest(s.m, s.d, j, nq, nv)) return false;
-    h.joints.emplace_back(s.m->jnt_qposadr[j], nq);
-    for (int i = 0; i < nq; ++i) h.qpos.push_back(s.d->qpos[s.m->jnt_qposadr[j] + i]);
-    for (int i = 0; i < nv; ++i) h.dofs.push_back(s.m->jnt_dofadr[j] + i);
+    h.held.Add(s.m, s.d, j, nq, nv);
   }
-  for (const int dof : h.dofs) {
-    h.armature.push_back(s.m->dof_armature[dof]);
-    s.m->dof_armature[dof] = kHeldArmature;
-  }
+  h.held.Freeze(s.m);
   h.qacc_warmstart.assign(s.d->qacc_warmstart, s.d->qacc_warmstart + s.m->nv);
   h.disableflags = s.m->opt.disableflags;
   s.m->opt.disableflags |= mjDSBL_CONTACT;
   s.hold = std::move(h);
-  s.KeepHeld();
+  s.hold->held.Keep(s.d);
   return true;
 }
 
@@ -299,10 +311,10 @@ void Simulation::Release() {
   Impl& s = *impl_;
   if (!s.hold) return;
   const Impl::Hold& h = *s.hold;
-  for (std::size_t i = 0; i < h.dofs.size(); ++i) s.m->dof_armature[h.dofs[i]] = h.armature[i];
+  h.held.Restore(s.m);
   std::copy(h.qacc_warmstart.begin(), h.qacc_warmstart.end(), s.d->qacc_warmstart);
   s.m->opt.disableflags = h.disableflags;
-  s.KeepHeld();
+  h.held.Keep(s.d);
   s.hold.reset();
 }
 

@@ -24,22 +24,28 @@ struct Simulation::Impl {
     bool left;
   };
   std::vector<Wheel> wheels;
-  // Simulation::HoldBase's saved state: the held joints' positions, their dofs' armature, the
-  // solver's warm start and the disable flags.
-  struct Hold {
+  // Joints made immovable: each keeps the position it had, at rest, its dofs' armature raised
+  // so far that the rest of the model cannot move them within a step (Keep puts back what moved).
+  struct HeldJoints {
     std::vector<std::pair<int, int>> joints;  // (qpos address, position count)
     std::vector<int> dofs;
-    std::vector<mjtNum> qpos, armature, qacc_warmstart;
+    std::vector<mjtNum> qpos, armature;  // held positions; the dofs' own armature
+    void Add(const mjModel* m, const mjData* d, int joint, int nq, int nv);
+    void Freeze(mjModel* m);             // raises the armature, saving it
+    void Keep(mjData* d) const;          // the held positions, zero velocity
+    void Restore(mjModel* m) const;      // the dofs' own armature back
+  };
+  // Simulation::HoldStill's saved state: every joint but the pitch joint held, the solver's warm
+  // start and the disable flags.
+  struct Hold {
+    HeldJoints held;
+    std::vector<mjtNum> qacc_warmstart;
     int disableflags = 0;
   };
   std::optional<Hold> hold;
-  void KeepHeld();  // the held joints back where HoldStill found them, still
   // The laser locked on the base while its servo holds a fixed setpoint (Simulation::Step says
-  // why): the pitch where it was locked and its dof's own armature.
-  struct PitchLock {
-    mjtNum qpos, armature;
-  };
-  std::optional<PitchLock> pitch_lock;
+  // why): the pitch joint held.
+  std::optional<HeldJoints> pitch_lock;
   double world_timestep_s = 0.0;  // the world's step: the pitch servo's, scanning
   double locked_timestep_s = 0.0;  // the step while the laser is locked (driving)
   void LockPitch();
