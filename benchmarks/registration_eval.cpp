@@ -37,6 +37,7 @@
 #include "pitchlab/mapping/map_builder.hpp"
 #include "pitchlab/mapping/mount_from_floor.hpp"
 #include "pitchlab/mapping/registration.hpp"
+#include "pitchlab/sensors/scan_pcd.hpp"
 #include "pitchlab/sensors/sensor_config.hpp"
 #include "pitchlab/sim/robot_model.hpp"
 #include "pitchlab/sim/sim_rig.hpp"
@@ -81,6 +82,7 @@ struct Options {
   std::string config;                              // YAML over our defaults, if given
   std::string sensor;                              // YAML of the lms200 section, if given
   std::set<int> only_pairs;                        // register only these pair ids (all if empty)
+  std::string dump_pairs;  // directory the registered pairs' scans are written to, if given
   std::set<std::string> near_start = {"terrain"};  // worlds sampled around their start only
   double near_start_radius_m = 3.0;
 };
@@ -120,6 +122,8 @@ Options ParseOptions(int argc, char** argv) {
       o.config = value();
     else if (a == "--sensor")
       o.sensor = value();
+    else if (a == "--dump-pairs")
+      o.dump_pairs = value();
     else if (a == "--only-pairs") {
       for (const std::string& id : Split(value(), ',')) o.only_pairs.insert(std::stoi(id));
     } else if (a == "--near-start") {
@@ -143,8 +147,12 @@ Options ParseOptions(int argc, char** argv) {
              "[--noise s,...] [--baseline-pairs N] [--table1-pairs N] [--sequence-scans N] "
              "[--seed S] [--paper-table FILE.json] [--near-start w1,w2] [--near-start-radius M] "
              "[--pair-cache DIR] [--config FILE.yaml] [--sensor FILE.yaml] [--only-pairs id,...]\n"
+             "[--dump-pairs DIR]\n"
              "--sensor: the simulated LMS200 (its lms200 section) over the defaults; --noise\n"
-             "sets its noise_sigma_m.\n";
+             "sets its noise_sigma_m.\n"
+             "--dump-pairs: each registered pair's scans as DIR/pair_ID_target.pcd and\n"
+             "pair_ID_source.pcd (VIEWPOINT the true pose), e.g. to replay one with\n"
+             "`pitchlab register DIR/pair_ID_source.pcd DIR/pair_ID_target.pcd`.\n";
       std::exit(0);
     } else {
       throw std::invalid_argument("unknown option " + a);
@@ -454,6 +462,24 @@ Eigen::Vector3f LaserInBase() {
   return sensors::MountConfig{}.BaseToLaser(0.0).translation().cast<float>();
 }
 
+// --dump-pairs: one scan of a pair as a PCD in base_link, its true pose the VIEWPOINT and the
+// laser's mirror the sensor origin, as `pitchlab register` reads it.
+void DumpScan(const SimScan& scan, const std::string& world, const std::string& path) {
+  sensors::Scan3D out;
+  out.points.reserve(scan.cloud.size());
+  const Eigen::Vector3f origin = LaserInBase();
+  for (const Eigen::Vector3f& p : scan.cloud) {
+    out.points.push_back({p.x(), p.y(), p.z(), (p - origin).norm()});
+  }
+  out.has_truth = true;
+  out.T_world_base = scan.T_world_base;
+  out.sensor_origin = origin.cast<double>();
+  out.world = world;
+  if (Result<void> w = sensors::WriteScanPcd(out, path); !w) {
+    throw std::runtime_error(w.error().message);
+  }
+}
+
 // A matrix's entries row by row: the pose and covariance in full, so two builds can be compared
 // bit for bit (a refactor of Register must not change them).
 template <typename Matrix>
@@ -721,6 +747,12 @@ int main(int argc, char** argv) {
         prior.odometry_uncertainty = mapping::GuessUncertainty{level_m, level_deg};  // its bound
         if (!o.only_pairs.empty() && !o.only_pairs.count(p.id))
           continue;  // guess drawn all the same
+        if (l == 0 && !o.dump_pairs.empty()) {
+          std::filesystem::create_directories(o.dump_pairs);
+          const std::string stem = o.dump_pairs + "/pair_" + std::to_string(p.id);
+          DumpScan(p.target, p.world, stem + "_target.pcd");
+          DumpScan(p.source, p.world, stem + "_source.pcd");
+        }
         json entry = PairInfo(p, level_m, level_deg, *prior.odometry);
         entry["ours"] = RunPair(p, prior, ours);
         if (l == 0) entry["ours_no_prior"] = RunPair(p, {}, ours);

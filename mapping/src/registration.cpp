@@ -250,7 +250,10 @@ Weakness DegenerateDirections(const IcpTarget& target, const PointCloud& source,
                0.25 * config.degeneracy_probe_deg;
       return p;
     };
-    if (r < config.free_ratio || Undetermined(r, at, probe, free_space, config)) {
+    // No free_ratio here: a rotation's ratio compares lever arms about two axes, the scene's
+    // shape (a wall 0.5 m tall seen along 10 m: pitch 0.004 of yaw, every wall point constraining
+    // pitch), not how many points decide it; the probe decides.
+    if (Undetermined(r, at, probe, free_space, config)) {
       out.rotation_axes.push_back(axis);
       out.rotation_ratios.push_back(r);
     }
