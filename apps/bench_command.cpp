@@ -105,10 +105,12 @@ CliArgs BenchArgs() {
       "own process and run folder (DIR/runs/<world>-s<seed>). One JSON line per run is\n"
       "appended to DIR/runs.jsonl as it ends; runs already recorded there are skipped, so\n"
       "a killed sweep resumes (with the same --config: each line records its config_hash,\n"
-      "and a sweep with another is refused). A summary per world is printed and written to\n"
-      "DIR/summary.json. With --shard K/N only runs whose index % N == K-1 are run, e.g.\n"
-      "--shard $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT; merge the shards' folders\n"
-      "with --summarize DIR1 DIR2 ... . Exit 0 when every run of the shard is recorded\n"
+      "and a sweep with another is refused). Each world's ground truth is ray cast by its\n"
+      "first run and read from DIR/truth by the others (pitchlab run --truth-cache). A\n"
+      "summary per world is printed and written to DIR/summary.json. With --shard K/N\n"
+      "only runs whose index % N == K-1 are run, e.g. --shard\n"
+      "$SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT; merge the shards' folders with\n"
+      "--summarize DIR1 DIR2 ... . Exit 0 when every run of the shard is recorded\n"
       "(failed runs are results, see the summary); 2 on bad input.");
   args.Option("worlds", "W1,W2,...", "built-in worlds (" + BuiltinWorldNames() + ") or MJCF files",
               "office,urban,terrain,gully")
@@ -366,6 +368,7 @@ pid_t StartRun(const SweepSettings& s, const BenchRun& run) {
                                     "--world",  run.world.arg,
                                     "--seed",   std::to_string(run.seed),
                                     "--out",    RunDir(s.out, run).string(),
+                                    "--truth-cache", (s.out / "truth").string(),
                                     "--json"};
   if (s.config) words.insert(words.end(), {"--config", s.config->string()});
   words.insert(words.end(), s.route_args.begin(), s.route_args.end());

@@ -43,6 +43,10 @@ CliArgs RunArgs() {
       .Option("backend", "sim|hw",
               "sim (default) or hw: the real devices of the config's `hw` "
               "section (`run --backend hw --help`), overrides the config's backend")
+      .Option("truth-cache", "DIR",
+              "keep the ground truth's elevation map in DIR and reuse it in later runs of the "
+              "same world, start and map grid by this same pitchlab executable (bench gives "
+              "its runs OUT/truth): the true surface is ray cast once per world, not per seed")
       .Flag("json", "print metrics.json on stdout at the end")
       .Flag("quiet", "no progress on stderr");
   return args;
@@ -123,6 +127,7 @@ int RunRun(int argc, char** argv) {
   }
   if (args.Has("via")) spec.via_m = Waypoints(args, mission::LoadWorldMetadata(world_path));
   spec.round_trip = args.Flagged("round-trip");
+  if (args.Has("truth-cache")) spec.truth_cache_dir = args.Get("truth-cache");
 
   const mission::SimMissionOutcome run = mission::RunSimMission(
       spec, out, args.Flagged("quiet") ? mission::SimMissionObserver{} : ProgressLines(wall_start));

@@ -12,6 +12,7 @@
 
 #include "background_jobs.hpp"
 #include "run_pictures.hpp"
+#include "truth_cache.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/elevation_truth.hpp"
 #include "pitchlab/mission/run_folder.hpp"
@@ -79,9 +80,8 @@ struct Truth {
   planning::Path optimum;
 };
 
-Truth ComputeTruth(const sensors::RayCaster& caster, const MissionConfig& mission,
-                   const Eigen::Vector2d& start) {
-  const mapping::ElevationMap map = mapping::ComputeTrueElevationMap(caster, mission.map_area);
+Truth TruthOf(const mapping::ElevationMap& map, const MissionConfig& mission,
+              const Eigen::Vector2d& start) {
   Truth truth;
   truth.layers = mapping::ComputeLayers(map, mission.layers);
   truth.grid = planning::BuildTraversability(truth.layers, mission.planner);
@@ -243,24 +243,54 @@ SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesyste
                                      meta.geodetic_origin->longitude_deg,
                                      meta.geodetic_origin->height_m};
   }
+  // The true surface: kept from an earlier run of the same world and placement, or ray cast.
+  std::filesystem::path truth_file;
+  std::optional<mapping::ElevationMap> cached_truth;
+  std::string truth_source = "true surface on " + std::to_string(mission.map_area.size_x) + " x " +
+                             std::to_string(mission.map_area.size_y) + " cells, beside the mission";
+  if (!spec.truth_cache_dir.empty()) {
+    const sensors::ScopedTime timing(stages[Stage::kGroundTruth]);
+    truth_file =
+        TruthCacheFile(spec.truth_cache_dir, rig.sim().model(), rig.sim().data(), mission.map_area);
+    Result<std::optional<mapping::ElevationMap>> loaded =
+        LoadCachedTruth(truth_file, mission.map_area);
+    if (!loaded) {
+      truth_source += " (the cached one is unusable: " + loaded.error().message + ")";
+    } else if (*loaded) {
+      cached_truth = std::move(**loaded);
+      truth_source = "true surface from " + truth_file.string();
+    }
+  }
   if (observer.on_setup) {
     observer.on_setup("ground truth of " +
-                      (spec.world_name.empty() ? world_stem : spec.world_name) +
-                      ": true surface on " + std::to_string(mission.map_area.size_x) + " x " +
-                      std::to_string(mission.map_area.size_y) + " cells, beside the mission");
+                      (spec.world_name.empty() ? world_stem : spec.world_name) + ": " +
+                      truth_source);
   }
   // The ground truth and each stop's files are made on a thread beside the mission (their CPU
   // time is theirs, their wall time what the run waits for them at the end).
-  const auto truth_scene = [&] {
+  std::shared_ptr<TruthScene> truth_scene;
+  if (!cached_truth) {
     const sensors::ScopedTime timing(stages[Stage::kGroundTruth]);
-    return std::make_shared<TruthScene>(rig);
-  }();
+    truth_scene = std::make_shared<TruthScene>(rig);
+  }
   std::optional<Truth> truth;
+  std::string truth_cache_error;              // a cache that could not be written: said at the end
   double truth_cpu_s = 0, outputs_cpu_s = 0;  // the jobs' own, read once they are done
   BackgroundJobs side;  // declared after what its jobs use: it ends first
   side.Post([&, truth_scene] {
     const double cpu0 = sensors::ThreadCpuSeconds();
-    truth = ComputeTruth(*truth_scene->caster, mission, start.head<2>());
+    if (cached_truth) {
+      truth = TruthOf(*cached_truth, mission, start.head<2>());
+    } else {
+      const mapping::ElevationMap map =
+          mapping::ComputeTrueElevationMap(*truth_scene->caster, mission.map_area);
+      truth = TruthOf(map, mission, start.head<2>());
+      if (!truth_file.empty()) {
+        if (Result<void> stored = StoreCachedTruth(map, truth_file); !stored) {
+          truth_cache_error = stored.error().message;
+        }
+      }
+    }
     truth_cpu_s = sensors::ThreadCpuSeconds() - cpu0;
   });
 
@@ -288,6 +318,9 @@ SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesyste
   {
     const sensors::ScopedTime timing(stages[Stage::kOutputs]);
     side.Wait();
+  }
+  if (!truth_cache_error.empty() && observer.on_setup) {
+    observer.on_setup("the ground truth was not kept for later runs: " + truth_cache_error);
   }
   stages[Stage::kGroundTruth].cpu_s += truth_cpu_s;
   stages[Stage::kOutputs].cpu_s += outputs_cpu_s;

@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -139,6 +141,65 @@ TEST(RunSimMission, ItsStageBreakdownAddsUpToTheRunWithOtherAsTheRest) {
                           "map_update", "outputs", "ground_truth"}) {
     EXPECT_GT(stages[key]["cpu_s"].get<double>(), 0.0) << key;
   }
+  fs::remove_all(dir);
+}
+
+std::vector<fs::path> TruthFiles(const fs::path& dir) {
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (e.path().extension() == ".plem") files.push_back(e.path());
+  }
+  return files;
+}
+
+// Runs of one world share its ground truth through truth_cache_dir: the first run ray casts it
+// and leaves it there, a run with another seed (another mount error drawn for the robot) reads it
+// back and scores against the same truth; a corrupt file is said and replaced; another world
+// (a box on the floor) is a file of its own.
+TEST(RunSimMission, RunsOfOneWorldShareTheGroundTruthThroughItsCache) {
+  const fs::path dir = Scratch();
+  const fs::path cache = dir / "truth";
+  int runs = 0;
+  auto run = [&](std::uint64_t seed, const fs::path& world, std::string& setup) {
+    SimMissionSpec spec = FloorSpec(dir, {-2.0, 0.0});
+    spec.world_file = world;
+    spec.config = LoadSimMissionSpec(std::nullopt, seed).config;
+    spec.truth_cache_dir = cache;
+    SimMissionObserver observer;
+    observer.on_setup = [&setup](const std::string& text) { setup += text + "\n"; };
+    const fs::path out = dir / ("run" + std::to_string(++runs));
+    return RunSimMission(spec, out, observer);
+  };
+  const fs::path floor = WriteFloorWorld(dir);
+  std::string first, second, corrupt, boxed;
+  const SimMissionOutcome a = run(1, floor, first);
+  ASSERT_TRUE(a.result.success) << a.result.reason;
+  const std::vector<fs::path> files = TruthFiles(cache);
+  ASSERT_EQ(files.size(), 1u) << first;
+  EXPECT_EQ(first.find("true surface from"), std::string::npos) << first;
+
+  const SimMissionOutcome b = run(2, floor, second);
+  ASSERT_TRUE(b.result.success) << b.result.reason;
+  EXPECT_NE(second.find("true surface from " + files[0].string()), std::string::npos) << second;
+  EXPECT_EQ(TruthFiles(cache).size(), 1u);
+  EXPECT_EQ(a.metrics["true_optimal_cost"], b.metrics["true_optimal_cost"]);
+
+  std::ofstream(files[0], std::ios::trunc) << "not a map";
+  const SimMissionOutcome c = run(2, floor, corrupt);
+  ASSERT_TRUE(c.result.success) << c.result.reason;
+  EXPECT_NE(corrupt.find("the cached one is unusable"), std::string::npos) << corrupt;
+  EXPECT_EQ(c.metrics["true_optimal_cost"], b.metrics["true_optimal_cost"]);
+  EXPECT_GT(fs::file_size(files[0]), 1000u) << "replaced by the truth";
+
+  const fs::path box_world = dir / "boxed.xml";
+  std::string xml = kFloorWorld;
+  xml.replace(xml.find("</worldbody>"), 0,
+              R"(<geom name="box" type="box" size="0.3 0.3 0.3" pos="3 2 0.3"/>)");
+  std::ofstream(box_world) << xml;
+  const SimMissionOutcome d = run(1, box_world, boxed);
+  ASSERT_TRUE(d.result.success) << d.result.reason;
+  EXPECT_EQ(boxed.find("true surface from"), std::string::npos) << boxed;
+  EXPECT_EQ(TruthFiles(cache).size(), 2u);
   fs::remove_all(dir);
 }
 

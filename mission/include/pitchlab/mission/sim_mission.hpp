@@ -39,6 +39,9 @@ struct SimMissionSpec {
   /// Through via_m to the goal (given or the world's), then back to the start: the mission's goal
   /// becomes the start, and the goal the last waypoint.
   bool round_trip = false;
+  /// Where the ground truth's elevation map is kept for later runs of the same world, placement,
+  /// map grid and executable (a sweep's runs share it: pitchlab bench); empty: none.
+  std::filesystem::path truth_cache_dir;
   AppConfig config;                       ///< sensors, simulated rig, seed
   /// Mission, planner, registration; the run sets the goal, map area and mount.
   RunSettings settings;
