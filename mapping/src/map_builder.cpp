@@ -5,6 +5,7 @@
 #include <string>
 
 #include "loop_closer.hpp"
+#include "pitchlab/mapping/cloud_statistics.hpp"
 
 namespace pitchlab::mapping {
 namespace {
@@ -121,6 +122,16 @@ Result<MergeStep> MapBuilder::Add(const PointCloud& cloud_base,
     if (bad > 0) {
       return Fail(Error::Code::kInvalidArgument, "first scan has " + std::to_string(bad) +
                                                      " points that are not finite (NaN/inf)");
+    }
+    // One map, one scale: its first scan resolves the registration's length_scale (when auto) for
+    // every later scan. A scan measured alone can read a decade off: a P3-DX stopped 0.3 m from a
+    // wall (corridor seed 1, stop 2) measured R = 0.32 m and n = 0.03 mm (the LMS200's centimetre
+    // steps on one flat surface leave a small patch no residual) and resolved to 0.1, every gate
+    // shrunk tenfold: "0 % of source points within 0.016 m".
+    if (std::isnan(config_.registration.length_scale)) {
+      const CloudStatistics first =
+          MeasureCloud(cloud_base, config_.sensor_base.value_or(Eigen::Vector3f::Zero()));
+      config_.registration.length_scale = config_.registration.Resolve(first, first).length_scale;
     }
     map_.Add(cloud_base, Eigen::Isometry3d::Identity());
     last_scan_ = cloud_base;

@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+
+#include "pitchlab/mapping/cloud_statistics.hpp"
 #include "pitchlab/mapping/map_builder.hpp"
 #include "sim_scans.hpp"
 
@@ -127,6 +130,53 @@ TEST(MapBuilder, MergesInARowKeepEveryRotationOrthonormal) {
     EXPECT_LT((R.transpose() * R - Eigen::Matrix3d::Identity()).norm(), 1e-12)
         << "scan " << p.scan_index;
   }
+}
+
+// A room 6 x 6 x 2.5 m around the sensor (0, 0, 0.5) at 5 cm spacing with `noise_m` of noise.
+PointCloud Room(double noise_m, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> noise(0.0f, static_cast<float>(noise_m));
+  PointCloud cloud;
+  auto add = [&](double x, double y, double z) {
+    cloud.emplace_back(x + noise(rng), y + noise(rng), z + noise(rng));
+  };
+  for (double u = -3; u < 3; u += 0.05) {
+    for (double v = -3; v < 3; v += 0.05) add(u, v, 0.0);     // floor
+    for (double z = 0; z < 2.5; z += 0.05) {
+      add(u, -3.0, z), add(u, 3.0, z), add(-3.0, u, z), add(3.0, u, z);  // walls
+    }
+  }
+  return cloud;
+}
+
+// One map, one scale: the first scan resolves the registration's length_scale (left auto), and a
+// later scan that alone would resolve a decade smaller keeps it. Here that scan sees mostly a
+// wall 0.3 m ahead without measurable noise (the P3-DX in the corridor, its returns on one wall
+// quantised to the LMS200's centimetre: R = 0.32 m, n = 0.03 mm), which alone resolves to 0.1 and
+// shrinks every gate tenfold.
+TEST(MapBuilder, TheFirstScanSetsTheLengthScaleOfEveryLaterOne) {
+  const Eigen::Vector3f sensor(0.0f, 0.0f, 0.5f);
+  MapConfig config;
+  config.sensor_base = sensor;
+  MapBuilder builder{config};
+  const PointCloud first = Room(0.003, 1);
+  const RegistrationConfig defaults;
+  const CloudStatistics first_stats = MeasureCloud(first, sensor);
+  ASSERT_DOUBLE_EQ(defaults.Resolve(first_stats, first_stats).length_scale, 1.0);
+  ASSERT_TRUE(builder.Add(first));
+
+  PointCloud near_wall;  // 1 x 0.6 m of wall 0.3 m ahead at 5 mm, and the room beyond, noise-free
+  for (double y = -0.5; y < 0.5; y += 0.005) {
+    for (double z = 0.2; z < 0.8; z += 0.005) near_wall.emplace_back(0.3f, y, z);
+  }
+  for (const Eigen::Vector3f& p : Room(0.0, 2)) {
+    if (p.x() < 0.3f) near_wall.push_back(p);
+  }
+  const CloudStatistics alone = MeasureCloud(near_wall, sensor);
+  ASSERT_DOUBLE_EQ(defaults.Resolve(alone, alone).length_scale, 0.1) << alone.median_range_m;
+  Result<MergeStep> step = builder.Add(near_wall, Eigen::Isometry3d::Identity());
+  ASSERT_TRUE(step) << step.error().message;
+  EXPECT_DOUBLE_EQ(step->registration.settings.length_scale, 1.0) << step->registration.reason;
 }
 
 TEST(MapBuilder, AnEmptyFirstScanIsAnError) {

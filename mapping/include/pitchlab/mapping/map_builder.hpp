@@ -74,7 +74,9 @@ struct LoopClosureConfig {
 struct MapConfig {
   double map_voxel_m = 0.1;          ///< map cloud voxel edge (centroid per voxel) [m]
   double local_map_radius_m = 40.0;  ///< map points this close to the last pose are the target [m]
-  RegistrationConfig registration;   ///< pairwise settings used for scan-to-map
+  /// Pairwise settings used for scan-to-map. A length_scale left auto is resolved once, by the
+  /// first scan, for the whole map (one map, one scale: a later scan alone can read a decade off).
+  RegistrationConfig registration;
   /// Where the laser (its mirror at zero pitch) sits in each scan's base_link [m]: normals face it
   /// and free space lies between it and the returns. Unset: at base_link's origin.
   std::optional<Eigen::Vector3f> sensor_base;
