@@ -35,6 +35,7 @@
 #include "commands.hpp"
 #include "interrupt.hpp"
 #include "pitchlab/mission/cleanup_registry.hpp"
+#include "pitchlab/sensors/fnv1a.hpp"
 #include "pitchlab/worlds/world_catalog.hpp"
 #include "pitchlab/mission/run_config.hpp"
 #include "pitchlab/mission/run_folder.hpp"
@@ -222,10 +223,10 @@ Shard ParseShard(const std::string& text) {
 /// Identifies the configuration a run was made with (a file edited in place changes it).
 std::string ConfigHash(const std::string& bytes) {
   if (bytes.empty()) return "built-in-defaults";
-  std::uint64_t h = 0xcbf29ce484222325ULL;  // FNV offset basis
-  for (unsigned char c : bytes) h = (h ^ c) * 0x100000001b3ULL;  // FNV prime
+  sensors::Fnv1a64 hash;
+  hash.Add(bytes);
   char text[17];
-  std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(h));
+  std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(hash.value()));
   return text;
 }
 

@@ -94,6 +94,13 @@ Truth TruthOf(const mapping::ElevationMap& map, const MissionConfig& mission,
   return truth;
 }
 
+// What the ground truth's rays see: the world without the robot.
+sensors::RayCasterOptions TruthCasterOptions() {
+  sensors::RayCasterOptions options;
+  options.exclude_subtree_of_body = sim::kRobotBody;
+  return options;
+}
+
 // The world as placed, for the ground truth's ray caster on another thread: a copy of the
 // simulation's state (the simulation steps on meanwhile) and a caster of its own.
 struct TruthScene {
@@ -101,9 +108,7 @@ struct TruthScene {
       : data(mj_makeData(rig.sim().model()), &mj_deleteData) {
     if (!data) throw std::runtime_error("ground truth: mj_makeData failed");
     mj_copyData(data.get(), rig.sim().model(), rig.sim().data());
-    sensors::RayCasterOptions options;
-    options.exclude_subtree_of_body = sim::kRobotBody;
-    caster = sensors::MakeEmbreeRayCaster(rig.sim().model(), data.get(), options);
+    caster = sensors::MakeEmbreeRayCaster(rig.sim().model(), data.get(), TruthCasterOptions());
   }
   std::unique_ptr<mjData, void (*)(mjData*)> data;
   std::unique_ptr<sensors::RayCaster> caster;
@@ -250,8 +255,8 @@ SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesyste
                              std::to_string(mission.map_area.size_y) + " cells, beside the mission";
   if (!spec.truth_cache_dir.empty()) {
     const sensors::ScopedTime timing(stages[Stage::kGroundTruth]);
-    truth_file =
-        TruthCacheFile(spec.truth_cache_dir, rig.sim().model(), rig.sim().data(), mission.map_area);
+    truth_file = TruthCacheFile(spec.truth_cache_dir, rig.sim().model(), rig.sim().data(),
+                                TruthCasterOptions(), mission.map_area);
     Result<std::optional<mapping::ElevationMap>> loaded =
         LoadCachedTruth(truth_file, mission.map_area);
     if (!loaded) {

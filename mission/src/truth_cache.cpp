@@ -10,48 +10,24 @@
 #include <mujoco/mujoco.h>
 
 #include "pitchlab/mapping/elevation_io.hpp"
-#include "pitchlab/sim/robot_model.hpp"
+#include "pitchlab/sensors/fnv1a.hpp"
 
 namespace pitchlab::mission {
-namespace {
-
-// FNV-1a, 64 bit: a cache name, not a defence against someone forging a file.
-struct Fnv64 {
-  std::uint64_t h = 14695981039346656037ull;
-  void Add(const void* bytes, std::size_t n) {
-    const auto* p = static_cast<const unsigned char*>(bytes);
-    for (std::size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
-  }
-  template <typename T>
-  void Add(const T& value) {
-    Add(&value, sizeof value);
-  }
-};
-
-}  // namespace
 
 std::filesystem::path TruthCacheFile(const std::filesystem::path& dir, const mjModel* m,
-                                     const mjData* d, const mapping::GridGeometry& area) {
-  Fnv64 hash;
-  // What the truth's ray caster sees: every geom outside the robot's subtree, posed as placed (the
-  // robot itself, its mount error drawn per seed included, is not part of the truth).
-  const int robot = mj_name2id(m, mjOBJ_BODY, sim::kRobotBody);
-  for (int g = 0; g < m->ngeom; ++g) {
-    bool on_robot = false;
-    for (int b = m->geom_bodyid[g]; b > 0 && !on_robot; b = m->body_parentid[b]) {
-      on_robot = b == robot;
-    }
-    if (on_robot) continue;
-    hash.Add(g);
-    hash.Add(m->geom_type[g]);
-    hash.Add(m->geom_dataid[g]);
-    hash.Add(m->geom_matid[g]);
-    hash.Add(m->geom_rgba + 4 * g, 4 * sizeof(float));
+                                     const mjData* d, const sensors::RayCasterOptions& caster,
+                                     const mapping::GridGeometry& area) {
+  sensors::Fnv1a64 hash;
+  // What the truth's ray caster sees, posed as placed: not the robot (its mount error is drawn
+  // per seed), nor what mj_ray skips as invisible.
+  for (const int g : sensors::VisibleGeoms(m, caster)) {
+    hash.AddValue(g);
+    hash.AddValue(m->geom_type[g]);
+    hash.AddValue(m->geom_dataid[g]);
     hash.Add(m->geom_size + 3 * g, 3 * sizeof(mjtNum));
     hash.Add(d->geom_xpos + 3 * g, 3 * sizeof(mjtNum));
     hash.Add(d->geom_xmat + 9 * g, 9 * sizeof(mjtNum));
   }
-  hash.Add(m->mat_rgba, 4 * sizeof(float) * static_cast<std::size_t>(m->nmat));
   hash.Add(m->hfield_size, 4 * sizeof(mjtNum) * static_cast<std::size_t>(m->nhfield));
   hash.Add(m->hfield_nrow, sizeof(int) * static_cast<std::size_t>(m->nhfield));
   hash.Add(m->hfield_ncol, sizeof(int) * static_cast<std::size_t>(m->nhfield));
@@ -60,19 +36,20 @@ std::filesystem::path TruthCacheFile(const std::filesystem::path& dir, const mjM
   hash.Add(m->mesh_faceadr, sizeof(int) * static_cast<std::size_t>(m->nmesh));
   hash.Add(m->mesh_vert, 3 * sizeof(float) * static_cast<std::size_t>(m->nmeshvert));
   hash.Add(m->mesh_face, 3 * sizeof(int) * static_cast<std::size_t>(m->nmeshface));
-  hash.Add(area.x_min_m);
-  hash.Add(area.y_min_m);
-  hash.Add(area.cell_m);
-  hash.Add(area.size_x);
-  hash.Add(area.size_y);
+  hash.AddValue(area.x_min_m);
+  hash.AddValue(area.y_min_m);
+  hash.AddValue(area.cell_m);
+  hash.AddValue(area.size_x);
+  hash.AddValue(area.size_y);
   std::error_code ec;
   const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
   const auto size = ec ? 0 : std::filesystem::file_size(exe, ec);
   const auto time = ec ? 0 : std::filesystem::last_write_time(exe, ec).time_since_epoch().count();
-  hash.Add(size);
-  hash.Add(time);
+  hash.AddValue(size);
+  hash.AddValue(time);
   char name[40];
-  std::snprintf(name, sizeof name, "truth-%016llx.plem", static_cast<unsigned long long>(hash.h));
+  std::snprintf(name, sizeof name, "truth-%016llx.plem",
+                static_cast<unsigned long long>(hash.value()));
   return dir / name;
 }
 

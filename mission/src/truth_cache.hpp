@@ -9,6 +9,7 @@
 #include <string>
 
 #include "pitchlab/mapping/elevation_map.hpp"
+#include "pitchlab/sensors/ray_caster.hpp"
 #include "pitchlab/sensors/result.hpp"
 
 struct mjModel_;
@@ -16,14 +17,15 @@ struct mjData_;
 
 namespace pitchlab::mission {
 
-/// The cache file in `dir` for the ground truth of `model` as `data` places it, over `area`, as
-/// this executable computes it: "truth-<16 hex digits>.plem", the digits an FNV-1a 64 hash of what
-/// the truth's ray caster sees (every geom outside the robot's subtree: type, size, mesh or
-/// heightfield, visibility, pose as placed), the grid, and this executable's size and modification
-/// time (another build may compute the truth otherwise). The robot (its mount error is drawn per
-/// seed) is not part of it, so runs of one world with different seeds share the file.
+/// The cache file in `dir` for the ground truth that a caster made with `caster` casts in `model`
+/// as `data` places it, over `area`, as this executable computes it: "truth-<16 hex digits>.plem",
+/// the digits an FNV-1a 64 hash of the geoms the caster sees (sensors::VisibleGeoms: type, size,
+/// mesh or heightfield, pose as placed), the grid, and this executable's size and modification
+/// time (another build may compute the truth otherwise). The robot is not among those geoms (its
+/// mount error is drawn per seed), so runs of one world with different seeds share the file.
 std::filesystem::path TruthCacheFile(const std::filesystem::path& dir, const mjModel_* model,
-                                     const mjData_* data, const mapping::GridGeometry& area);
+                                     const mjData_* data, const sensors::RayCasterOptions& caster,
+                                     const mapping::GridGeometry& area);
 
 /// The map cached in `file`, when there is one on `area`'s grid; nothing when the file is absent.
 /// A file that does not read back whole (a bad hash, another grid) is an error naming it.

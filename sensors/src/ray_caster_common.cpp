@@ -36,3 +36,16 @@ bool GeomMoves(const mjModel* model, int geom) {
 }
 
 }  // namespace pitchlab::sensors::detail
+
+namespace pitchlab::sensors {
+
+std::vector<int> VisibleGeoms(const mjModel* model, const RayCasterOptions& options) {
+  const std::vector<char> excluded = detail::ExcludedGeoms(model, options);
+  std::vector<int> visible;
+  for (int g = 0; g < model->ngeom; ++g) {
+    if (!excluded[g] && !detail::MjRaySkips(model, g)) visible.push_back(g);
+  }
+  return visible;
+}
+
+}  // namespace pitchlab::sensors

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <vector>
 
 struct mjModel_;
 struct mjData_;
@@ -45,5 +46,9 @@ std::unique_ptr<RayCaster> MakeEmbreeRayCaster(const mjModel_* model, const mjDa
 /// Reference caster: one mj_ray call per ray. Same contract as the Embree caster.
 std::unique_ptr<RayCaster> MakeMujocoRayCaster(const mjModel_* model, const mjData_* data,
                                                const RayCasterOptions& options = {});
+
+/// The geoms a caster made with `options` can hit, ascending: those outside the excluded subtree
+/// that mj_ray does not skip as invisible. What a cache of a caster's answers must be keyed on.
+std::vector<int> VisibleGeoms(const mjModel_* model, const RayCasterOptions& options = {});
 
 }  // namespace pitchlab::sensors
