@@ -132,6 +132,18 @@ void BM_BuildTraversability(benchmark::State& state) {
 }
 BENCHMARK(BM_BuildTraversability)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
+// The same into one grid kept between calls, as a run does (Mission reuses its grid's buffers).
+void BM_BuildTraversabilityInto(benchmark::State& state) {
+  planning::PlannerConfig config;
+  if (state.range(0) == 1) config.clearance_m = 0.5, config.clearance_cost = 1.0;
+  planning::TraversabilityGrid grid;
+  for (auto _ : state) {
+    planning::BuildTraversabilityInto(Layers(), config, grid);
+    benchmark::DoNotOptimize(grid.move_cost.data());
+  }
+}
+BENCHMARK(BM_BuildTraversabilityInto)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
 template <typename G>
 void BM_Bgl(benchmark::State& state) {
   const G g = MakeBgl<G>(Grid());

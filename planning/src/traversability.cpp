@@ -51,12 +51,13 @@ constexpr double kResidualPerStep = 0.25;
 // (CoarserThanRobot) a rise between neighbours d apart is a slope: kTooSteep beyond
 // d tan(max_inclination) (and step_max), and a cell's own points may spread by a slope at that
 // limit over its half diagonal as well as by a step.
-Blocked StepOrSlope(const ElevationLayers& L, int i, int j, const RobotLimits& robot) {
+// `max_grade` is tan(robot.max_inclination_rad).
+Blocked StepOrSlope(const ElevationLayers& L, int i, int j, const RobotLimits& robot,
+                    double max_grade) {
   const GridGeometry& g = L.geometry;
   const std::size_t k = g.Linear({i, j});
   const double step_max = robot.step_max_m;
   const bool coarse = CoarserThanRobot(g, robot);
-  const double max_grade = std::tan(robot.max_inclination_rad);
   const double in_cell = step_max + (coarse ? M_SQRT1_2 * g.cell_m * max_grade : 0.0);
   const float z = L.mean_z[k];
   if (L.max_z[k] - z > in_cell || z - L.min_z[k] > in_cell) return Blocked::kStep;
@@ -140,11 +141,18 @@ void InflateHazards(TraversabilityGrid& T, const std::vector<std::size_t>& borde
   }
   // Off the grid is nothing known to stand on (a DEM's or a world's edge): the footprint may not
   // hang over it (a terrain run drove off the world's edge along a path hugging the border).
-  for (int j = 0; j < g.size_y; ++j)
+  // A cell is cells_out = min(i, j, size_x - 1 - i, size_y - 1 - j) + 1 cells from the edge, and
+  // the test grows with cells_out: the cells with cells_out <= band, a frame `band` cells wide.
+  int band = 0;
+  while ((band + 1) * g.cell_m < reach_m - 1e-9) ++band;
+  for (int j = 0; j < g.size_y; ++j) {
+    const bool edge_row = std::min(j, g.size_y - 1 - j) < band;
     for (int i = 0; i < g.size_x; ++i) {
-      const int cells_out = std::min({i, j, g.size_x - 1 - i, g.size_y - 1 - j}) + 1;
-      if (cells_out * g.cell_m < reach_m - 1e-9) near(g.Linear({i, j}));
+      if (!edge_row && i == band) i = std::max(band, g.size_x - band);  // skip the inside
+      if (i >= g.size_x) break;
+      near(g.Linear({i, j}));
     }
+  }
 }
 
 // Soft clearance (PlannerConfig::clearance_m): the distance of every free cell's centre to the
@@ -164,7 +172,10 @@ void AddClearanceCosts(TraversabilityGrid& T, const std::vector<std::size_t>& bo
     const double d = std::hypot(di, dj) * g.cell_m;
     if (d >= reach_m - 1e-9) ring.emplace_back(di, dj), offset_m.push_back(static_cast<float>(d));
   }
-  std::vector<float> nearest_m(g.cell_count(), std::numeric_limits<float>::infinity());
+  // Kept between calls (a run builds a grid or two every stop): a fresh 4-byte-per-cell buffer
+  // costs its pages' clearing by the kernel each time.
+  thread_local std::vector<float> nearest_m;
+  nearest_m.assign(g.cell_count(), std::numeric_limits<float>::infinity());
   for (std::size_t k : border) {
     const CellIndex h = g.FromLinear(k);
     for (std::size_t o = 0; o < ring.size(); ++o) {
@@ -181,23 +192,45 @@ void AddClearanceCosts(TraversabilityGrid& T, const std::vector<std::size_t>& bo
   }
 }
 
-// The 8-neighbour move mask of every cell (see TraversabilityGrid::moves).
+// The 8-neighbour move mask of every cell (see TraversabilityGrid::moves). Inside the grid's
+// one-cell frame every neighbour exists and a move's cells are a fixed offset away.
 void ComputeMoves(TraversabilityGrid& T) {
-  const int* kDi = kMoveDi;
-  const int* kDj = kMoveDj;
   const GridGeometry& g = T.geometry;
+  const int sx = g.size_x, sy = g.size_y;
   T.moves.assign(g.cell_count(), 0);
   const auto free = [&](int i, int j) { return g.Contains({i, j}) && T.Free(g.Linear({i, j})); };
-  for (int j = 0; j < g.size_y; ++j)
-    for (int i = 0; i < g.size_x; ++i) {
+  const auto edge_cell = [&](int i, int j) {
+    std::uint8_t m = 0;
+    for (int b = 0; b < 8; ++b) {
+      const bool ok = free(i + kMoveDi[b], j + kMoveDj[b]) &&
+                      (b < 4 || (free(i + kMoveDi[b], j) && free(i, j + kMoveDj[b])));
+      m |= static_cast<std::uint8_t>(ok) << b;
+    }
+    T.moves[g.Linear({i, j})] = m;
+  };
+  const Blocked* blocked = T.blocked.data();
+  const std::ptrdiff_t row = g.Linear({0, 1}) - g.Linear({0, 0});
+  std::ptrdiff_t offset[8];
+  for (int b = 0; b < 8; ++b) offset[b] = kMoveDi[b] + kMoveDj[b] * row;
+  for (int j = 0; j < sy; ++j) {
+    if (j == 0 || j == sy - 1 || sx < 3) {
+      for (int i = 0; i < sx; ++i) edge_cell(i, j);
+      continue;
+    }
+    edge_cell(0, j);
+    for (int i = 1; i < sx - 1; ++i) {
+      const std::size_t k = g.Linear({i, j});
+      const Blocked* c = blocked + k;
+      const auto f = [c](std::ptrdiff_t o) { return c[o] == Blocked::kFree; };
       std::uint8_t m = 0;
       for (int b = 0; b < 8; ++b) {
-        const bool ok =
-            free(i + kDi[b], j + kDj[b]) && (b < 4 || (free(i + kDi[b], j) && free(i, j + kDj[b])));
+        const bool ok = f(offset[b]) && (b < 4 || (f(kMoveDi[b]) && f(kMoveDj[b] * row)));
         m |= static_cast<std::uint8_t>(ok) << b;
       }
-      T.moves[g.Linear({i, j})] = m;
+      T.moves[k] = m;
     }
+    edge_cell(sx - 1, j);
+  }
 }
 
 // Eq. 4-5 for move b out of cell (i, j), whether allowed or not, rounded to float: the one
@@ -216,39 +249,60 @@ float MoveCostAt(const TraversabilityGrid& T, int i, int j, int b) {
 }
 
 // The Eq. 4-5 cost of every allowed move of every cell, +inf for the others
-// (TraversabilityGrid::move_cost).
+// (TraversabilityGrid::move_cost), and the extremes of the allowed moves' costs that the searches
+// need: the A* heuristic's per-move lower bounds and the bucket queue's span, over the cells a
+// search may expand (free ones, and unknown ones as a start).
 void ComputeMoveCosts(TraversabilityGrid& T) {
   const GridGeometry& g = T.geometry;
-  MoveCosts none;
-  std::fill(std::begin(none.to), std::end(none.to), std::numeric_limits<float>::infinity());
-  T.move_cost.assign(g.cell_count(), none);
+  // The unknown or level moves' length, sqrt(d^2 + 0^2): the same double the general case gives.
+  double flat_m[8];
+  for (int b = 0; b < 8; ++b) {
+    const double d_m = (b < 4 ? 1.0 : M_SQRT2) * g.cell_m, dz = 0.0;
+    flat_m[b] = std::sqrt(d_m * d_m + dz * dz);
+  }
+  constexpr float kNone = std::numeric_limits<float>::infinity();
+  T.move_cost.resize(g.cell_count());
+  // In locals, not in T's fields: the compiler cannot keep those in registers across the stores
+  // into T (a chain of loads and stores through memory took a third of FinishTraversability).
+  double min_straight = std::numeric_limits<double>::infinity(), min_diagonal = min_straight;
+  double max_edge = 0;
+  // An allowed move's neighbour is on the grid (ComputeMoves), a fixed offset away; what follows
+  // is MoveCostAt's arithmetic, step for step.
+  const std::ptrdiff_t row = g.Linear({0, 1}) - g.Linear({0, 0});
+  std::ptrdiff_t offset[8];
+  double d2[8];
+  for (int b = 0; b < 8; ++b) {
+    offset[b] = kMoveDi[b] + kMoveDj[b] * row;
+    const double d_m = (b < 4 ? 1.0 : M_SQRT2) * g.cell_m;
+    d2[b] = d_m * d_m;
+  }
+  const double w_length = T.config.weights.length;
+  const float* z = T.z_m.data();
+  const float* enter = T.enter_cost.data();
   for (int j = 0; j < g.size_y; ++j)
     for (int i = 0; i < g.size_x; ++i) {
       const std::size_t k = g.Linear({i, j});
-      for (int b = 0; b < 8; ++b)
-        if (T.moves[k] >> b & 1) T.move_cost[k].to[b] = MoveCostAt(T, i, j, b);
+      const std::uint8_t m = T.moves[k];
+      MoveCosts& out = T.move_cost[k];
+      const bool source = T.Free(k) || T.blocked[k] == Blocked::kUnknown;
+      const float za = z[k];
+      for (int b = 0; b < 8; ++b) {
+        if (!(m >> b & 1)) {
+          out.to[b] = kNone;
+          continue;
+        }
+        const std::size_t kn = k + offset[b];
+        const float zb = z[kn];
+        const double dz = (std::isfinite(za) && std::isfinite(zb)) ? double(zb) - za : 0.0;
+        const double length_m = dz == 0.0 ? flat_m[b] : std::sqrt(d2[b] + dz * dz);
+        const float c = static_cast<float>(enter[kn] + w_length * length_m);
+        out.to[b] = c;
+        if (!source) continue;
+        double& lo = b < 4 ? min_straight : min_diagonal;
+        lo = std::min(lo, double{c});
+        max_edge = std::max(max_edge, double{c});
+      }
     }
-}
-
-// The extremes of the allowed moves' costs that the searches need: the A* heuristic's per-move
-// lower bounds and the bucket queue's span.
-void ComputeMoveCostRange(TraversabilityGrid& T) {
-  const GridGeometry& g = T.geometry;
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  // In locals, not in T's fields: the compiler cannot keep those in registers across the stores
-  // into T (a chain of loads and stores through memory took a third of FinishTraversability).
-  double min_straight = kInf, min_diagonal = kInf, max_edge = 0;
-  for (std::size_t k = 0; k < g.cell_count(); ++k) {
-    const bool source = T.Free(k) || T.blocked[k] == Blocked::kUnknown;
-    if (!source) continue;
-    for (int b = 0; b < 8; ++b) {
-      if (!(T.moves[k] >> b & 1)) continue;
-      const double c = T.move_cost[k][b];
-      double& lo = b < 4 ? min_straight : min_diagonal;
-      lo = std::min(lo, c);
-      max_edge = std::max(max_edge, c);
-    }
-  }
   T.min_straight_cost = min_straight;
   T.min_diagonal_cost = min_diagonal;
   T.max_edge_cost = max_edge;
@@ -381,6 +435,21 @@ void BuildTraversabilityInto(const ElevationLayers& L, const PlannerConfig& conf
   const GridGeometry& g = L.geometry;
   StartTraversability(g, config, T);
   const CostWeights& w = config.weights;
+  const double max_grade = std::tan(config.robot.max_inclination_rad);
+  // L.Tilt(k) > the limit, i.e. atan(t) > limit for t = |(tan phi_x, tan phi_y)|: decided on t
+  // against tan(limit) where t is more than 1e-5 (relative) from it, far beyond the float atan's
+  // error, so the verdict is the same; atan only for the few cells at the limit itself.
+  const double limit = config.robot.max_inclination_rad;
+  const bool by_tan = limit > 0 && limit < 1.5;  // tan(limit) finite and well-conditioned
+  const auto steeper = [&](std::size_t k) {
+    if (by_tan) {
+      const float tx = std::tan(L.phi_x[k]), ty = std::tan(L.phi_y[k]);
+      const double t = std::sqrt(tx * tx + ty * ty);
+      if (t < max_grade * (1 - 1e-5)) return false;
+      if (t > max_grade * (1 + 1e-5)) return true;
+    }
+    return L.Tilt(k) > limit;
+  };
   for (int j = 0; j < g.size_y; ++j)
     for (int i = 0; i < g.size_x; ++i) {
       const std::size_t k = g.Linear({i, j});
@@ -403,9 +472,10 @@ void BuildTraversabilityInto(const ElevationLayers& L, const PlannerConfig& conf
       T.enter_cost[k] = static_cast<float>(w.roughness * T.roughness_m[k] +
                                            w.inclination_x * std::abs(T.phi_x_rad[k]) +
                                            w.inclination_y * std::abs(T.phi_y_rad[k]));
-      if (incl_known && L.Tilt(k) > config.robot.max_inclination_rad) {
+      if (incl_known && steeper(k)) {
         T.blocked[k] = Blocked::kTooSteep;
-      } else if (const Blocked b = StepOrSlope(L, i, j, config.robot); b != Blocked::kFree) {
+      } else if (const Blocked b = StepOrSlope(L, i, j, config.robot, max_grade);
+                 b != Blocked::kFree) {
         T.blocked[k] = b;
       } else if (!incl_known) {
         // Seen, but the scan did not determine its slope (one or two far points, grazing lines:
@@ -441,7 +511,6 @@ void FinishTraversability(TraversabilityGrid& T) {
   AddClearanceCosts(T, border);
   ComputeMoves(T);
   ComputeMoveCosts(T);
-  ComputeMoveCostRange(T);
   float min_cost = std::numeric_limits<float>::infinity();
   for (std::size_t k = 0; k < T.geometry.cell_count(); ++k)
     if (T.Free(k)) min_cost = std::min(min_cost, T.enter_cost[k]);
