@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "cell_sort.hpp"
 #include "voxel_hash.hpp"
 
 namespace pitchlab::mapping {
@@ -32,17 +33,15 @@ PointCloud VoxelDownsample(const PointCloud& cloud, double voxel_size_m) {
   }
   if (voxel_size_m <= 0 || finite.empty()) return finite;
   const float inv = static_cast<float>(1.0 / voxel_size_m);
-  std::vector<std::pair<std::uint64_t, int>> keyed(finite.size());
-  for (std::size_t i = 0; i < finite.size(); ++i) {
-    keyed[i] = {CellKey(finite[i], inv), static_cast<int>(i)};
-  }
-  std::sort(keyed.begin(), keyed.end());
+  std::vector<std::uint64_t> keys(finite.size());
+  for (std::size_t i = 0; i < finite.size(); ++i) keys[i] = CellKey(finite[i], inv);
+  const std::vector<int> order = internal::OrderByCell(keys);
   PointCloud out;
-  for (std::size_t b = 0; b < keyed.size();) {
+  for (std::size_t b = 0; b < order.size();) {
     std::size_t e = b;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (; e < keyed.size() && keyed[e].first == keyed[b].first; ++e) {
-      sum += finite[keyed[e].second].cast<double>();
+    for (; e < order.size() && keys[order[e]] == keys[order[b]]; ++e) {
+      sum += finite[order[e]].cast<double>();
     }
     out.push_back((sum / static_cast<double>(e - b)).cast<float>());
     b = e;

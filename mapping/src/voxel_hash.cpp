@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <utility>
 
+#include "cell_sort.hpp"
+
 namespace pitchlab::mapping {
 namespace {
 
@@ -13,29 +15,27 @@ std::uint64_t Mix(std::uint64_t key) { return key * 0x9E3779B97F4A7C15ull; }
 
 VoxelHashIndex::VoxelHashIndex(const PointCloud& cloud, double cell_m)
     : inv_cell_(static_cast<float>(1.0 / cell_m)) {
-  std::vector<std::pair<std::uint64_t, int>> keyed(cloud.size());
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    keyed[i] = {CellKey(cloud[i], inv_cell_), static_cast<int>(i)};
-  }
-  std::sort(keyed.begin(), keyed.end());
-  points_.resize(keyed.size());
-  order_.resize(keyed.size());
-  for (std::size_t k = 0; k < keyed.size(); ++k) {
-    order_[k] = keyed[k].second;
-    points_[k] = cloud[keyed[k].second];
+  std::vector<std::uint64_t> keys(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) keys[i] = CellKey(cloud[i], inv_cell_);
+  order_ = internal::OrderByCell(keys);
+  points_.resize(order_.size());
+  std::vector<std::uint64_t> sorted(order_.size());
+  for (std::size_t k = 0; k < order_.size(); ++k) {
+    points_[k] = cloud[order_[k]];
+    sorted[k] = keys[order_[k]];
   }
   std::size_t cells = 0;
-  for (std::size_t k = 0; k < keyed.size(); ++k) {
-    cells += (k == 0 || keyed[k].first != keyed[k - 1].first) ? 1 : 0;
+  for (std::size_t k = 0; k < sorted.size(); ++k) {
+    cells += (k == 0 || sorted[k] != sorted[k - 1]) ? 1 : 0;
   }
   std::size_t size = 16;
   while (size < 2 * cells) size *= 2;  // load factor <= 0.5
   slots_.assign(size, Slot{kEmpty, 0, 0});
   mask_ = size - 1;
-  for (std::size_t b = 0; b < keyed.size();) {
+  for (std::size_t b = 0; b < sorted.size();) {
     std::size_t e = b;
-    while (e < keyed.size() && keyed[e].first == keyed[b].first) ++e;
-    const std::uint64_t key = keyed[b].first;
+    while (e < sorted.size() && sorted[e] == sorted[b]) ++e;
+    const std::uint64_t key = sorted[b];
     std::uint64_t s = (Mix(key) >> 32) & mask_;
     while (slots_[s].key != kEmpty) s = (s + 1) & mask_;
     slots_[s] = Slot{key, static_cast<int>(b), static_cast<int>(e)};
