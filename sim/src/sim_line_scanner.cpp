@@ -14,6 +14,25 @@ float SimLineScanner::cast_range_m() const {
 
 // One ray per beam: direction = R_world_laser [cos(theta + offset), sin(theta + offset), 0], tipped
 // out of the scan plane by `tip_rad` (towards the laser's +z).
+// The beams' directions in the laser frame depend only on (offset, tip), of which a line uses at
+// most seven: each set is computed once, and every line only rotates it.
+const std::vector<Eigen::Vector3d>& SimLineScanner::BeamDirections(double offset_rad,
+                                                                   double tip_rad) {
+  for (const BeamSet& set : beam_sets_) {
+    if (set.offset_rad == offset_rad && set.tip_rad == tip_rad) return set.laser;
+  }
+  BeamSet set{offset_rad, tip_rad, {}};
+  const int n = model_.readings();
+  set.laser.reserve(n);
+  for (int i = 0; i < n; ++i) {
+    const double theta = model_.angle_min_rad() + i * model_.angle_increment_rad() + offset_rad;
+    set.laser.emplace_back(std::cos(tip_rad) * std::cos(theta),
+                           std::cos(tip_rad) * std::sin(theta), std::sin(tip_rad));
+  }
+  beam_sets_.push_back(std::move(set));
+  return beam_sets_.back().laser;
+}
+
 void SimLineScanner::CastAt(const Eigen::Isometry3d& T_world_laser, double offset_rad,
                             std::vector<float>& out, double tip_rad) {
   const int n = model_.readings();
@@ -21,12 +40,9 @@ void SimLineScanner::CastAt(const Eigen::Isometry3d& T_world_laser, double offse
   directions_.resize(3 * n);
   out.resize(n);
   const Eigen::Vector3d o = T_world_laser.translation();
+  const std::vector<Eigen::Vector3d>& beams = BeamDirections(offset_rad, tip_rad);
   for (int i = 0; i < n; ++i) {
-    const double theta = model_.angle_min_rad() + i * model_.angle_increment_rad() + offset_rad;
-    const Eigen::Vector3d d =
-        T_world_laser.linear() * Eigen::Vector3d(std::cos(tip_rad) * std::cos(theta),
-                                                 std::cos(tip_rad) * std::sin(theta),
-                                                 std::sin(tip_rad));
+    const Eigen::Vector3d d = T_world_laser.linear() * beams[i];
     for (int k = 0; k < 3; ++k) {
       origins_[3 * i + k] = static_cast<float>(o[k]);
       directions_[3 * i + k] = static_cast<float>(d[k]);

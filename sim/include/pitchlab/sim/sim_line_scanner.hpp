@@ -2,6 +2,7 @@
 // The simulated LMS200 behind the LineScanner seam: one ray per beam from the "robot_laser" site,
 // cast by a sensors::RayCaster, turned into readings by sensors::Lms200Model.
 
+#include <deque>
 #include <vector>
 
 #include "pitchlab/sensors/lms200.hpp"
@@ -31,6 +32,13 @@ class SimLineScanner final : public sensors::LineScanner {
   void CastAt(const Eigen::Isometry3d& T_world_laser, double offset_rad, std::vector<float>& out,
               double tip_rad = 0.0);
   void CastIncidence(const Eigen::Isometry3d& T_world_laser);
+  const std::vector<Eigen::Vector3d>& BeamDirections(double offset_rad, double tip_rad);
+
+  // One set of beam directions in the laser frame (BeamDirections).
+  struct BeamSet {
+    double offset_rad, tip_rad;
+    std::vector<Eigen::Vector3d> laser;
+  };
 
   Simulation& sim_;
   sensors::RayCaster& caster_;
@@ -38,6 +46,7 @@ class SimLineScanner final : public sensors::LineScanner {
   std::vector<float> origins_, directions_, ranges_, edge_lo_, edge_hi_, along_, across_,
       along_back_, across_back_, cos_incidence_;
   sensors::Elapsed line_time_;
+  std::deque<BeamSet> beam_sets_;  // a deque: a set's reference stays valid as others are added
 };
 
 }  // namespace pitchlab::sim
