@@ -5,6 +5,7 @@
 #include <string>
 
 #include "loop_closer.hpp"
+#include "parallel_for.hpp"
 #include "pitchlab/mapping/cloud_statistics.hpp"
 
 namespace pitchlab::mapping {
@@ -106,7 +107,17 @@ Result<void> MapBuilder::CloseLoops(const PointCloud& cloud_base, MergeStep& ste
   }
   if (!step.reposed) return {};
   for (std::size_t i = 0; i < poses.size(); ++i) trajectory_[i].T_map_base = poses[i];
+  next_target_.reset();
   return map_.Repose(poses);
+}
+
+void MapBuilder::PrepareNext() {
+  if (trajectory_.empty() || next_target_) return;
+  const internal::SerialLoops alone;
+  auto target = std::make_unique<RegistrationTarget>(
+      map_.Around(trajectory_.back().T_map_base, config_.local_map_radius_m), config_.sensor_base);
+  target->Prepare(config_.registration);
+  next_target_ = std::move(target);
 }
 
 Result<MergeStep> MapBuilder::Add(const PointCloud& cloud_base,
@@ -134,6 +145,7 @@ Result<MergeStep> MapBuilder::Add(const PointCloud& cloud_base,
       config_.registration.length_scale = config_.registration.Resolve(first, first).length_scale;
     }
     map_.Add(cloud_base, Eigen::Isometry3d::Identity());
+    next_target_.reset();
     last_scan_ = cloud_base;
     trajectory_.push_back({step.scan_index, Eigen::Isometry3d::Identity()});
     step.merged = true;
@@ -158,13 +170,18 @@ Result<MergeStep> MapBuilder::Add(const PointCloud& cloud_base,
   prior.previous_motion = last_motion_ ? *last_motion_ : Eigen::Isometry3d::Identity();
   prior.target_scan = &last_scan_;  // the map was seen from many places; free space from one
   prior.source_sensor = prior.target_sensor = config_.sensor_base;  // target: the last base_link
-  Result<RegistrationResult> r = Register(map_.Around(T_map_last, config_.local_map_radius_m),
-                                          cloud_base, prior, config_.registration);
+  // The target: the map around the last pose, as PrepareNext made it or made here.
+  if (!next_target_) {
+    next_target_ = std::make_unique<RegistrationTarget>(
+        map_.Around(T_map_last, config_.local_map_radius_m), config_.sensor_base);
+  }
+  Result<RegistrationResult> r = Register(*next_target_, cloud_base, prior, config_.registration);
   if (!r) return tl::make_unexpected(r.error());
   step.registration = *r;
-  if (!r->success) return step;  // reported, never merged
+  if (!r->success) return step;  // reported, never merged: the map and its target stay
   step.T_map_base = Orthonormal(T_map_last * r->T_target_source);
   map_.Add(cloud_base, step.T_map_base);
+  next_target_.reset();
   trajectory_.push_back({step.scan_index, step.T_map_base});
   last_scan_ = cloud_base;
   last_motion_ = r->T_target_source;

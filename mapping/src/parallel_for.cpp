@@ -18,6 +18,8 @@ namespace {
 
 constexpr unsigned kMaxThreads = 8;  // beyond the 2-8 cores this runs on, blocks get too few
 
+thread_local bool serial_loops = false;  // SerialLoops
+
 // The cores this process may run on: its CPU affinity (taskset, a cluster job's cpuset), which
 // hardware_concurrency ignores: a run given one core of 64 would start 8 threads on it.
 unsigned Cores() {
@@ -129,7 +131,7 @@ void ParallelFor(std::size_t n, std::size_t block,
   job->block = std::max<std::size_t>(block, 1);
   job->blocks = (n + job->block - 1) / job->block;
   job->body = &body;
-  const unsigned cores = std::min(Cores(), kMaxThreads);
+  const unsigned cores = serial_loops ? 1u : std::min(Cores(), kMaxThreads);
   const unsigned threads = static_cast<unsigned>(
       std::min<std::size_t>(job->blocks, max_threads > 0 ? std::min(max_threads, cores) : cores));
   for (unsigned t = 1; t < threads; ++t) {
@@ -149,5 +151,8 @@ void ParallelFor(std::size_t n, std::size_t block,
   if (own) std::rethrow_exception(own);
   if (job->failure) std::rethrow_exception(job->failure);
 }
+
+SerialLoops::SerialLoops() : was_(serial_loops) { serial_loops = true; }
+SerialLoops::~SerialLoops() { serial_loops = was_; }
 
 }  // namespace pitchlab::mapping::internal

@@ -15,4 +15,18 @@ void ParallelFor(std::size_t n, std::size_t block,
                  const std::function<void(std::size_t begin, std::size_t end)>& body,
                  unsigned max_threads = 0);
 
+/// While one lives, the ParallelFor calls its thread makes run on that thread alone: work done
+/// beside other work (a registration target prepared while the robot drives) would take the
+/// cores that work needs. Made and ended on one thread; they nest.
+class SerialLoops {
+ public:
+  SerialLoops();
+  ~SerialLoops();
+  SerialLoops(const SerialLoops&) = delete;
+  SerialLoops& operator=(const SerialLoops&) = delete;
+
+ private:
+  bool was_;
+};
+
 }  // namespace pitchlab::mapping::internal

@@ -12,6 +12,7 @@
 #include "guess_grid.hpp"
 #include "pcl_pipeline.hpp"
 #include "seen_space.hpp"
+#include "target_memo.hpp"
 
 namespace pitchlab::mapping {
 namespace {
@@ -140,9 +141,12 @@ Weakness WithoutTilt(Weakness weak, const Eigen::Vector3d& up_target) {
   return weak;
 }
 
-// The clouds after the voxel grid, and where each cloud's sensor stood (normals face it).
+// The clouds after the voxel grid (the target's kept in its TargetMemo), and where each cloud's
+// sensor stood (normals face it).
 struct Prepared {
-  PointCloud target_icp, source_icp, target_features, source_features;
+  const PointCloud& target_icp;
+  const PointCloud& target_features;
+  PointCloud source_icp, source_features;
   Eigen::Vector3f target_sensor = Eigen::Vector3f::Zero(), source_sensor = Eigen::Vector3f::Zero();
 };
 
@@ -448,15 +452,9 @@ struct FeatureMatches {
   RegistrationConfig config;
 };
 
-// The normals features are computed from. Their radius is half the features' by default: on an
-// index of cells as wide as the features' a query scanned about twice the points it needed.
-Normals FeatureNormals(const PointCloud& cloud, const VoxelHashIndex& feature_index, float r_normal,
-                       float r_feature, const Eigen::Vector3f& sensor) {
-  if (r_normal >= r_feature) return EstimateNormals(cloud, feature_index, r_normal, sensor);
-  return EstimateNormals(cloud, VoxelHashIndex(cloud, r_normal), r_normal, sensor);
-}
-
-SacResult FastFeatureAlignment(const Prepared& prep, const RegistrationConfig& config,
+// The target's side at the config's own scale comes from `memo` (made there once).
+SacResult FastFeatureAlignment(const Prepared& prep, internal::TargetMemo& memo,
+                               const RegistrationConfig& config,
                                const std::optional<PriorRegion>& region, StageTimings& timings,
                                FeatureMatches& matches) {
   SacResult sac;
@@ -474,19 +472,32 @@ SacResult FastFeatureAlignment(const Prepared& prep, const RegistrationConfig& c
     timings.voxel_s += lap.Lap();
     const float r_normal = static_cast<float>(c.normal_radius_m);
     const float r_feature = static_cast<float>(c.feature_radius_m);
-    const VoxelHashIndex t_index(target, std::max(r_normal, r_feature));
+    // The target's keypoints and features: kept at the config's own scale, made here at half.
+    std::optional<internal::TargetMemo::Features> half_target;
+    if (scale != 1.0) {
+      internal::TargetMemo::Features& f = half_target.emplace();
+      f.index = std::make_unique<VoxelHashIndex>(target, std::max(r_normal, r_feature));
+      f.normals = internal::FeatureNormals(target, *f.index, r_normal, r_feature,
+                                           prep.target_sensor);
+    }
     const VoxelHashIndex s_index(source, std::max(r_normal, r_feature));
-    const Normals tn = FeatureNormals(target, t_index, r_normal, r_feature, prep.target_sensor);
-    const Normals sn = FeatureNormals(source, s_index, r_normal, r_feature, prep.source_sensor);
+    const Normals sn =
+        internal::FeatureNormals(source, s_index, r_normal, r_feature, prep.source_sensor);
     timings.normals_s += lap.Lap();
-    const std::vector<int> tk = EvenIndices(target.size(), c.max_feature_points);
+    if (half_target) {
+      internal::TargetMemo::Features& f = *half_target;
+      f.keys = EvenIndices(target.size(), c.max_feature_points);
+      for (int i : f.keys) f.key_points.push_back(target[i]);
+      f.fpfh = ComputeFpfh(target, f.normals, *f.index, r_feature, c.max_neighbors, f.keys);
+    }
+    const internal::TargetMemo::Features& tf =
+        half_target ? *half_target : memo.FeatureParts(c, prep.target_sensor);
     const std::vector<int> sk = EvenIndices(source.size(), c.max_feature_points);
-    const FeatureMatrix tf = ComputeFpfh(target, tn, t_index, r_feature, c.max_neighbors, tk);
     const FeatureMatrix sf = ComputeFpfh(source, sn, s_index, r_feature, c.max_neighbors, sk);
     timings.features_s += lap.Lap();
-    const std::vector<Correspondence> corrs = MatchFeatures(sf, tf);
-    PointCloud t_key, s_key;
-    for (int i : tk) t_key.push_back(target[i]);
+    const std::vector<Correspondence> corrs = MatchFeatures(sf, tf.fpfh);
+    const PointCloud& t_key = tf.key_points;
+    PointCloud s_key;
     for (int i : sk) s_key.push_back(source[i]);
     sac = SampleConsensus(s_key, t_key, corrs, c, region);
     timings.initial_alignment_s += lap.Lap();
@@ -973,28 +984,29 @@ Result<void> CheckInput(const PointCloud& target, const PointCloud& source,
 
 // 0. What each cloud measures (range, spacing, noise: MeasureCloud) into `out`, and the settings
 // `requested`'s `auto` values resolve to (RegistrationConfig::Resolve).
-RegistrationConfig ResolveSettings(const PointCloud& target, const PointCloud& source,
+RegistrationConfig ResolveSettings(internal::TargetMemo& target, const PointCloud& source,
                                    const RegistrationPrior& prior,
                                    const RegistrationConfig& requested, RegistrationResult& out) {
   out.source_statistics =
       MeasureCloud(source, prior.source_sensor.value_or(Eigen::Vector3f::Zero()));
   out.target_statistics =
-      MeasureCloud(target, prior.target_sensor.value_or(Eigen::Vector3f::Zero()));
+      target.Statistics(prior.target_sensor.value_or(Eigen::Vector3f::Zero()));
   out.settings = requested.Resolve(out.source_statistics, out.target_statistics);
   return out.settings;
 }
 
 // 1. Voxel grid: the ICP clouds at icp_voxel_m, the feature clouds at feature_voxel_m from those.
-Prepared VoxelGrid(const PointCloud& target, const PointCloud& source,
+Prepared VoxelGrid(internal::TargetMemo& target, const PointCloud& source,
                    const RegistrationPrior& prior, const RegistrationConfig& config) {
-  Prepared prep;
-  prep.source_sensor = prior.source_sensor.value_or(Eigen::Vector3f::Zero());
-  prep.target_sensor = prior.target_sensor.value_or(Eigen::Vector3f::Zero());
-  prep.target_icp = VoxelDownsample(target, config.icp_voxel_m);
-  prep.source_icp = VoxelDownsample(source, config.icp_voxel_m);
-  prep.target_features = VoxelDownsample(prep.target_icp, config.feature_voxel_m);
-  prep.source_features = VoxelDownsample(prep.source_icp, config.feature_voxel_m);
-  return prep;
+  const internal::TargetMemo::Voxels& grids = target.VoxelGrids(config);
+  PointCloud source_icp = VoxelDownsample(source, config.icp_voxel_m);
+  PointCloud source_features = VoxelDownsample(source_icp, config.feature_voxel_m);
+  return Prepared{grids.icp,
+                  grids.features,
+                  std::move(source_icp),
+                  std::move(source_features),
+                  prior.target_sensor.value_or(Eigen::Vector3f::Zero()),
+                  prior.source_sensor.value_or(Eigen::Vector3f::Zero())};
 }
 
 // Fewer than kMinPoints points left by the voxel grid in either cloud is bad input.
@@ -1027,23 +1039,20 @@ SeenMargins FreeSpaceMargins(const RegistrationConfig& config) {
 // (prior.target_scan), in 1 deg bins: two or more of a seed-pattern scan's 0.5 deg beams and
 // ~0.5 deg lines per bin, so inside the view a bin is rarely empty.
 struct IcpScene {
-  IcpScene(const Prepared& prep, const PointCloud& target, const RegistrationPrior& prior,
+  IcpScene(const Prepared& prep, internal::TargetMemo& memo, const RegistrationPrior& prior,
            const RegistrationConfig& config)
       : fine_cell(static_cast<float>(std::max(
             {config.icp_min_distance_m, config.inlier_distance_m, config.icp_normal_radius_m}))),
-        fine(prep.target_icp, fine_cell),
-        coarse(prep.target_icp, std::max<double>(fine_cell, config.icp_max_distance_m)),
-        normals(EstimateNormals(prep.target_icp, fine,
-                                static_cast<float>(config.icp_normal_radius_m),
-                                prep.target_sensor)),
-        seen(prior.target_scan ? *prior.target_scan : target, prep.target_sensor, 1.0,
+        parts(memo.IcpParts(config, fine_cell,
+                            std::max<double>(fine_cell, config.icp_max_distance_m),
+                            prep.target_sensor)),
+        seen(prior.target_scan ? *prior.target_scan : memo.cloud(), prep.target_sensor, 1.0,
              FreeSpaceMargins(config)),
-        target{prep.target_icp, normals, coarse, fine, fine_cell, &seen},
+        target{prep.target_icp, parts.normals, *parts.coarse, *parts.fine, fine_cell, &seen},
         source(EvenSubsample(prep.source_icp, config.icp_max_points)) {}
 
   const float fine_cell;
-  const VoxelHashIndex fine, coarse;
-  const Normals normals;
+  const internal::TargetMemo::Icp& parts;  // hashes and normals, kept in the memo
   const LazySeenSpace seen;
   const IcpTarget target;
   const PointCloud source;
@@ -1063,6 +1072,7 @@ std::optional<std::size_t> ConfinedVoxels(const Prepared& prep, const Registrati
 
 // What stages 3-6 work on: the input, the resolved settings and what stages 1-2 made of them.
 struct Stages {
+  internal::TargetMemo& memo;  // what the target alone gives, made once
   const PointCloud& target;
   const PointCloud& source;
   const RegistrationPrior& prior;
@@ -1117,7 +1127,7 @@ SacResult InitialAlignment(const Stages& s, const std::optional<PriorRegion>& re
   if (s.config.features == FeatureKind::kNarf) {
     return FastNarfAlignment(s.target, s.source, s.config, region, timings);
   }
-  return FastFeatureAlignment(s.prep, s.config, region, timings, matches);
+  return FastFeatureAlignment(s.prep, s.memo, s.config, region, timings, matches);
 }
 
 // The initial alignment refined by ICP: PCL's ICP-NL from it (backend pcl), or the verification
@@ -1363,26 +1373,31 @@ Eigen::Isometry3d PoseFromXyzRpyDeg(double x, double y, double z, double roll_de
 
 // Algorithm 1, stage by stage: 0-2 prepare both clouds, 3-4 align their features and verify the
 // alignment by ICP, 5 else ICP from the prior's guess, 6 conclude. Stages 3-5 decide the pose.
-Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& source,
-                                    const RegistrationPrior& prior,
-                                    const RegistrationConfig& requested) {
+namespace {
+
+Result<RegistrationResult> RegisterWith(internal::TargetMemo& memo, const PointCloud& source,
+                                        const RegistrationPrior& prior,
+                                        const RegistrationConfig& requested) {
+  const PointCloud& target = memo.cloud();
   if (Result<void> ok = CheckInput(target, source, prior, requested); !ok) {
     return tl::make_unexpected(ok.error());
   }
   Stopwatch total;
   Progress run;
   // 0. What the clouds measure, and the settings that follow from it.
-  const RegistrationConfig config = ResolveSettings(target, source, prior, requested, run.out);
+  const RegistrationConfig config = ResolveSettings(memo, source, prior, requested, run.out);
   // 1. Voxel grid.
-  const Prepared prep = VoxelGrid(target, source, prior, config);
+  const Prepared prep = VoxelGrid(memo, source, prior, config);
   run.out.timings.voxel_s = run.lap.Lap();
   if (Result<void> ok = CheckEnoughPoints(prep, config); !ok) {
     return tl::make_unexpected(ok.error());
   }
   // 2. Normals of the ICP target, its search structures and the free space its scan saw.
-  const IcpScene scene(prep, target, prior, config);
+  const IcpScene scene(prep, memo, prior, config);
   run.out.timings.normals_s = run.lap.Lap();
-  const Stages s{target, source, prior, config, prep, scene, ConfinedVoxels(prep, config)};
+  const Stages s{memo,  target, source,
+                 prior, config, prep,
+                 scene, ConfinedVoxels(prep, config)};
   // 3-4. Features, sample-consensus initial alignment, ICP from it (Levenberg-Marquardt).
   const FeatureStage features = AlignByFeatures(s, run);
   Verdict verdict = features.verdict;
@@ -1399,6 +1414,60 @@ Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& 
   Finish(s, verdict, run);
   run.out.timings.total_s = total.Lap();
   return std::move(run.out);
+}
+
+}  // namespace
+
+Result<RegistrationResult> Register(const PointCloud& target, const PointCloud& source,
+                                    const RegistrationPrior& prior,
+                                    const RegistrationConfig& requested) {
+  internal::TargetMemo memo(target);
+  return RegisterWith(memo, source, prior, requested);
+}
+
+struct RegistrationTarget::Parts {
+  explicit Parts(PointCloud c) : cloud(std::move(c)), memo(cloud) {}
+  const PointCloud cloud;
+  internal::TargetMemo memo;
+};
+
+RegistrationTarget::RegistrationTarget(PointCloud cloud, std::optional<Eigen::Vector3f> sensor)
+    : parts_(std::make_unique<Parts>(std::move(cloud))), sensor_(sensor) {}
+RegistrationTarget::~RegistrationTarget() = default;
+RegistrationTarget::RegistrationTarget(RegistrationTarget&&) noexcept = default;
+RegistrationTarget& RegistrationTarget::operator=(RegistrationTarget&&) noexcept = default;
+
+const PointCloud& RegistrationTarget::cloud() const { return parts_->cloud; }
+
+void RegistrationTarget::Prepare(const RegistrationConfig& requested) {
+  const PointCloud& target = parts_->cloud;
+  if (!CheckCloud(target, "target")) return;  // Register names the problem
+  try {
+    requested.Validate();
+  } catch (const std::invalid_argument&) {
+    return;
+  }
+  internal::TargetMemo& memo = parts_->memo;
+  const Eigen::Vector3f sensor = sensor_.value_or(Eigen::Vector3f::Zero());
+  const CloudStatistics& stats = memo.Statistics(sensor);
+  // The source is the next scan, unmeasured yet: resolved as if it measured like the target. A
+  // setting that comes out otherwise (the inlier distance, from both clouds' noise, sets the fine
+  // hash's cells when it exceeds the normals' radius) has its parts made again by Register.
+  const RegistrationConfig config = requested.Resolve(stats, stats);
+  const internal::TargetMemo::Voxels& grids = memo.VoxelGrids(config);
+  if (grids.icp.size() < kMinPoints) return;
+  const float fine_cell = static_cast<float>(
+      std::max({config.icp_min_distance_m, config.inlier_distance_m, config.icp_normal_radius_m}));
+  memo.IcpParts(config, fine_cell, std::max<double>(fine_cell, config.icp_max_distance_m), sensor);
+  if (config.backend == RegistrationBackend::kFast && config.features == FeatureKind::kFpfh) {
+    memo.FeatureParts(config, sensor);
+  }
+}
+
+Result<RegistrationResult> Register(RegistrationTarget& target, const PointCloud& source,
+                                    const RegistrationPrior& prior,
+                                    const RegistrationConfig& config) {
+  return RegisterWith(target.parts_->memo, source, prior, config);
 }
 
 }  // namespace pitchlab::mapping

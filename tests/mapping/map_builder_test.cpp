@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <thread>
+#include <vector>
 
 #include "pitchlab/mapping/cloud_statistics.hpp"
 #include "pitchlab/mapping/map_builder.hpp"
@@ -177,6 +179,50 @@ TEST(MapBuilder, TheFirstScanSetsTheLengthScaleOfEveryLaterOne) {
   Result<MergeStep> step = builder.Add(near_wall, Eigen::Isometry3d::Identity());
   ASSERT_TRUE(step) << step.error().message;
   EXPECT_DOUBLE_EQ(step->registration.settings.length_scale, 1.0) << step->registration.reason;
+}
+
+// A target made beforehand (PrepareNext, on another thread as a mission does while its robot
+// drives) gives every registration the result to the bit that one made in Add gives, a failed
+// one's kept target included; and a registration prepared with other settings than it is asked
+// with gives the unprepared result too.
+TEST(MapBuilder, ATargetPreparedBeforehandGivesTheSameResults) {
+  std::vector<PointCloud> scans;
+  for (std::size_t i = 0; i < 4; ++i) {
+    const Pose2& p = kOfficePath[i];
+    scans.push_back(CloudFromScan(SimulatedScan("office", p.x_m, p.y_m, p.yaw_deg, 10 + i)));
+  }
+  // Third: a scan from another world (registration fails, the map and its target stay).
+  scans.insert(scans.begin() + 2, CloudFromScan(SimulatedScan("urban", 0, 0, 0, 3)));
+  MapBuilder plain{SimConfig()}, prepared{SimConfig()};
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    std::thread beside([&] { prepared.PrepareNext(); });
+    beside.join();
+    Result<MergeStep> a = plain.Add(scans[i]);
+    Result<MergeStep> b = prepared.Add(scans[i]);
+    ASSERT_TRUE(a && b);
+    EXPECT_EQ(a->merged, i != 2) << "scan " << i << ": " << a->registration.reason;
+    EXPECT_EQ(a->merged, b->merged) << "scan " << i;
+    EXPECT_EQ(a->registration.reason, b->registration.reason) << "scan " << i;
+    EXPECT_EQ(a->registration.T_target_source.matrix(), b->registration.T_target_source.matrix())
+        << "scan " << i;
+    EXPECT_EQ(a->registration.information, b->registration.information) << "scan " << i;
+  }
+  // Prepared for another scale than registered at: the parts are made again, the result holds.
+  RegistrationConfig other = SimConfig().registration;
+  other.length_scale = 1.0;
+  RegistrationConfig half = other;
+  half.length_scale = 0.5;
+  const Eigen::Vector3f sensor = *SimConfig().sensor_base;
+  RegistrationTarget target(scans[0], sensor);
+  target.Prepare(half);
+  RegistrationPrior prior;
+  prior.source_sensor = prior.target_sensor = sensor;
+  Result<RegistrationResult> a = Register(scans[0], scans[1], prior, other);
+  Result<RegistrationResult> b = Register(target, scans[1], prior, other);
+  ASSERT_TRUE(a && b);
+  EXPECT_TRUE(a->success) << a->reason;
+  EXPECT_EQ(a->T_target_source.matrix(), b->T_target_source.matrix());
+  EXPECT_EQ(a->reason, b->reason);
 }
 
 TEST(MapBuilder, AnEmptyFirstScanIsAnError) {

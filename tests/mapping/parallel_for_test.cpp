@@ -68,6 +68,39 @@ TEST(ParallelFor, UsesMoreThanOneThreadWhereTheMachineHasThem) {
   EXPECT_EQ(ids.size(), 2u);
 }
 
+// Within a SerialLoops' life the thread's loops run on it alone (they nest); after it, as before.
+TEST(ParallelFor, SerialLoopsKeepTheThreadsLoopsOnItself) {
+  // Each of the two blocks waits (up to `wait_ms`) until the other started.
+  const auto threads_used = [](int wait_ms) {
+    std::mutex mutex;
+    std::set<std::thread::id> ids;
+    std::atomic<int> arrived{0};
+    ParallelFor(2, 1, [&](std::size_t, std::size_t) {
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        ids.insert(std::this_thread::get_id());
+      }
+      ++arrived;
+      for (int i = 0; i < wait_ms && arrived.load() < 2; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
+    });
+    return ids;
+  };
+  const std::set<std::thread::id> me{std::this_thread::get_id()};
+  {
+    const SerialLoops alone;
+    EXPECT_EQ(threads_used(20), me);
+    {
+      const SerialLoops nested;
+      EXPECT_EQ(threads_used(20), me);
+    }
+    EXPECT_EQ(threads_used(20), me);
+  }
+  if (AllowedCores() < 2) GTEST_SKIP() << "one core";
+  EXPECT_EQ(threads_used(2000).size(), 2u);
+}
+
 // A process allowed one core (taskset, a cluster job's cpuset) runs its loops on the caller alone,
 // however many cores the machine has.
 TEST(ParallelFor, KeepsToTheCoresTheProcessIsAllowed) {

@@ -149,6 +149,14 @@ class MapBuilder {
       const std::optional<GuessUncertainty>& odometry_uncertainty = {},
       const std::optional<MeasuredTilt>& measured_tilt = {});
 
+  /// Makes the next Add's registration target now, the map around the last merged pose, and
+  /// what registration derives from it alone (RegistrationTarget::Prepare), its loops on the
+  /// calling thread alone: for a caller with a core to spare before its next scan (a robot
+  /// driving to its next stop). Add uses it while the map stays as it is, and gives the same
+  /// result without it. Nothing to do before the first scan. No other call on this builder may
+  /// run meanwhile.
+  void PrepareNext();
+
   /// The merged map in `map` [m], one centroid per voxel.
   PointCloud MapCloud() const;
   /// T_map_base of every merged scan, in order (optimised, with loop closure on).
@@ -173,6 +181,8 @@ class MapBuilder {
   PointCloud last_scan_;  // the last merged scan in its base_link: the registration's view
   std::optional<Eigen::Isometry3d> last_motion_;  // T_prev_last of the last two merged scans
   std::size_t scans_seen_ = 0;
+  // PrepareNext's target for the next Add; dropped whenever the map changes.
+  std::unique_ptr<RegistrationTarget> next_target_;
 };
 
 }  // namespace pitchlab::mapping

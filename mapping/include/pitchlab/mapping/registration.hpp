@@ -3,6 +3,7 @@
 // consensus initial alignment, non-linear ICP (Levenberg-Marquardt); with an odometry prior, a
 // geometric constraint around it and a constant-velocity fallback.
 
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -117,6 +118,41 @@ struct RegistrationResult {
 /// fails (no overlap, features ambiguous without a fallback, constraint violated) is a result
 /// with success == false and the reason. Deterministic: the same input gives the same output.
 [[nodiscard]] Result<RegistrationResult> Register(const PointCloud& target,
+                                                  const PointCloud& source,
+                                                  const RegistrationPrior& prior,
+                                                  const RegistrationConfig& config);
+
+/// A target cloud and what registration derives from it alone (its statistics, voxel grids, the
+/// ICP target's search structures and normals, the feature cloud's FPFH), each made once and kept.
+/// A mission knows its next target, the local map around its last pose, before the robot has
+/// driven to the next stop: Prepare makes these parts then (on a core the drive leaves idle), and
+/// Register uses them. Register with it gives what Register with the cloud gives, to the bit: a
+/// part the call needs with other settings than it was prepared with is made afresh. Not for two
+/// calls at once (Register may add parts).
+class RegistrationTarget {
+ public:
+  /// `sensor`: where the target's sensor stood, in its frame (RegistrationPrior::target_sensor).
+  RegistrationTarget(PointCloud cloud, std::optional<Eigen::Vector3f> sensor);
+  ~RegistrationTarget();
+  RegistrationTarget(RegistrationTarget&&) noexcept;
+  RegistrationTarget& operator=(RegistrationTarget&&) noexcept;
+
+  const PointCloud& cloud() const;
+  /// Makes the parts a registration with `config` needs, its `auto` settings resolved as if the
+  /// source measured like this target. Bad input is left for Register to name.
+  void Prepare(const RegistrationConfig& config);
+
+ private:
+  friend Result<RegistrationResult> Register(RegistrationTarget&, const PointCloud&,
+                                             const RegistrationPrior&, const RegistrationConfig&);
+  struct Parts;
+  std::unique_ptr<Parts> parts_;
+  std::optional<Eigen::Vector3f> sensor_;
+};
+
+/// Register against a prepared target (`prior.target_sensor` should be the target's sensor: parts
+/// made for another are made again).
+[[nodiscard]] Result<RegistrationResult> Register(RegistrationTarget& target,
                                                   const PointCloud& source,
                                                   const RegistrationPrior& prior,
                                                   const RegistrationConfig& config);

@@ -1,0 +1,79 @@
+#pragma once
+// Private: what registration derives from its target cloud alone, each part made on first demand
+// and kept with the settings it was made with (RegistrationTarget's inside). A call asking with
+// other settings gets the part made afresh, so a kept part never changes a result.
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "fast_pipeline.hpp"
+#include "pitchlab/mapping/cloud_statistics.hpp"
+#include "pitchlab/mapping/point_cloud.hpp"
+#include "pitchlab/mapping/registration_config.hpp"
+#include "voxel_hash.hpp"
+
+namespace pitchlab::mapping::internal {
+
+class TargetMemo {
+ public:
+  /// `cloud` must outlive the memo.
+  explicit TargetMemo(const PointCloud& cloud) : cloud_(cloud) {}
+
+  const PointCloud& cloud() const { return cloud_; }
+
+  /// MeasureCloud of the target from `sensor`.
+  const CloudStatistics& Statistics(const Eigen::Vector3f& sensor);
+
+  /// The target after the voxel grid: at icp_voxel_m (ICP's), and that at feature_voxel_m.
+  struct Voxels {
+    double icp_voxel_m = 0, feature_voxel_m = 0;
+    PointCloud icp, features;
+  };
+  const Voxels& VoxelGrids(const RegistrationConfig& config);
+
+  /// ICP's target (IcpScene): hashes of the ICP cloud with `fine_cell` and `coarse_cell` edges,
+  /// and its normals within `normal_radius` facing `sensor`, searched on the fine hash.
+  struct Icp {
+    double icp_voxel_m = 0;
+    float fine_cell = 0, normal_radius = 0;
+    double coarse_cell = 0;
+    Eigen::Vector3f sensor = Eigen::Vector3f::Zero();
+    std::unique_ptr<VoxelHashIndex> fine, coarse;
+    Normals normals;
+  };
+  const Icp& IcpParts(const RegistrationConfig& config, float fine_cell, double coarse_cell,
+                      const Eigen::Vector3f& sensor);
+
+  /// The feature cloud's FPFH at the config's own scale (FastFeatureAlignment's first try): the
+  /// hash, the normals, the keypoints (indices and points) and their features.
+  struct Features {
+    double icp_voxel_m = 0, feature_voxel_m = 0;
+    float normal_radius = 0, feature_radius = 0;
+    int max_feature_points = 0, max_neighbors = 0;
+    Eigen::Vector3f sensor = Eigen::Vector3f::Zero();
+    std::unique_ptr<VoxelHashIndex> index;
+    Normals normals;
+    std::vector<int> keys;
+    PointCloud key_points;
+    FeatureMatrix fpfh;
+  };
+  const Features& FeatureParts(const RegistrationConfig& config, const Eigen::Vector3f& sensor);
+
+ private:
+  const PointCloud& cloud_;
+  std::optional<Eigen::Vector3f> statistics_sensor_;
+  CloudStatistics statistics_;
+  std::optional<Voxels> voxels_;
+  std::optional<Icp> icp_;
+  std::optional<Features> features_;
+};
+
+/// The normals FPFH is computed from: within `r_normal`, on `feature_index` when its cells are as
+/// wide (r_normal >= r_feature), else on an index of their own radius.
+Normals FeatureNormals(const PointCloud& cloud, const VoxelHashIndex& feature_index, float r_normal,
+                       float r_feature, const Eigen::Vector3f& sensor);
+
+}  // namespace pitchlab::mapping::internal
