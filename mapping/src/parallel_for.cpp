@@ -13,6 +13,8 @@
 #include <thread>
 #include <vector>
 
+#include "pitchlab/sensors/stopwatch.hpp"
+
 namespace pitchlab::mapping::internal {
 namespace {
 
@@ -101,6 +103,7 @@ class HelperThreads {
     }
   }
   void Run() {
+    const sensors::WorkerThread worker;  // its loops' time is the stage's that runs them
     std::unique_lock<std::mutex> lock(mutex_);
     while (true) {
       wake_.wait(lock, [this] { return stopping_ || !queue_.empty(); });

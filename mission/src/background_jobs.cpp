@@ -60,7 +60,6 @@ void LowerThisThreadsPriority() {
 }  // namespace
 
 void BackgroundJobs::Run() {
-  const sensors::BackgroundThread background;
   LowerThisThreadsPriority();
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {

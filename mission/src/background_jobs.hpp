@@ -11,9 +11,9 @@
 
 namespace pitchlab::mission {
 
-/// Runs posted jobs one after another, in order, on a thread of its own, which is a
-/// sensors::BackgroundThread: the stages timed meanwhile leave its CPU time out; each job measures
-/// its own (sensors::ThreadCpuSeconds). Not copyable.
+/// Runs posted jobs one after another, in order, on a thread of its own, whose CPU time the stages
+/// timed meanwhile leave out (sensors::CpuOf::kForeground); each job measures its own
+/// (sensors::ThreadCpuSeconds). Not copyable.
 class BackgroundJobs {
  public:
   BackgroundJobs();

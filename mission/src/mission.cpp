@@ -236,14 +236,13 @@ class Mission {
   const MissionProbes& probes_;
   const MissionObserver& observer_;
   mapping::MapBuilder builder_;
-  // MapBuilder::PrepareNext running beside the drive to the next stop (its own thread, marked
-  // background: its CPU time is the registration's, added by Builder()), and that time.
+  // MapBuilder::PrepareNext running beside the drive to the next stop (its own thread, which the
+  // stages' stopwatches leave out: its CPU time is the registration's, added by Builder()).
   std::future<void> next_target_;
   double next_target_cpu_s_ = 0;
   // Starts PrepareNext beside whatever the mission does until its next scan is registered.
   void PrepareNextTarget() {
     next_target_ = std::async(std::launch::async, [this] {
-      const sensors::BackgroundThread beside;
       builder_.PrepareNext();
       next_target_cpu_s_ = sensors::ThreadCpuSeconds();
     });

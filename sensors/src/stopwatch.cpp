@@ -16,29 +16,45 @@ double Seconds(clockid_t clock) {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
-// The background threads: the CPU clocks of those running, and the CPU time of those that ended
-// (still in the process's CPU time).
-struct Background {
+// Threads whose CPU clocks are read together: the CPU clocks of those running, and the CPU time
+// of those that ended.
+struct ThreadClocks {
   std::mutex mutex;
   std::vector<clockid_t> running;
   double ended_s = 0;
+
+  void Add(clockid_t clock) {
+    std::lock_guard<std::mutex> lock(mutex);
+    running.push_back(clock);
+  }
+  void Remove(clockid_t clock) {
+    std::lock_guard<std::mutex> lock(mutex);
+    ended_s += Seconds(clock);
+    running.erase(std::find(running.begin(), running.end(), clock));
+  }
+  double Total() {
+    std::lock_guard<std::mutex> lock(mutex);
+    double total = ended_s;
+    for (const clockid_t c : running) total += Seconds(c);
+    return total;
+  }
 };
-Background& TheBackground() {
-  static Background background;
-  return background;
+// Never destroyed: worker threads kept for the process's life end during static destruction.
+ThreadClocks& TheWorkers() {
+  static ThreadClocks* const workers = new ThreadClocks;
+  return *workers;
 }
 
-double BackgroundCpuSeconds() {
-  Background& b = TheBackground();
-  std::lock_guard<std::mutex> lock(b.mutex);
-  double total = b.ended_s;
-  for (const clockid_t c : b.running) total += Seconds(c);
-  return total;
+clockid_t CallingThreadsClock() {
+  clockid_t clock{};
+  pthread_getcpuclockid(pthread_self(), &clock);  // cannot fail for the calling thread
+  return clock;
 }
 
 Elapsed Now(CpuOf cpu) {
-  double cpu_s = Seconds(CLOCK_PROCESS_CPUTIME_ID);
-  if (cpu == CpuOf::kForeground) cpu_s -= BackgroundCpuSeconds();
+  const double cpu_s = cpu == CpuOf::kProcess
+                           ? Seconds(CLOCK_PROCESS_CPUTIME_ID)
+                           : Seconds(CLOCK_THREAD_CPUTIME_ID) + TheWorkers().Total();
   return {Seconds(CLOCK_MONOTONIC), cpu_s};
 }
 
@@ -48,21 +64,8 @@ void Stopwatch::Restart() { start_ = Now(cpu_); }
 
 Elapsed Stopwatch::Read() const { return Now(cpu_) - start_; }
 
-BackgroundThread::BackgroundThread() {
-  clockid_t clock{};
-  pthread_getcpuclockid(pthread_self(), &clock);  // cannot fail for the calling thread
-  clock_ = clock;
-  Background& b = TheBackground();
-  std::lock_guard<std::mutex> lock(b.mutex);
-  b.running.push_back(clock);
-}
-
-BackgroundThread::~BackgroundThread() {
-  Background& b = TheBackground();
-  std::lock_guard<std::mutex> lock(b.mutex);
-  b.ended_s += Seconds(clock_);
-  b.running.erase(std::find(b.running.begin(), b.running.end(), clock_));
-}
+WorkerThread::WorkerThread() : clock_(CallingThreadsClock()) { TheWorkers().Add(clock_); }
+WorkerThread::~WorkerThread() { TheWorkers().Remove(clock_); }
 
 double ThreadCpuSeconds() { return Seconds(CLOCK_THREAD_CPUTIME_ID); }
 

@@ -83,7 +83,7 @@ TEST(BackgroundJobs, DestructionDropsJobsNotStarted) {
 }
 
 // The jobs' CPU time is theirs: a foreground stopwatch leaves it out, a whole-process one counts
-// it (CLOCK_PROCESS_CPUTIME_ID less the background threads' clocks).
+// it.
 TEST(BackgroundJobs, TheirCpuTimeIsLeftOutOfForegroundStopwatches) {
   const sensors::Stopwatch foreground(sensors::CpuOf::kForeground);
   const sensors::Stopwatch process(sensors::CpuOf::kProcess);

@@ -6,9 +6,8 @@
 
 namespace pitchlab::sensors {
 
-/// Time spent: wall clock (steady) and CPU time of the whole process, i.e. all its threads, so
-/// that work a library hands to worker threads (Embree's scene builds) is counted too, except
-/// threads marked BackgroundThread: work beside the timed one is not its time [s].
+/// Time spent: wall clock (steady) and CPU time [s]: of the timing thread and the WorkerThreads
+/// it hands work to (a stage's own work), or of the whole process.
 struct Elapsed {
   double wall_s = 0;
   double cpu_s = 0;
@@ -28,14 +27,20 @@ struct Elapsed {
 
 /// Which threads' CPU time a Stopwatch counts.
 enum class CpuOf {
-  kForeground,  ///< all but BackgroundThreads: a stage's own work
-  kProcess,     ///< all: a whole run's
+  /// The thread that reads the Stopwatch (it must be the one that started it) and the
+  /// WorkerThreads: a stage's own work. Not the threads beside it (a run's files written while
+  /// the robot drives on), nor threads a library starts (Embree's scene builds): a run's "other".
+  kForeground,
+  kProcess,  ///< all threads: a whole run's
 };
 
-/// Started at construction (or Restart); Read() is the time since. CLOCK_MONOTONIC and
-/// CLOCK_PROCESS_CPUTIME_ID less the background threads' CPU clocks (nanosecond resolution on
-/// Linux; a read costs about a microsecond, so a timer around each line or each control period
-/// costs nothing measurable).
+/// Started at construction (or Restart); Read() is the time since. CLOCK_MONOTONIC, and the
+/// threads' own CPU clocks (nanosecond resolution on Linux; a read costs about a microsecond, so
+/// a timer around each line or each control period costs nothing measurable) or
+/// CLOCK_PROCESS_CPUTIME_ID. The foreground is summed from per-thread clocks, not the process's
+/// less the background's: Linux brings a thread's time running on another core into the process
+/// clock only at its next tick, so that difference lost up to a tick per read while work ran
+/// beside (driving, timed per 2 ms control period, read 0.4 s of CPU for 1.9 s of stepping).
 class Stopwatch {
  public:
   explicit Stopwatch(CpuOf cpu = CpuOf::kForeground) : cpu_(cpu) { Restart(); }
@@ -47,16 +52,15 @@ class Stopwatch {
   Elapsed start_;  // the clocks' readings at the start
 };
 
-/// Marks the calling thread, for this object's lifetime, as background work: work that runs
-/// beside the stages Stopwatches time (a run's files written while the robot drives on), whose
-/// CPU time is its own to report (ThreadCpuSeconds), not theirs. One per thread, made and ended on
-/// it.
-class BackgroundThread {
+/// Marks the calling thread, for this object's lifetime, as a worker of whichever thread hands it
+/// work (a parallel loop's helper): its CPU time counts to the foreground's stages. One per
+/// thread, made and ended on it.
+class WorkerThread {
  public:
-  BackgroundThread();
-  ~BackgroundThread();
-  BackgroundThread(const BackgroundThread&) = delete;
-  BackgroundThread& operator=(const BackgroundThread&) = delete;
+  WorkerThread();
+  ~WorkerThread();
+  WorkerThread(const WorkerThread&) = delete;
+  WorkerThread& operator=(const WorkerThread&) = delete;
 
  private:
   int clock_;  // the thread's CPU clock (a clockid_t)
