@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <future>
 #include <sstream>
 #include <stdexcept>
 
@@ -16,6 +17,7 @@
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/planning/path_io.hpp"
 #include "pitchlab/sensors/scan_pcd.hpp"
+#include "pitchlab/sensors/stopwatch.hpp"
 
 namespace pitchlab::mission {
 namespace {
@@ -304,15 +306,20 @@ mapping::ElevationLayers WriteFinalData(RunFolder& folder, const RunContext& c,
                                         const mapping::ElevationLayers* truth,
                                         const std::optional<planning::Path>& truth_optimum) {
   WriteTextFile(folder.File("config.yaml"), c.config_yaml);
-  sensors::Scan3D cloud;
-  for (const Eigen::Vector3f& p : r.map_cloud_world) {
-    sensors::ScanPoint q;
-    q.x = p.x(), q.y = p.y(), q.z = p.z();
-    cloud.points.push_back(q);
-  }
-  cloud.world = std::filesystem::path(c.world_file).stem().string();  // in the world's frame
-  Check(sensors::WriteScanPcd(cloud, folder.File("map_cloud.pcd").string()));
-  Check(mapping::SaveElevationMap(r.elevation, folder.File("elevation.plem").string()));
+  // The map's cloud and cells on a thread of their own beside the rest (the run waits for its
+  // final files).
+  std::future<void> map_files = std::async(std::launch::async, [&] {
+    const sensors::WorkerThread worker;  // the run's outputs, done beside it
+    sensors::Scan3D cloud;
+    for (const Eigen::Vector3f& p : r.map_cloud_world) {
+      sensors::ScanPoint q;
+      q.x = p.x(), q.y = p.y(), q.z = p.z();
+      cloud.points.push_back(q);
+    }
+    cloud.world = std::filesystem::path(c.world_file).stem().string();  // in the world's frame
+    Check(sensors::WriteScanPcd(cloud, folder.File("map_cloud.pcd").string()));
+    Check(mapping::SaveElevationMap(r.elevation, folder.File("elevation.plem").string()));
+  });
   const mapping::ElevationLayers layers = mapping::ComputeLayers(r.elevation, c.layers);
   Check(mapping::WriteEsriAsciiGrid(layers, c.geodetic_origin,
                                     folder.File("elevation.asc").string()));
@@ -323,6 +330,7 @@ mapping::ElevationLayers WriteFinalData(RunFolder& folder, const RunContext& c,
     WriteTrajectoryGeoJson(folder.File("trajectories.geojson"), r, *c.geodetic_origin);
   }
   WriteRunPictures(folder, c, r, layers, truth, truth_optimum);
+  map_files.get();
   return layers;
 }
 

@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
 #include <stdexcept>
 
 #include "pitchlab/mission/map_figure.hpp"
 #include "pitchlab/planning/path_io.hpp"
 #include "pitchlab/mission/traversability_image.hpp"
+#include "pitchlab/sensors/stopwatch.hpp"
 
 namespace pitchlab::mission {
 namespace {
@@ -114,6 +116,28 @@ void WriteRunPictures(RunFolder& folder, const RunContext& c, const MissionResul
   FigureMarks height_marks = marks;
   height_marks.colour_bar = HeightBar(layers);
 
+  // The truth's pictures on a thread of their own beside the estimate's: the run waits for its
+  // final files, and a second core halves that wait.
+  std::future<planning::TraversabilityGrid> truth_pictures;
+  if (truth) {
+    truth_pictures = std::async(std::launch::async, [&] {
+      const sensors::WorkerThread worker;  // the run's outputs, done beside it
+      const mapping::GridGeometry& tg = truth->geometry;
+      mapping::ImageOptions truth_options;
+      truth_options.pixels_per_cell = FigurePixelsPerCell(tg, window);
+      planning::TraversabilityGrid true_grid = planning::BuildTraversability(*truth, c.planner);
+      Write(ComposeMapFigure(RenderTraversability(true_grid, truth_options), tg, window, marks),
+            folder.File("truth_traversability.png"));
+      mapping::RgbImage truth_image = mapping::RenderElevationImage(*truth, truth_options);
+      if (truth_optimum) planning::DrawPath(*truth_optimum, tg, truth_image);
+      DrawPolyline(truth_image, tg, tru, 30, 80, 255);
+      FigureMarks truth_marks = marks;
+      truth_marks.colour_bar = HeightBar(*truth);
+      Write(ComposeMapFigure(truth_image, tg, window, truth_marks),
+            folder.File("truth_elevation.png"));
+      return true_grid;
+    });
+  }
   mapping::RgbImage image = mapping::RenderElevationImage(layers, options);
   for (const StopRecord& s : r.stops) {
     if (s.plan) planning::DrawPath(*s.plan, g, image);
@@ -125,18 +149,7 @@ void WriteRunPictures(RunFolder& folder, const RunContext& c, const MissionResul
   Write(ComposeMapFigure(RenderTraversability(estimated, options), g, window, marks),
         folder.File("traversability.png"));
   if (!truth) return;
-  const mapping::GridGeometry& tg = truth->geometry;
-  mapping::ImageOptions truth_options;
-  truth_options.pixels_per_cell = FigurePixelsPerCell(tg, window);
-  const planning::TraversabilityGrid true_grid = planning::BuildTraversability(*truth, c.planner);
-  Write(ComposeMapFigure(RenderTraversability(true_grid, truth_options), tg, window, marks),
-        folder.File("truth_traversability.png"));
-  mapping::RgbImage truth_image = mapping::RenderElevationImage(*truth, truth_options);
-  if (truth_optimum) planning::DrawPath(*truth_optimum, tg, truth_image);
-  DrawPolyline(truth_image, tg, tru, 30, 80, 255);
-  FigureMarks truth_marks = marks;
-  truth_marks.colour_bar = HeightBar(*truth);
-  Write(ComposeMapFigure(truth_image, tg, window, truth_marks), folder.File("truth_elevation.png"));
+  const planning::TraversabilityGrid true_grid = truth_pictures.get();
   // The picture of map_hazards: the same grids ScoreRun compares (same layers, same planner).
   Write(ComposeMapFigure(RenderHazardErrors(estimated, true_grid, options), g, window, marks),
         folder.File("hazard_errors.png"));

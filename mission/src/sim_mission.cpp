@@ -102,14 +102,19 @@ sensors::RayCasterOptions TruthCasterOptions() {
 }
 
 // The world as placed, for the ground truth's ray caster on another thread: a copy of the
-// simulation's state (the simulation steps on meanwhile) and a caster of its own.
+// simulation's state (the simulation steps on meanwhile), taken before the mission starts, and a
+// caster of its own, built (BuildCaster) on that thread. The caster reads the model's geoms,
+// which the mission never writes (it changes the timestep and the joints' state only).
 struct TruthScene {
   explicit TruthScene(sim::SimRig& rig)
-      : data(mj_makeData(rig.sim().model()), &mj_deleteData) {
+      : model(rig.sim().model()), data(mj_makeData(model), &mj_deleteData) {
     if (!data) throw std::runtime_error("ground truth: mj_makeData failed");
-    mj_copyData(data.get(), rig.sim().model(), rig.sim().data());
-    caster = sensors::MakeEmbreeRayCaster(rig.sim().model(), data.get(), TruthCasterOptions());
+    mj_copyData(data.get(), model, rig.sim().data());
   }
+  void BuildCaster() {
+    caster = sensors::MakeEmbreeRayCaster(model, data.get(), TruthCasterOptions());
+  }
+  const mjModel* model;
   std::unique_ptr<mjData, void (*)(mjData*)> data;
   std::unique_ptr<sensors::RayCaster> caster;
 };
@@ -287,6 +292,7 @@ SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesyste
     if (cached_truth) {
       truth = TruthOf(*cached_truth, mission, start.head<2>());
     } else {
+      truth_scene->BuildCaster();
       const mapping::ElevationMap map =
           mapping::ComputeTrueElevationMap(*truth_scene->caster, mission.map_area);
       truth = TruthOf(map, mission, start.head<2>());
