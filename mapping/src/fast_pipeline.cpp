@@ -119,16 +119,24 @@ bool PriorRegion::Contains(const Eigen::Isometry3d& T) const {
          Eigen::AngleAxisd(d.linear()).angle() <= rotation_rad;
 }
 
-Eigen::Matrix3d Scatter(const PointCloud& cloud, const std::vector<int>& indices) {
+namespace {
+// Scatter of the points point(0 .. n - 1), summed in that order.
+template <typename Point>
+Eigen::Matrix3d ScatterOf(std::size_t n, Point point) {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (int j : indices) mean += cloud[j].cast<double>();
-  mean /= static_cast<double>(std::max<std::size_t>(1, indices.size()));
+  for (std::size_t k = 0; k < n; ++k) mean += point(k).template cast<double>();
+  mean /= static_cast<double>(std::max<std::size_t>(1, n));
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  for (int j : indices) {
-    const Eigen::Vector3d d = cloud[j].cast<double>() - mean;
+  for (std::size_t k = 0; k < n; ++k) {
+    const Eigen::Vector3d d = point(k).template cast<double>() - mean;
     scatter += d * d.transpose();
   }
   return scatter;
+}
+}  // namespace
+
+Eigen::Matrix3d Scatter(const PointCloud& cloud, const std::vector<int>& indices) {
+  return ScatterOf(indices.size(), [&](std::size_t k) { return cloud[indices[k]]; });
 }
 
 // Both loops below run on the machine's cores (ParallelFor): every point's normal, SPFH and FPFH
@@ -140,13 +148,13 @@ Normals EstimateNormals(const PointCloud& cloud, const VoxelHashIndex& index, fl
                         const Eigen::Vector3f& viewpoint) {
   Normals normals(cloud.size(), Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()));
   internal::ParallelFor(cloud.size(), kPointsPerBlock, [&](std::size_t begin, std::size_t end) {
-    std::vector<int> nn;
+    std::vector<Eigen::Vector3f> nn;  // the neighbours themselves: Scatter's order, read in line
     for (std::size_t i = begin; i < end; ++i) {
       nn.clear();
-      index.Radius(cloud[i], radius_m, nn);
+      index.RadiusPoints(cloud[i], radius_m, nn);
       if (nn.size() < 5) continue;
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-      eig.computeDirect(Scatter(cloud, nn));
+      eig.computeDirect(ScatterOf(nn.size(), [&](std::size_t k) { return nn[k]; }));
       Eigen::Vector3f n = eig.eigenvectors().col(0).cast<float>();
       if (n.dot(viewpoint - cloud[i]) < 0) n = -n;
       normals[i] = n;

@@ -79,6 +79,16 @@ void VoxelHashIndex::Radius(const Eigen::Vector3f& q, float radius_m, std::vecto
   });
 }
 
+void VoxelHashIndex::RadiusPoints(const Eigen::Vector3f& q, float radius_m,
+                                  std::vector<Eigen::Vector3f>& out) const {
+  const float r2 = radius_m * radius_m;
+  ForCells(q, radius_m, [&](int begin, int end) {
+    for (int k = begin; k < end; ++k) {
+      if ((points_[k] - q).squaredNorm() <= r2) out.push_back(points_[k]);
+    }
+  });
+}
+
 int VoxelHashIndex::Nearest(const Eigen::Vector3f& q, float max_m, float& d2) const {
   int best = -1;
   d2 = max_m * max_m;

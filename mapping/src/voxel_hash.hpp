@@ -36,6 +36,10 @@ class VoxelHashIndex {
   /// Indices of points within `radius_m` (<= the cell edge) of `q`, appended to `out` in the order
   /// of their cells (x, then y, then z ascending) and, within a cell, of their indices.
   void Radius(const Eigen::Vector3f& q, float radius_m, std::vector<int>& out) const;
+  /// The points Radius finds, themselves (copies, in the same order): read from the index's own
+  /// cell-ordered copy, not the cloud, whose order scatters them through memory.
+  void RadiusPoints(const Eigen::Vector3f& q, float radius_m,
+                    std::vector<Eigen::Vector3f>& out) const;
   /// Nearest point within `max_m` (<= the cell edge), or -1; its squared distance in `d2`.
   int Nearest(const Eigen::Vector3f& q, float max_m, float& d2) const;
 

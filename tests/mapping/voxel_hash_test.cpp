@@ -81,6 +81,10 @@ TEST(VoxelHashIndex, FindsWhatASearchOfEveryPointFinds) {
         std::vector<int> got;
         index.Radius(q, r, got);
         ASSERT_EQ(got, BruteRadius(cloud, order, q, r)) << "query " << q.transpose() << " r " << r;
+        std::vector<Eigen::Vector3f> points;  // RadiusPoints: the same points, the same order
+        index.RadiusPoints(q, r, points);
+        ASSERT_EQ(points.size(), got.size());
+        for (std::size_t n = 0; n < got.size(); ++n) ASSERT_EQ(points[n], cloud[got[n]]);
         float d2 = -1;
         const int nearest = index.Nearest(q, r, d2);
         const auto [want, want_d2] = BruteNearest(cloud, order, q, r);
