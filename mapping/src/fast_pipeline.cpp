@@ -230,19 +230,37 @@ std::vector<Correspondence> MatchFeatures(const FeatureMatrix& source,
   std::vector<float> best_s_d(nt, std::numeric_limits<float>::max());
   const Eigen::VectorXf tn = target.rowwise().squaredNorm();
   const Eigen::VectorXf sn = source.rowwise().squaredNorm();
+  // |s - t|^2 = |s|^2 + |t|^2 - 2 s.t, in blocks of source rows on the machine's cores. Each block
+  // keeps the best source row of every target column it saw (the first of equals); merged in
+  // block order below, the first of equals overall, as one loop over the rows finds.
   constexpr int kBlock = 256;
-  for (int b = 0; b < ns; b += kBlock) {  // |s - t|^2 = |s|^2 + |t|^2 - 2 s.t, in blocks
-    const int rows = std::min(kBlock, ns - b);
-    Eigen::MatrixXf d = -2.0f * source.middleRows(b, rows) * target.transpose();
-    for (int r = 0; r < rows; ++r) {
-      const int i = b + r;
-      if (sn(i) <= 0) continue;
-      for (int j = 0; j < nt; ++j) {
-        if (tn(j) <= 0) continue;
-        const float dist = d(r, j) + sn(i) + tn(j);
-        if (dist < best_t_d[i]) best_t_d[i] = dist, best_t[i] = j;
-        if (dist < best_s_d[j]) best_s_d[j] = dist, best_s[j] = i;
+  const int blocks = (ns + kBlock - 1) / kBlock;
+  std::vector<std::vector<int>> block_s(blocks);
+  std::vector<std::vector<float>> block_s_d(blocks);
+  internal::ParallelFor(blocks, 1, [&](std::size_t first, std::size_t last) {
+    for (std::size_t k = first; k < last; ++k) {
+      const int b = static_cast<int>(k) * kBlock;
+      const int rows = std::min(kBlock, ns - b);
+      std::vector<int>& bs = block_s[k];
+      std::vector<float>& bs_d = block_s_d[k];
+      bs.assign(nt, -1);
+      bs_d.assign(nt, std::numeric_limits<float>::max());
+      Eigen::MatrixXf d = -2.0f * source.middleRows(b, rows) * target.transpose();
+      for (int r = 0; r < rows; ++r) {
+        const int i = b + r;
+        if (sn(i) <= 0) continue;
+        for (int j = 0; j < nt; ++j) {
+          if (tn(j) <= 0) continue;
+          const float dist = d(r, j) + sn(i) + tn(j);
+          if (dist < best_t_d[i]) best_t_d[i] = dist, best_t[i] = j;
+          if (dist < bs_d[j]) bs_d[j] = dist, bs[j] = i;
+        }
       }
+    }
+  });
+  for (int k = 0; k < blocks; ++k) {
+    for (int j = 0; j < nt; ++j) {
+      if (block_s_d[k][j] < best_s_d[j]) best_s_d[j] = block_s_d[k][j], best_s[j] = block_s[k][j];
     }
   }
   std::vector<Correspondence> corrs;
