@@ -137,10 +137,13 @@ std::string RenderRunReport(const RunReportInput& in, const Result<ThreeJs>& thr
   if (const auto rows = StageRows(m); !rows.empty()) {
     page.Heading("Where the run's time went", "stages");
     page.Paragraph(
-        "Wall-clock and CPU time (all the process's threads) per stage, up to writing "
-        "metrics.json and this page; shares of the whole run. The ground truth and each stop's "
-        "files are made on a thread beside the mission: their CPU time is that thread's, their "
-        "wall time only what the run waited for them.");
+        "Wall-clock and CPU time per stage, up to writing metrics.json and this page; shares "
+        "of the whole run. A stage's CPU time is the mission thread's and its parallel loops' "
+        "helpers'. The ground truth, each stop's files and the next stop's registration target "
+        "are made on threads beside the mission: their CPU time is theirs (the target's is "
+        "registration's), their wall time only what the run waited for them. The whole run's CPU "
+        "time counts every thread; \"other\" is what no stage holds (set-up, the ray caster's "
+        "scene).");
     page.Table(StageHeader(), rows);
   }
 
