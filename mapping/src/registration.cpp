@@ -477,8 +477,8 @@ SacResult FastFeatureAlignment(const Prepared& prep, internal::TargetMemo& memo,
     if (scale != 1.0) {
       internal::TargetMemo::Features& f = half_target.emplace();
       f.index = std::make_unique<VoxelHashIndex>(target, std::max(r_normal, r_feature));
-      f.normals = internal::FeatureNormals(target, *f.index, r_normal, r_feature,
-                                           prep.target_sensor);
+      f.normals =
+          internal::FeatureNormals(target, *f.index, r_normal, r_feature, prep.target_sensor);
     }
     const VoxelHashIndex s_index(source, std::max(r_normal, r_feature));
     const Normals sn =
@@ -989,8 +989,7 @@ RegistrationConfig ResolveSettings(internal::TargetMemo& target, const PointClou
                                    const RegistrationConfig& requested, RegistrationResult& out) {
   out.source_statistics =
       MeasureCloud(source, prior.source_sensor.value_or(Eigen::Vector3f::Zero()));
-  out.target_statistics =
-      target.Statistics(prior.target_sensor.value_or(Eigen::Vector3f::Zero()));
+  out.target_statistics = target.Statistics(prior.target_sensor.value_or(Eigen::Vector3f::Zero()));
   out.settings = requested.Resolve(out.source_statistics, out.target_statistics);
   return out.settings;
 }
@@ -1395,9 +1394,7 @@ Result<RegistrationResult> RegisterWith(internal::TargetMemo& memo, const PointC
   // 2. Normals of the ICP target, its search structures and the free space its scan saw.
   const IcpScene scene(prep, memo, prior, config);
   run.out.timings.normals_s = run.lap.Lap();
-  const Stages s{memo,  target, source,
-                 prior, config, prep,
-                 scene, ConfinedVoxels(prep, config)};
+  const Stages s{memo, target, source, prior, config, prep, scene, ConfinedVoxels(prep, config)};
   // 3-4. Features, sample-consensus initial alignment, ICP from it (Levenberg-Marquardt).
   const FeatureStage features = AlignByFeatures(s, run);
   Verdict verdict = features.verdict;

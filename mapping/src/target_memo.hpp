@@ -17,6 +17,9 @@
 
 namespace pitchlab::mapping::internal {
 
+// A part's reference stays valid until a call asks for that part with other settings (for the
+// voxel grids: other voxel sizes, which drop every part made from them): one registration asks
+// with one resolved config throughout.
 class TargetMemo {
  public:
   /// `cloud` must outlive the memo.

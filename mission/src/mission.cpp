@@ -4,8 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
-#include <limits>
 #include <future>
+#include <limits>
 #include <map>
 #include <stdexcept>
 

@@ -6,8 +6,8 @@
 #include <stdexcept>
 
 #include "pitchlab/mission/map_figure.hpp"
-#include "pitchlab/planning/path_io.hpp"
 #include "pitchlab/mission/traversability_image.hpp"
+#include "pitchlab/planning/path_io.hpp"
 #include "pitchlab/sensors/stopwatch.hpp"
 
 namespace pitchlab::mission {

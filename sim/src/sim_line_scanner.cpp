@@ -26,8 +26,8 @@ const std::vector<Eigen::Vector3d>& SimLineScanner::BeamDirections(double offset
   set.laser.reserve(n);
   for (int i = 0; i < n; ++i) {
     const double theta = model_.angle_min_rad() + i * model_.angle_increment_rad() + offset_rad;
-    set.laser.emplace_back(std::cos(tip_rad) * std::cos(theta),
-                           std::cos(tip_rad) * std::sin(theta), std::sin(tip_rad));
+    set.laser.emplace_back(std::cos(tip_rad) * std::cos(theta), std::cos(tip_rad) * std::sin(theta),
+                           std::sin(tip_rad));
   }
   beam_sets_.push_back(std::move(set));
   return beam_sets_.back().laser;

@@ -17,8 +17,8 @@ namespace pitchlab::mission {
 /// at most the run's own time; what no stage covers (loading the world, building the ray caster's
 /// scene, placing the robot, the loop's own bookkeeping) is the breakdown's "other". The ground
 /// truth and each stop's files are made on a thread beside the mission: their CPU time is that
-/// thread's (the other stages' CPU time is the mission thread's and its loops' helpers'), their wall time what
-/// the run waited for them.
+/// thread's (the other stages' CPU time is the mission thread's and its loops' helpers'), their
+/// wall time what the run waited for them.
 enum class Stage : std::size_t {
   kPhysicsDriving,   ///< the base's drive commands: physics stepped while moving (and braking)
   kPhysicsStanding,  ///< a scan minus its lines: the pitch servo's physics while standing still
