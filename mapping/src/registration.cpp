@@ -470,35 +470,19 @@ SacResult FastFeatureAlignment(const Prepared& prep, internal::TargetMemo& memo,
     const PointCloud source =
         scale == 1.0 ? prep.source_features : VoxelDownsample(prep.source_icp, c.feature_voxel_m);
     timings.voxel_s += lap.Lap();
-    const float r_normal = static_cast<float>(c.normal_radius_m);
-    const float r_feature = static_cast<float>(c.feature_radius_m);
-    // The target's keypoints and features: kept at the config's own scale, made here at half.
-    std::optional<internal::TargetMemo::Features> half_target;
-    if (scale != 1.0) {
-      internal::TargetMemo::Features& f = half_target.emplace();
-      f.index = std::make_unique<VoxelHashIndex>(target, std::max(r_normal, r_feature));
-      f.normals =
-          internal::FeatureNormals(target, *f.index, r_normal, r_feature, prep.target_sensor);
-    }
-    const VoxelHashIndex s_index(source, std::max(r_normal, r_feature));
-    const Normals sn =
-        internal::FeatureNormals(source, s_index, r_normal, r_feature, prep.source_sensor);
+    // The target's side: kept at the config's own scale, made here at half.
+    std::optional<internal::FeatureSide> half_target;
+    if (scale != 1.0) half_target = internal::FeatureGeometry(target, c, prep.target_sensor);
+    internal::FeatureSide s_side = internal::FeatureGeometry(source, c, prep.source_sensor);
     timings.normals_s += lap.Lap();
-    if (half_target) {
-      internal::TargetMemo::Features& f = *half_target;
-      f.keys = EvenIndices(target.size(), c.max_feature_points);
-      for (int i : f.keys) f.key_points.push_back(target[i]);
-      f.fpfh = ComputeFpfh(target, f.normals, *f.index, r_feature, c.max_neighbors, f.keys);
-    }
-    const internal::TargetMemo::Features& tf =
+    if (half_target) internal::AddFeatures(*half_target, target, c);
+    internal::AddFeatures(s_side, source, c);
+    const internal::FeatureSide& t_side =
         half_target ? *half_target : memo.FeatureParts(c, prep.target_sensor);
-    const std::vector<int> sk = EvenIndices(source.size(), c.max_feature_points);
-    const FeatureMatrix sf = ComputeFpfh(source, sn, s_index, r_feature, c.max_neighbors, sk);
     timings.features_s += lap.Lap();
-    const std::vector<Correspondence> corrs = MatchFeatures(sf, tf.fpfh);
-    const PointCloud& t_key = tf.key_points;
-    PointCloud s_key;
-    for (int i : sk) s_key.push_back(source[i]);
+    const std::vector<Correspondence> corrs = MatchFeatures(s_side.fpfh, t_side.fpfh);
+    const PointCloud& t_key = t_side.key_points;
+    const PointCloud& s_key = s_side.key_points;
     sac = SampleConsensus(s_key, t_key, corrs, c, region);
     timings.initial_alignment_s += lap.Lap();
     if (scale == 1.0 || sac.found) matches = {s_key, t_key, corrs, c};
@@ -840,13 +824,12 @@ IcpResult HalfScaleIcp(const PointCloud& target, const PointCloud& source,
     if (box.contains(p)) near.push_back(p);
   }
   const PointCloud target_icp = VoxelDownsample(near, half.icp_voxel_m);
-  const float fine_cell = static_cast<float>(
-      std::max({half.icp_min_distance_m, half.inlier_distance_m, half.icp_normal_radius_m}));
-  const VoxelHashIndex fine(target_icp, fine_cell);
-  const VoxelHashIndex coarse(target_icp, std::max<double>(fine_cell, half.icp_max_distance_m));
+  const internal::IcpCells cells = internal::IcpCellsOf(half);
+  const VoxelHashIndex fine(target_icp, cells.fine);
+  const VoxelHashIndex coarse(target_icp, cells.coarse);
   const Normals normals =
       EstimateNormals(target_icp, fine, static_cast<float>(half.icp_normal_radius_m), target_sensor);
-  const IcpTarget icp_target{target_icp, normals, coarse, fine, fine_cell};
+  const IcpTarget icp_target{target_icp, normals, coarse, fine, cells.fine};
   return PointToPlaneLm(icp_target, source_icp, at, half, frozen);
 }
 
@@ -1040,17 +1023,13 @@ SeenMargins FreeSpaceMargins(const RegistrationConfig& config) {
 struct IcpScene {
   IcpScene(const Prepared& prep, internal::TargetMemo& memo, const RegistrationPrior& prior,
            const RegistrationConfig& config)
-      : fine_cell(static_cast<float>(std::max(
-            {config.icp_min_distance_m, config.inlier_distance_m, config.icp_normal_radius_m}))),
-        parts(memo.IcpParts(config, fine_cell,
-                            std::max<double>(fine_cell, config.icp_max_distance_m),
-                            prep.target_sensor)),
+      : parts(memo.IcpParts(config, prep.target_sensor)),
         seen(prior.target_scan ? *prior.target_scan : memo.cloud(), prep.target_sensor, 1.0,
              FreeSpaceMargins(config)),
-        target{prep.target_icp, parts.normals, *parts.coarse, *parts.fine, fine_cell, &seen},
+        target{prep.target_icp, parts.normals, *parts.coarse, *parts.fine, parts.cells.fine,
+               &seen},
         source(EvenSubsample(prep.source_icp, config.icp_max_points)) {}
 
-  const float fine_cell;
   const internal::TargetMemo::Icp& parts;  // hashes and normals, kept in the memo
   const LazySeenSpace seen;
   const IcpTarget target;
@@ -1453,9 +1432,7 @@ void RegistrationTarget::Prepare(const RegistrationConfig& requested) {
   const RegistrationConfig config = requested.Resolve(stats, stats);
   const internal::TargetMemo::Voxels& grids = memo.VoxelGrids(config);
   if (grids.icp.size() < kMinPoints) return;
-  const float fine_cell = static_cast<float>(
-      std::max({config.icp_min_distance_m, config.inlier_distance_m, config.icp_normal_radius_m}));
-  memo.IcpParts(config, fine_cell, std::max<double>(fine_cell, config.icp_max_distance_m), sensor);
+  memo.IcpParts(config, sensor);
   if (config.backend == RegistrationBackend::kFast && config.features == FeatureKind::kFpfh) {
     memo.FeatureParts(config, sensor);
   }

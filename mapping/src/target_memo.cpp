@@ -3,13 +3,43 @@
 #include <algorithm>
 
 namespace pitchlab::mapping::internal {
+namespace {
 
-// Their radius is half the features' by default: on an index of cells as wide as the features' a
-// query scanned about twice the points it needed.
+// The normals FPFH is computed from: within `r_normal`, on `feature_index` when its cells are as
+// wide (r_normal >= r_feature), else on an index of their own radius. Their radius is half the
+// features' by default: on an index of cells as wide as the features' a query scanned about twice
+// the points it needed.
 Normals FeatureNormals(const PointCloud& cloud, const VoxelHashIndex& feature_index, float r_normal,
                        float r_feature, const Eigen::Vector3f& sensor) {
   if (r_normal >= r_feature) return EstimateNormals(cloud, feature_index, r_normal, sensor);
   return EstimateNormals(cloud, VoxelHashIndex(cloud, r_normal), r_normal, sensor);
+}
+
+}  // namespace
+
+IcpCells IcpCellsOf(const RegistrationConfig& config) {
+  const float fine = static_cast<float>(
+      std::max({config.icp_min_distance_m, config.inlier_distance_m, config.icp_normal_radius_m}));
+  return {fine, std::max<double>(fine, config.icp_max_distance_m)};
+}
+
+FeatureSide FeatureGeometry(const PointCloud& cloud, const RegistrationConfig& config,
+                            const Eigen::Vector3f& sensor) {
+  const float r_normal = static_cast<float>(config.normal_radius_m);
+  const float r_feature = static_cast<float>(config.feature_radius_m);
+  FeatureSide side;
+  side.index = std::make_unique<VoxelHashIndex>(cloud, std::max(r_normal, r_feature));
+  side.normals = FeatureNormals(cloud, *side.index, r_normal, r_feature, sensor);
+  return side;
+}
+
+void AddFeatures(FeatureSide& side, const PointCloud& cloud, const RegistrationConfig& config) {
+  side.keys = EvenIndices(cloud.size(), config.max_feature_points);
+  side.key_points.clear();
+  for (int i : side.keys) side.key_points.push_back(cloud[i]);
+  side.fpfh = ComputeFpfh(cloud, side.normals, *side.index,
+                          static_cast<float>(config.feature_radius_m), config.max_neighbors,
+                          side.keys);
 }
 
 const CloudStatistics& TargetMemo::Statistics(const Eigen::Vector3f& sensor) {
@@ -35,28 +65,28 @@ const TargetMemo::Voxels& TargetMemo::VoxelGrids(const RegistrationConfig& confi
   return *voxels_;
 }
 
-const TargetMemo::Icp& TargetMemo::IcpParts(const RegistrationConfig& config, float fine_cell,
-                                            double coarse_cell, const Eigen::Vector3f& sensor) {
+const TargetMemo::Icp& TargetMemo::IcpParts(const RegistrationConfig& config,
+                                            const Eigen::Vector3f& sensor) {
   const Voxels& v = VoxelGrids(config);
+  const IcpCells cells = IcpCellsOf(config);
   const float normal_radius = static_cast<float>(config.icp_normal_radius_m);
-  if (!icp_ || icp_->icp_voxel_m != v.icp_voxel_m || icp_->fine_cell != fine_cell ||
-      icp_->coarse_cell != coarse_cell || icp_->normal_radius != normal_radius ||
+  if (!icp_ || icp_->icp_voxel_m != v.icp_voxel_m || icp_->cells.fine != cells.fine ||
+      icp_->cells.coarse != cells.coarse || icp_->normal_radius != normal_radius ||
       icp_->sensor != sensor) {
     Icp p;
     p.icp_voxel_m = v.icp_voxel_m;
-    p.fine_cell = fine_cell;
-    p.coarse_cell = coarse_cell;
+    p.cells = cells;
     p.normal_radius = normal_radius;
     p.sensor = sensor;
-    p.fine = std::make_unique<VoxelHashIndex>(v.icp, fine_cell);
-    p.coarse = std::make_unique<VoxelHashIndex>(v.icp, coarse_cell);
+    p.fine = std::make_unique<VoxelHashIndex>(v.icp, cells.fine);
+    p.coarse = std::make_unique<VoxelHashIndex>(v.icp, cells.coarse);
     p.normals = EstimateNormals(v.icp, *p.fine, normal_radius, sensor);
     icp_ = std::move(p);
   }
   return *icp_;
 }
 
-const TargetMemo::Features& TargetMemo::FeatureParts(const RegistrationConfig& config,
+const FeatureSide& TargetMemo::FeatureParts(const RegistrationConfig& config,
                                                      const Eigen::Vector3f& sensor) {
   const Voxels& v = VoxelGrids(config);
   const float r_normal = static_cast<float>(config.normal_radius_m);
@@ -74,14 +104,11 @@ const TargetMemo::Features& TargetMemo::FeatureParts(const RegistrationConfig& c
     f.max_feature_points = config.max_feature_points;
     f.max_neighbors = config.max_neighbors;
     f.sensor = sensor;
-    f.index = std::make_unique<VoxelHashIndex>(v.features, std::max(r_normal, r_feature));
-    f.normals = FeatureNormals(v.features, *f.index, r_normal, r_feature, sensor);
-    f.keys = EvenIndices(v.features.size(), config.max_feature_points);
-    for (int i : f.keys) f.key_points.push_back(v.features[i]);
-    f.fpfh = ComputeFpfh(v.features, f.normals, *f.index, r_feature, config.max_neighbors, f.keys);
+    f.side = FeatureGeometry(v.features, config, sensor);
+    AddFeatures(f.side, v.features, config);
     features_ = std::move(f);
   }
-  return *features_;
+  return features_->side;
 }
 
 }  // namespace pitchlab::mapping::internal

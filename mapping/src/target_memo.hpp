@@ -17,6 +17,29 @@
 
 namespace pitchlab::mapping::internal {
 
+/// The cells of ICP's target hashes: the fine one for the gates up to the normals' radius and the
+/// inlier band, the coarse one for the widest gate [m].
+struct IcpCells {
+  float fine;
+  double coarse;
+};
+IcpCells IcpCellsOf(const RegistrationConfig& config);
+
+/// One cloud's side of the feature matching (FastFeatureAlignment): the hash, the normals facing
+/// its sensor, then the keypoints (indices and points) and their FPFH rows.
+struct FeatureSide {
+  std::unique_ptr<VoxelHashIndex> index;
+  Normals normals;
+  std::vector<int> keys;
+  PointCloud key_points;
+  FeatureMatrix fpfh;
+};
+/// The hash and the normals of `cloud` at `config`'s feature radii.
+FeatureSide FeatureGeometry(const PointCloud& cloud, const RegistrationConfig& config,
+                            const Eigen::Vector3f& sensor);
+/// The keypoints and their features, on what FeatureGeometry made of `cloud`.
+void AddFeatures(FeatureSide& side, const PointCloud& cloud, const RegistrationConfig& config);
+
 // A part's reference stays valid until a call asks for that part with other settings (for the
 // voxel grids: other voxel sizes, which drop every part made from them): one registration asks
 // with one resolved config throughout.
@@ -37,33 +60,28 @@ class TargetMemo {
   };
   const Voxels& VoxelGrids(const RegistrationConfig& config);
 
-  /// ICP's target (IcpScene): hashes of the ICP cloud with `fine_cell` and `coarse_cell` edges,
-  /// and its normals within `normal_radius` facing `sensor`, searched on the fine hash.
+  /// ICP's target (IcpScene): hashes of the ICP cloud with IcpCellsOf's edges, and its normals
+  /// within `normal_radius` facing `sensor`, searched on the fine hash.
   struct Icp {
     double icp_voxel_m = 0;
-    float fine_cell = 0, normal_radius = 0;
-    double coarse_cell = 0;
+    IcpCells cells{0, 0};
+    float normal_radius = 0;
     Eigen::Vector3f sensor = Eigen::Vector3f::Zero();
     std::unique_ptr<VoxelHashIndex> fine, coarse;
     Normals normals;
   };
-  const Icp& IcpParts(const RegistrationConfig& config, float fine_cell, double coarse_cell,
-                      const Eigen::Vector3f& sensor);
+  const Icp& IcpParts(const RegistrationConfig& config, const Eigen::Vector3f& sensor);
 
-  /// The feature cloud's FPFH at the config's own scale (FastFeatureAlignment's first try): the
-  /// hash, the normals, the keypoints (indices and points) and their features.
+  /// The feature cloud's side of the matching at the config's own scale (FastFeatureAlignment's
+  /// first try), with the settings it was made with.
   struct Features {
     double icp_voxel_m = 0, feature_voxel_m = 0;
     float normal_radius = 0, feature_radius = 0;
     int max_feature_points = 0, max_neighbors = 0;
     Eigen::Vector3f sensor = Eigen::Vector3f::Zero();
-    std::unique_ptr<VoxelHashIndex> index;
-    Normals normals;
-    std::vector<int> keys;
-    PointCloud key_points;
-    FeatureMatrix fpfh;
+    FeatureSide side;
   };
-  const Features& FeatureParts(const RegistrationConfig& config, const Eigen::Vector3f& sensor);
+  const FeatureSide& FeatureParts(const RegistrationConfig& config, const Eigen::Vector3f& sensor);
 
  private:
   const PointCloud& cloud_;
@@ -73,10 +91,5 @@ class TargetMemo {
   std::optional<Icp> icp_;
   std::optional<Features> features_;
 };
-
-/// The normals FPFH is computed from: within `r_normal`, on `feature_index` when its cells are as
-/// wide (r_normal >= r_feature), else on an index of their own radius.
-Normals FeatureNormals(const PointCloud& cloud, const VoxelHashIndex& feature_index, float r_normal,
-                       float r_feature, const Eigen::Vector3f& sensor);
 
 }  // namespace pitchlab::mapping::internal

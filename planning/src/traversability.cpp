@@ -233,19 +233,34 @@ void ComputeMoves(TraversabilityGrid& T) {
   }
 }
 
-// Eq. 4-5 for move b out of cell (i, j), whether allowed or not, rounded to float: the one
-// definition behind MoveCostOf and TraversabilityGrid::move_cost; +inf off the grid [1].
+// Move b's planar length between cell centres, squared [m^2], and as Eq. 4's P when the height
+// does not change, sqrt(d^2 + 0^2) [m].
+struct Step {
+  double squared_m2, level_m;
+};
+Step StepOf(int b, double cell_m) {
+  const double d_m = (b < 4 ? 1.0 : M_SQRT2) * cell_m, dz = 0.0;
+  return {d_m * d_m, std::sqrt(d_m * d_m + dz * dz)};
+}
+
+// Eq. 5 with Eq. 4's P, the 3D length between the cell centres (dz = 0 when a height is unknown),
+// rounded to float: the one definition behind MoveCostOf and TraversabilityGrid::move_cost. A
+// level move takes the length computed once (the same double), sparing the square root.
+float MoveCost(float enter_to, float z_from, float z_to, const Step& step, double w_length) {
+  const double dz =
+      (std::isfinite(z_from) && std::isfinite(z_to)) ? double(z_to) - z_from : 0.0;
+  const double length_m = dz == 0.0 ? step.level_m : std::sqrt(step.squared_m2 + dz * dz);
+  return static_cast<float>(enter_to + w_length * length_m);
+}
+
+// Eq. 4-5 for move b out of cell (i, j), whether allowed or not; +inf off the grid [1].
 float MoveCostAt(const TraversabilityGrid& T, int i, int j, int b) {
   const GridGeometry& g = T.geometry;
   const CellIndex nb{i + kMoveDi[b], j + kMoveDj[b]};
   if (!g.Contains(nb)) return std::numeric_limits<float>::infinity();
   const std::size_t k = g.Linear({i, j}), kn = g.Linear(nb);
-  const float za = T.z_m[k], zb = T.z_m[kn];
-  const double dz = (std::isfinite(za) && std::isfinite(zb)) ? double(zb) - za : 0.0;
-  const double d_m = (b < 4 ? 1.0 : M_SQRT2) * g.cell_m;
-  // Eq. 5 with Eq. 4's P, the 3D length between the cell centres (dz = 0 when a height is unknown).
-  return static_cast<float>(T.enter_cost[kn] +
-                            T.config.weights.length * std::sqrt(d_m * d_m + dz * dz));
+  return MoveCost(T.enter_cost[kn], T.z_m[k], T.z_m[kn], StepOf(b, g.cell_m),
+                  T.config.weights.length);
 }
 
 // The Eq. 4-5 cost of every allowed move of every cell, +inf for the others
@@ -254,27 +269,19 @@ float MoveCostAt(const TraversabilityGrid& T, int i, int j, int b) {
 // search may expand (free ones, and unknown ones as a start).
 void ComputeMoveCosts(TraversabilityGrid& T) {
   const GridGeometry& g = T.geometry;
-  // The unknown or level moves' length, sqrt(d^2 + 0^2): the same double the general case gives.
-  double flat_m[8];
-  for (int b = 0; b < 8; ++b) {
-    const double d_m = (b < 4 ? 1.0 : M_SQRT2) * g.cell_m, dz = 0.0;
-    flat_m[b] = std::sqrt(d_m * d_m + dz * dz);
-  }
   constexpr float kNone = std::numeric_limits<float>::infinity();
   T.move_cost.resize(g.cell_count());
   // In locals, not in T's fields: the compiler cannot keep those in registers across the stores
   // into T (a chain of loads and stores through memory took a third of FinishTraversability).
   double min_straight = std::numeric_limits<double>::infinity(), min_diagonal = min_straight;
   double max_edge = 0;
-  // An allowed move's neighbour is on the grid (ComputeMoves), a fixed offset away; what follows
-  // is MoveCostAt's arithmetic, step for step.
+  // An allowed move's neighbour is on the grid (ComputeMoves), a fixed offset away.
   const std::ptrdiff_t row = g.Linear({0, 1}) - g.Linear({0, 0});
   std::ptrdiff_t offset[8];
-  double d2[8];
+  Step step[8];
   for (int b = 0; b < 8; ++b) {
     offset[b] = kMoveDi[b] + kMoveDj[b] * row;
-    const double d_m = (b < 4 ? 1.0 : M_SQRT2) * g.cell_m;
-    d2[b] = d_m * d_m;
+    step[b] = StepOf(b, g.cell_m);
   }
   const double w_length = T.config.weights.length;
   const float* z = T.z_m.data();
@@ -285,17 +292,13 @@ void ComputeMoveCosts(TraversabilityGrid& T) {
       const std::uint8_t m = T.moves[k];
       MoveCosts& out = T.move_cost[k];
       const bool source = T.Free(k) || T.blocked[k] == Blocked::kUnknown;
-      const float za = z[k];
       for (int b = 0; b < 8; ++b) {
         if (!(m >> b & 1)) {
           out.to[b] = kNone;
           continue;
         }
         const std::size_t kn = k + offset[b];
-        const float zb = z[kn];
-        const double dz = (std::isfinite(za) && std::isfinite(zb)) ? double(zb) - za : 0.0;
-        const double length_m = dz == 0.0 ? flat_m[b] : std::sqrt(d2[b] + dz * dz);
-        const float c = static_cast<float>(enter[kn] + w_length * length_m);
+        const float c = MoveCost(enter[kn], z[k], z[kn], step[b], w_length);
         out.to[b] = c;
         if (!source) continue;
         double& lo = b < 4 ? min_straight : min_diagonal;
