@@ -24,30 +24,36 @@ VoxelHashIndex::VoxelHashIndex(const PointCloud& cloud, double cell_m)
     points_[k] = cloud[order_[k]];
     sorted[k] = keys[order_[k]];
   }
-  std::size_t cells = 0;
   for (std::size_t k = 0; k < sorted.size(); ++k) {
-    cells += (k == 0 || sorted[k] != sorted[k - 1]) ? 1 : 0;
+    if (k == 0 || sorted[k] != sorted[k - 1]) {
+      cells_.push_back({static_cast<std::uint32_t>(sorted[k] & 0x1FFFFF), static_cast<int>(k)});
+    }
+  }
+  std::size_t columns = 0;
+  for (std::size_t c = 0; c < cells_.size(); ++c) {
+    columns += (c == 0 || (sorted[cells_[c].begin] >> 21) != (sorted[cells_[c - 1].begin] >> 21));
   }
   std::size_t size = 16;
-  while (size < 2 * cells) size *= 2;  // load factor <= 0.5
-  slots_.assign(size, Slot{kEmpty, 0, 0});
+  while (size < 2 * columns) size *= 2;  // load factor <= 0.5
+  columns_.assign(size, Column{kEmpty, 0, 0});
   mask_ = size - 1;
-  for (std::size_t b = 0; b < sorted.size();) {
-    std::size_t e = b;
-    while (e < sorted.size() && sorted[e] == sorted[b]) ++e;
-    const std::uint64_t key = sorted[b];
+  for (std::size_t b = 0; b < cells_.size();) {
+    const std::uint64_t key = sorted[cells_[b].begin] >> 21;
+    std::size_t e = b + 1;
+    while (e < cells_.size() && (sorted[cells_[e].begin] >> 21) == key) ++e;
     std::uint64_t s = (Mix(key) >> 32) & mask_;
-    while (slots_[s].key != kEmpty) s = (s + 1) & mask_;
-    slots_[s] = Slot{key, static_cast<int>(b), static_cast<int>(e)};
+    while (columns_[s].key != kEmpty) s = (s + 1) & mask_;
+    columns_[s] = Column{key, static_cast<int>(b), static_cast<int>(e)};
     b = e;
   }
+  cells_.push_back({0, static_cast<int>(points_.size())});  // the last cell's end
 }
 
-const VoxelHashIndex::Slot* VoxelHashIndex::Find(std::uint64_t key) const {
+const VoxelHashIndex::Column* VoxelHashIndex::FindColumn(std::uint64_t key) const {
   for (std::uint64_t s = (Mix(key) >> 32) & mask_;; s = (s + 1) & mask_) {
-    const Slot& slot = slots_[s];
-    if (slot.key == key) return &slot;
-    if (slot.key == kEmpty) return nullptr;
+    const Column& column = columns_[s];
+    if (column.key == key) return &column;
+    if (column.key == kEmpty) return nullptr;
   }
 }
 
@@ -61,11 +67,18 @@ void VoxelHashIndex::ForCells(const Eigen::Vector3f& q, float radius_m, F&& f) c
     lo[a] = std::max(c - 1, static_cast<std::int64_t>(std::floor((q[a] - radius_m) * inv_cell_)));
     hi[a] = std::min(c + 1, static_cast<std::int64_t>(std::floor((q[a] + radius_m) * inv_cell_)));
   }
+  // CellKey's z bits, in which order the cells of a column are sorted.
+  const std::uint32_t z_lo = static_cast<std::uint32_t>(CellKey(0, 0, lo[2]));
+  const std::uint32_t z_hi = static_cast<std::uint32_t>(CellKey(0, 0, hi[2]));
   for (std::int64_t x = lo[0]; x <= hi[0]; ++x) {
     for (std::int64_t y = lo[1]; y <= hi[1]; ++y) {
-      for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
-        if (const Slot* slot = Find(CellKey(x, y, z))) f(slot->begin, slot->end);
-      }
+      const Column* column = FindColumn(CellKey(x, y, 0) >> 21);
+      if (!column) continue;
+      int first = column->first_cell;
+      while (first < column->end_cell && cells_[first].z < z_lo) ++first;
+      int end = first;
+      while (end < column->end_cell && cells_[end].z <= z_hi) ++end;
+      if (first < end) f(cells_[first].begin, cells_[end].begin);
     }
   }
 }

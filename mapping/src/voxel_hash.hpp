@@ -1,8 +1,8 @@
 #pragma once
 // A spatial hash of points in cubic cells: fixed-radius and nearest-neighbour queries that look at
 // the cells (at most 27) the query ball reaches. Faster than a k-d tree when the radius is known up
-// front. ICP asks it millions of times per pair, so the cells live in a flat open-addressing table
-// and the points are copied in cell order (one contiguous run per cell).
+// front. ICP asks it millions of times per pair, so the (x, y) columns of cells live in a flat
+// open-addressing table and the points are copied in cell order (one contiguous run per column).
 
 #include <cmath>
 #include <cstdint>
@@ -44,21 +44,30 @@ class VoxelHashIndex {
   int Nearest(const Eigen::Vector3f& q, float max_m, float& d2) const;
 
  private:
-  struct Slot {
-    std::uint64_t key;
-    int begin, end;  // [begin, end) in points_ / order_
+  // The cells of one (x, y) column: their points are one contiguous run of points_, the cells in
+  // ascending z, so a query reads each column it reaches as one run (one table probe per column,
+  // not per cell).
+  struct Column {
+    std::uint64_t key;            // CellKey(x, y, 0) >> 21
+    int first_cell, end_cell;     // [first_cell, end_cell) in cells_
   };
-  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // no CellKey has all 64 bits set
+  struct Cell {
+    std::uint32_t z;  // CellKey's low 21 bits: ascending z
+    int begin;        // first point in points_; the cell ends where cells_'s next begins
+  };
+  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // no column key has all bits set
 
-  const Slot* Find(std::uint64_t key) const;
-  // Calls f(begin, end) for every occupied cell the ball (q, radius_m) reaches.
+  const Column* FindColumn(std::uint64_t key) const;
+  // Calls f(begin, end) for the points of the occupied cells the ball (q, radius_m) reaches, in
+  // the cells' order (x, then y, then z ascending), each column's cells as one run.
   template <typename F>
   void ForCells(const Eigen::Vector3f& q, float radius_m, F&& f) const;
 
   float inv_cell_;
   std::vector<Eigen::Vector3f> points_;  // the cloud's points sorted by cell
   std::vector<int> order_;               // index into the cloud of each of points_
-  std::vector<Slot> slots_;              // open addressing, linear probing; size a power of two
+  std::vector<Cell> cells_;              // every occupied cell in key order, then an end marker
+  std::vector<Column> columns_;          // open addressing, linear probing; size a power of two
   std::uint64_t mask_ = 0;
 };
 
