@@ -31,29 +31,38 @@ float AtanUnit(float z) {
                     z2 * (0.19354346f + z2 * (-0.11643287f + z2 * (0.05265332f + z2 * -0.01172120f)))));
 }
 
-// AtanUnit's 1.8e-6, the quotient's and the quadrant's rounding (2.4e-7 at pi) and atan2f's own
-// error (< 1 ulp), with 30x room: a wrong bracket would have to be 30x worse than measured.
-constexpr float kApproxAtan2Error = 1e-4f;
+// std::atan2(y, x) within 5e-6 rad: AtanUnit's 1.8e-6, the quotient's and the quadrant's rounding
+// (2.4e-7 at pi), with atan2's quadrants and signed zeros.
+float Atan2Polynomial(float y, float x) {
+  const float ax = std::fabs(x), ay = std::fabs(y);
+  const float big = std::max(ax, ay);
+  const float t = big > 0 ? AtanUnit(std::min(ax, ay) / big) : 0.0f;
+  // Selects, not branches: the quadrants of neighbouring points' pairs follow no pattern.
+  const float r = ay > ax ? 0.5f * kPi - t : t;
+  return std::copysign(std::signbit(x) ? kPi - r : r, y);
+}
+
+// How near (in bins) an angle's bin position may come to an edge between two bins before its bin
+// is taken from atan2 itself: 5e-4 bins is 2.9e-4 rad, against the polynomial's 5e-6 rad, atan2f's
+// < 1 ulp and AngleBin's float rounding (< 1e-5 bins): 25x room.
+constexpr float kEdgeMarginBins = 5e-4f;
+
+// AngleBin(std::atan2(y, x)), bit for bit: AngleBin's edges are where its bin position (angle +
+// pi) * 11 / 2pi crosses 1 .. 10, and its float operations never decrease with the angle, so an
+// angle whose approximate position lies farther than the margin from every inner edge has the bin
+// atan2's value (within the margin) has. Only angles near an edge (~0.1 % of pairs) call atan2.
+int AngleBinFast(float y, float x) {
+  const float position = (Atan2Polynomial(y, x) + kPi) * (kBins / (2 * kPi));
+  const int bin = std::clamp(static_cast<int>(position), 0, kBins - 1);
+  const bool near_lower = bin > 0 && position - static_cast<float>(bin) <= kEdgeMarginBins;
+  const bool near_upper = bin < kBins - 1 && static_cast<float>(bin + 1) - position <= kEdgeMarginBins;
+  return near_lower || near_upper ? AngleBin(std::atan2(y, x)) : bin;
+}
 
 }  // namespace
 
-float internal::ApproxAtan2(float y, float x) {
-  const float ax = std::fabs(x), ay = std::fabs(y);
-  const float big = std::max(ax, ay);
-  float r = big > 0 ? AtanUnit(std::min(ax, ay) / big) : 0.0f;
-  if (ay > ax) r = 0.5f * kPi - r;
-  if (std::signbit(x)) r = kPi - r;
-  return std::signbit(y) ? -r : r;
-}
-
-// The float operations in AngleBin never decrease with their argument, so when both ends of the
-// approximation's bracket fall in one bin, atan2's value (inside the bracket) does too. Only
-// angles within 1e-4 rad of a bin's edge (~0.04 % of pairs) call atan2.
-int internal::AngleBinOfAtan2(float y, float x) {
-  const float a = ApproxAtan2(y, x);
-  const int lo = AngleBin(a - kApproxAtan2Error), hi = AngleBin(a + kApproxAtan2Error);
-  return lo == hi ? lo : AngleBin(std::atan2(y, x));
-}
+float internal::ApproxAtan2(float y, float x) { return Atan2Polynomial(y, x); }
+int internal::AngleBinOfAtan2(float y, float x) { return AngleBinFast(y, x); }
 
 namespace {
 
@@ -82,7 +91,7 @@ bool PairFeatureBins(const Eigen::Vector3f& p1, const Eigen::Vector3f& n1,
   v /= vn;
   const Eigen::Vector3f w = a.cross(v);
   const float f2 = v.dot(b);
-  b1 = internal::AngleBinOfAtan2(w.dot(b), a.dot(b));
+  b1 = AngleBinFast(w.dot(b), a.dot(b));
   b2 = Bin((f2 + 1) * 0.5f);
   b3 = Bin((f3 + 1) * 0.5f);
   return true;
