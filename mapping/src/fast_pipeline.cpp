@@ -152,13 +152,13 @@ void FindPairs(const IcpTarget& target, const PointCloud& source, const Eigen::I
     for (std::size_t i = begin; i < end; ++i) {
       moved[i] = Tf * source[i];
       float d2 = 0;
-      const int j = index.Nearest(moved[i], gate_m, d2);
-      nearest[i] = j >= 0 && target.normals[j].allFinite() ? j : -1;
+      nearest[i] = index.Nearest(moved[i], gate_m, d2);
     }
   });
+  target.normals.Make(nearest);
   for (std::size_t i = 0; i < source.size(); ++i) {
     const int j = nearest[i];
-    if (j < 0) continue;
+    if (j < 0 || !target.normals[j].allFinite()) continue;
     pairs.push_back({moved[i].cast<double>(), target.points[j].cast<double>(),
                      target.normals[j].cast<double>()});
   }
@@ -197,23 +197,61 @@ Eigen::Matrix3d Scatter(const PointCloud& cloud, const std::vector<int>& indices
 // 60 % of a registration's CPU (features and normals; terrain seed 1, 20 stops).
 constexpr std::size_t kPointsPerBlock = 256;
 
+namespace {
+
+// The PCA normal at `p` over `radius_m`, facing `viewpoint`; NaN with fewer than 5 neighbours.
+// `nn`: the caller's buffer for the neighbours themselves (Scatter's order, read in line).
+Eigen::Vector3f NormalAt(const Eigen::Vector3f& p, const VoxelHashIndex& index, float radius_m,
+                         const Eigen::Vector3f& viewpoint, std::vector<Eigen::Vector3f>& nn) {
+  nn.clear();
+  index.RadiusPoints(p, radius_m, nn);
+  if (nn.size() < 5) return Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(ScatterOf(nn.size(), [&](std::size_t k) { return nn[k]; }));
+  Eigen::Vector3f n = eig.eigenvectors().col(0).cast<float>();
+  if (n.dot(viewpoint - p) < 0) n = -n;
+  return n;
+}
+
+}  // namespace
+
 Normals EstimateNormals(const PointCloud& cloud, const VoxelHashIndex& index, float radius_m,
                         const Eigen::Vector3f& viewpoint) {
-  Normals normals(cloud.size(), Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()));
+  Normals normals(cloud.size());
   internal::ParallelFor(cloud.size(), kPointsPerBlock, [&](std::size_t begin, std::size_t end) {
-    std::vector<Eigen::Vector3f> nn;  // the neighbours themselves: Scatter's order, read in line
+    std::vector<Eigen::Vector3f> nn;
     for (std::size_t i = begin; i < end; ++i) {
-      nn.clear();
-      index.RadiusPoints(cloud[i], radius_m, nn);
-      if (nn.size() < 5) continue;
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-      eig.computeDirect(ScatterOf(nn.size(), [&](std::size_t k) { return nn[k]; }));
-      Eigen::Vector3f n = eig.eigenvectors().col(0).cast<float>();
-      if (n.dot(viewpoint - cloud[i]) < 0) n = -n;
-      normals[i] = n;
+      normals[i] = NormalAt(cloud[i], index, radius_m, viewpoint, nn);
     }
   });
   return normals;
+}
+
+LazyNormals::LazyNormals(const PointCloud& cloud, const VoxelHashIndex& index, float radius_m,
+                         const Eigen::Vector3f& viewpoint)
+    : cloud_(cloud),
+      index_(index),
+      radius_m_(radius_m),
+      viewpoint_(viewpoint),
+      normals_(cloud.size()),
+      made_(cloud.size(), 0) {}
+
+void LazyNormals::Make(const std::vector<int>& indices) const {
+  missing_.clear();
+  for (const int i : indices) {
+    if (i >= 0 && !made_[i]) {
+      made_[i] = 1;
+      missing_.push_back(i);
+    }
+  }
+  internal::ParallelFor(missing_.size(), kPointsPerBlock, [&](std::size_t begin, std::size_t end) {
+    std::vector<Eigen::Vector3f> nn;
+    for (std::size_t k = begin; k < end; ++k) {
+      const int i = missing_[k];
+      normals_[i] = NormalAt(cloud_[i], index_, radius_m_, viewpoint_, nn);
+    }
+  });
+  made_count_ += missing_.size();
 }
 
 namespace {

@@ -2,6 +2,7 @@
 // Our own implementation of the registration stages (backend "fast"): PCA normals, FPFH,
 // correspondence RANSAC with edge prerejection, point-to-plane ICP with Levenberg-Marquardt.
 
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -24,6 +25,32 @@ Eigen::Matrix3d Scatter(const PointCloud& cloud, const std::vector<int>& indices
 /// PCA normals over `radius_m`, oriented towards `viewpoint` (the sensor, in the cloud's frame).
 Normals EstimateNormals(const PointCloud& cloud, const VoxelHashIndex& index, float radius_m,
                         const Eigen::Vector3f& viewpoint);
+
+/// EstimateNormals' normals of a cloud, each made when first asked for: ICP reads only the target
+/// points nearest the source's, on a map often a fraction of them. Holds the cloud and the index
+/// by reference. Make is not thread-safe (one registration at a time asks); it makes the missing
+/// normals on the machine's cores, each as EstimateNormals makes it, bit for bit.
+class LazyNormals {
+ public:
+  LazyNormals(const PointCloud& cloud, const VoxelHashIndex& index, float radius_m,
+              const Eigen::Vector3f& viewpoint);
+  /// Makes the normals of `indices` (points of the cloud; negative ones are skipped) not made yet.
+  void Make(const std::vector<int>& indices) const;
+  /// Point i's normal (NaN where it has too few neighbours); i must have been made.
+  const Eigen::Vector3f& operator[](int i) const { return normals_[i]; }
+  /// How many normals were made so far.
+  std::size_t made() const { return made_count_; }
+
+ private:
+  const PointCloud& cloud_;
+  const VoxelHashIndex& index_;
+  float radius_m_;
+  Eigen::Vector3f viewpoint_;
+  mutable Normals normals_;
+  mutable std::vector<std::uint8_t> made_;
+  mutable std::vector<int> missing_;  // Make's buffer
+  mutable std::size_t made_count_ = 0;
+};
 
 /// FPFH (Rusu 2009, as pcl::FPFHEstimation): one 33-bin row per keypoint (an index into `cloud`,
 /// whose points all serve as neighbours); zero rows without normals.
@@ -79,7 +106,7 @@ SacResult SampleConsensus(const PointCloud& source, const PointCloud& target,
 /// final gates (queries with a radius <= fine_cell_m use `fine`).
 struct IcpTarget {
   const PointCloud& points;
-  const Normals& normals;
+  const LazyNormals& normals;
   const VoxelHashIndex& coarse;
   const VoxelHashIndex& fine;
   float fine_cell_m;

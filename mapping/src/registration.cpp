@@ -827,8 +827,8 @@ IcpResult HalfScaleIcp(const PointCloud& target, const PointCloud& source,
   const internal::IcpCells cells = internal::IcpCellsOf(half);
   const VoxelHashIndex fine(target_icp, cells.fine);
   const VoxelHashIndex coarse(target_icp, cells.coarse);
-  const Normals normals =
-      EstimateNormals(target_icp, fine, static_cast<float>(half.icp_normal_radius_m), target_sensor);
+  const LazyNormals normals(target_icp, fine, static_cast<float>(half.icp_normal_radius_m),
+                            target_sensor);
   const IcpTarget icp_target{target_icp, normals, coarse, fine, cells.fine};
   return PointToPlaneLm(icp_target, source_icp, at, half, frozen);
 }
@@ -1026,7 +1026,7 @@ struct IcpScene {
       : parts(memo.IcpParts(config, prep.target_sensor)),
         seen(prior.target_scan ? *prior.target_scan : memo.cloud(), prep.target_sensor, 1.0,
              FreeSpaceMargins(config)),
-        target{prep.target_icp, parts.normals, *parts.coarse, *parts.fine, parts.cells.fine,
+        target{prep.target_icp, *parts.normals, *parts.coarse, *parts.fine, parts.cells.fine,
                &seen},
         source(EvenSubsample(prep.source_icp, config.icp_max_points)) {}
 

@@ -80,7 +80,7 @@ const TargetMemo::Icp& TargetMemo::IcpParts(const RegistrationConfig& config,
     p.sensor = sensor;
     p.fine = std::make_unique<VoxelHashIndex>(v.icp, cells.fine);
     p.coarse = std::make_unique<VoxelHashIndex>(v.icp, cells.coarse);
-    p.normals = EstimateNormals(v.icp, *p.fine, normal_radius, sensor);
+    p.normals = std::make_unique<LazyNormals>(v.icp, *p.fine, normal_radius, sensor);
     icp_ = std::move(p);
   }
   return *icp_;

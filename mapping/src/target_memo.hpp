@@ -61,14 +61,14 @@ class TargetMemo {
   const Voxels& VoxelGrids(const RegistrationConfig& config);
 
   /// ICP's target (IcpScene): hashes of the ICP cloud with IcpCellsOf's edges, and its normals
-  /// within `normal_radius` facing `sensor`, searched on the fine hash.
+  /// within `normal_radius` facing `sensor`, searched on the fine hash as ICP first reads them.
   struct Icp {
     double icp_voxel_m = 0;
     IcpCells cells{0, 0};
     float normal_radius = 0;
     Eigen::Vector3f sensor = Eigen::Vector3f::Zero();
     std::unique_ptr<VoxelHashIndex> fine, coarse;
-    Normals normals;
+    std::unique_ptr<LazyNormals> normals;  // made as ICP reads them
   };
   const Icp& IcpParts(const RegistrationConfig& config, const Eigen::Vector3f& sensor);
 
