@@ -22,8 +22,8 @@ int Bin(float unit) { return std::clamp(static_cast<int>(std::floor(unit * kBins
 // The FPFH bin of an angle in [-pi, pi].
 int AngleBin(float angle) { return Bin((angle + kPi) / (2 * kPi)); }
 
-// atan(z) for z in [0, 1]: an odd minimax polynomial, within 1.8e-6 rad of atan on every float in
-// [0, 1] when evaluated in float (checked exhaustively against double atan; the test samples it).
+// atan(z) for z in [-1, 1]: an odd minimax polynomial, within 1.8e-6 rad of atan on every float in
+// [0, 1] when evaluated in float (checked exhaustively against double atan), and odd in float too.
 float AtanUnit(float z) {
   const float z2 = z * z;
   return z * (0.99997726f +
@@ -31,15 +31,19 @@ float AtanUnit(float z) {
                     z2 * (0.19354346f + z2 * (-0.11643287f + z2 * (0.05265332f + z2 * -0.01172120f)))));
 }
 
-// std::atan2(y, x) within 5e-6 rad: AtanUnit's 1.8e-6, the quotient's and the quadrant's rounding
-// (2.4e-7 at pi), with atan2's quadrants and signed zeros.
+// Below this, a vector's angle is left to atan2 (Atan2Polynomial divides by at least this).
+constexpr float kTinyVector = 1e-20f;
+
+// std::atan2(y, x) within 5e-6 rad where max(|x|, |y|) >= kTinyVector: AtanUnit's 1.8e-6, the
+// quotient's rounding (< 2e-7: atan's slope is at most 1) and the sums' (< 4e-7), with atan2's
+// quadrants and signs. One formula for every octant, atan2(|y|, |x|) = pi/4 + atan((|y| - |x|) /
+// (|y| + |x|)), and the left half by a product with 0 or 1: no branch, for the quadrants of
+// neighbouring points' pairs follow no pattern a branch predictor could learn.
 float Atan2Polynomial(float y, float x) {
   const float ax = std::fabs(x), ay = std::fabs(y);
-  const float big = std::max(ax, ay);
-  const float t = big > 0 ? AtanUnit(std::min(ax, ay) / big) : 0.0f;
-  // Selects, not branches: the quadrants of neighbouring points' pairs follow no pattern.
-  const float r = ay > ax ? 0.5f * kPi - t : t;
-  return std::copysign(std::signbit(x) ? kPi - r : r, y);
+  const float right = 0.25f * kPi + AtanUnit((ay - ax) / std::max(ay + ax, kTinyVector));
+  const float left = static_cast<float>(std::signbit(x));
+  return std::copysign(right + left * (kPi - 2 * right), y);  // pi - right where x < 0
 }
 
 // How near (in bins) an angle's bin position may come to an edge between two bins before its bin
@@ -50,13 +54,17 @@ constexpr float kEdgeMarginBins = 5e-4f;
 // AngleBin(std::atan2(y, x)), bit for bit: AngleBin's edges are where its bin position (angle +
 // pi) * 11 / 2pi crosses 1 .. 10, and its float operations never decrease with the angle, so an
 // angle whose approximate position lies farther than the margin from every inner edge has the bin
-// atan2's value (within the margin) has. Only angles near an edge (~0.1 % of pairs) call atan2.
+// atan2's value (within the margin) has. Only angles near an edge (~0.1 % of pairs) and tiny
+// vectors call atan2.
 int AngleBinFast(float y, float x) {
   const float position = (Atan2Polynomial(y, x) + kPi) * (kBins / (2 * kPi));
   const int bin = std::clamp(static_cast<int>(position), 0, kBins - 1);
-  const bool near_lower = bin > 0 && position - static_cast<float>(bin) <= kEdgeMarginBins;
-  const bool near_upper = bin < kBins - 1 && static_cast<float>(bin + 1) - position <= kEdgeMarginBins;
-  return near_lower || near_upper ? AngleBin(std::atan2(y, x)) : bin;
+  const bool near_lower = (bin > 0) & (position - static_cast<float>(bin) <= kEdgeMarginBins);
+  const bool near_upper =
+      (bin < kBins - 1) & (static_cast<float>(bin + 1) - position <= kEdgeMarginBins);
+  const bool tiny = std::max(std::fabs(x), std::fabs(y)) < kTinyVector;
+  if (near_lower | near_upper | tiny) [[unlikely]] return AngleBin(std::atan2(y, x));
+  return bin;
 }
 
 }  // namespace

@@ -59,8 +59,9 @@ FeatureMatrix ComputeFpfh(const PointCloud& cloud, const Normals& normals,
                           const std::vector<int>& keypoints);
 
 namespace internal {
-/// std::atan2(y, x) within 5e-6 rad (measured: 2e-6), with atan2's quadrants and signed zeros
-/// (atan2(+-0, -0) = +-pi, atan2(+-0, +0) = +-0). A polynomial: several times cheaper than atan2f.
+/// std::atan2(y, x) within 5e-6 rad (measured: 2.4e-6) where max(|x|, |y|) >= 1e-20, with atan2's
+/// quadrants and signs (atan2(+-0, -1) = +-pi, atan2(+-0, 1) = +-0). A polynomial without
+/// branches: several times cheaper than atan2f.
 float ApproxAtan2(float y, float x);
 /// FPFH's bin (one of 11 over [-pi, pi]) of std::atan2(y, x), always the bin atan2's own value
 /// gives; atan2 is called only for angles within 3e-4 rad of an edge between two bins.

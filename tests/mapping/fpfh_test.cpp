@@ -32,9 +32,9 @@ TEST(Fpfh, ApproxAtan2IsWithinItsBoundInEveryQuadrantAndKeepsSignedZeros) {
                                      std::atan2(double(y), double(x))));
   }
   EXPECT_LT(worst, 5e-6);  // the bound AngleBinOfAtan2 relies on, with 25x room in its margin
-  // Along the axes, the diagonals and at zero, as atan2 (signed zeros decide +-pi and +-0).
-  for (const float y : {0.0f, -0.0f, 1.0f, -1.0f, 3e-30f, -3e-30f}) {
-    for (const float x : {0.0f, -0.0f, 1.0f, -1.0f, 3e-30f, -3e-30f}) {
+  // Along the axes and the diagonals, as atan2 (signed zeros decide +-pi and +-0).
+  for (const float y : {0.0f, -0.0f, 1.0f, -1.0f, 3e-20f, -3e-20f}) {
+    for (const float x : {1.0f, -1.0f, 3e-20f, -3e-20f}) {
       const float want = std::atan2(y, x), got = internal::ApproxAtan2(y, x);
       EXPECT_NEAR(got, want, 5e-6) << "y " << y << " x " << x;
       EXPECT_EQ(std::signbit(got), std::signbit(want)) << "y " << y << " x " << x;
@@ -55,8 +55,9 @@ TEST(Fpfh, AngleBinsAreAtan2sEvenAtTheBinsEdges) {
       }
     }
   }
-  for (const float y : {0.0f, -0.0f}) {
-    for (const float x : {0.0f, -0.0f, 1.0f, -1.0f}) yx.emplace_back(y, x);
+  // Zeros (atan2's signed zeros pick +-pi and +-0) and vectors too short for the polynomial.
+  for (const float y : {0.0f, -0.0f, 3e-30f, -3e-30f, 1e-21f}) {
+    for (const float x : {0.0f, -0.0f, 1.0f, -1.0f, 2e-30f, -5e-30f}) yx.emplace_back(y, x);
   }
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
