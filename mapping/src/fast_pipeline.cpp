@@ -272,6 +272,7 @@ void Spfh(const PointCloud& cloud, const Normals& normals, const VoxelHashIndex&
   nn.clear();
   index.Radius(cloud[i], radius_m, nn);
   const int stride = std::max<int>(1, static_cast<int>(nn.size()) / max_neighbors);
+  kept.reserve((nn.size() + stride - 1) / stride);  // one allocation, not a vector's doublings
   for (std::size_t k = 0; k < nn.size(); k += stride) {
     if (nn[k] != i && normals[nn[k]].allFinite()) kept.push_back(nn[k]);
   }
@@ -327,33 +328,44 @@ std::vector<Correspondence> MatchFeatures(const FeatureMatrix& source,
   std::vector<int> best_t(ns, -1), best_s(nt, -1);
   std::vector<float> best_t_d(ns, std::numeric_limits<float>::max());
   std::vector<float> best_s_d(nt, std::numeric_limits<float>::max());
-  const Eigen::VectorXf tn = target.rowwise().squaredNorm();
+  // Rows of zeros (no histogram) match nothing: their |t|^2 is +inf below, so no distance to them
+  // is below the FLT_MAX every best starts at.
+  const Eigen::ArrayXf tn = target.rowwise().squaredNorm().array();
+  const Eigen::ArrayXf tn_or_inf =
+      (tn > 0).select(tn, Eigen::ArrayXf::Constant(nt, std::numeric_limits<float>::infinity()));
   const Eigen::VectorXf sn = source.rowwise().squaredNorm();
   // |s - t|^2 = |s|^2 + |t|^2 - 2 s.t, in blocks of source rows on the machine's cores. Each block
   // keeps the best source row of every target column it saw (the first of equals); merged in
-  // block order below, the first of equals overall, as one loop over the rows finds.
+  // block order below, the first of equals overall, as one loop over the rows finds. A row's
+  // distances are whole arrays (Eigen vectorises them): its best column is the first holding
+  // their minimum, each column's best row replaced where a row is strictly nearer.
   constexpr int kBlock = 256;
   const int blocks = (ns + kBlock - 1) / kBlock;
-  std::vector<std::vector<int>> block_s(blocks);
-  std::vector<std::vector<float>> block_s_d(blocks);
+  std::vector<Eigen::ArrayXi> block_s(blocks);
+  std::vector<Eigen::ArrayXf> block_s_d(blocks);
+  using RowMajorXf = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   internal::ParallelFor(blocks, 1, [&](std::size_t first, std::size_t last) {
+    Eigen::ArrayXf dist(nt);
     for (std::size_t k = first; k < last; ++k) {
       const int b = static_cast<int>(k) * kBlock;
       const int rows = std::min(kBlock, ns - b);
-      std::vector<int>& bs = block_s[k];
-      std::vector<float>& bs_d = block_s_d[k];
-      bs.assign(nt, -1);
-      bs_d.assign(nt, std::numeric_limits<float>::max());
-      Eigen::MatrixXf d = -2.0f * source.middleRows(b, rows) * target.transpose();
+      Eigen::ArrayXi& bs = block_s[k];
+      Eigen::ArrayXf& bs_d = block_s_d[k];
+      bs.setConstant(nt, -1);
+      bs_d.setConstant(nt, std::numeric_limits<float>::max());
+      const RowMajorXf d = -2.0f * source.middleRows(b, rows) * target.transpose();
       for (int r = 0; r < rows; ++r) {
         const int i = b + r;
         if (sn(i) <= 0) continue;
-        for (int j = 0; j < nt; ++j) {
-          if (tn(j) <= 0) continue;
-          const float dist = d(r, j) + sn(i) + tn(j);
-          if (dist < best_t_d[i]) best_t_d[i] = dist, best_t[i] = j;
-          if (dist < bs_d[j]) bs_d[j] = dist, bs[j] = i;
+        dist = d.row(r).array().transpose() + sn(i) + tn_or_inf;
+        const float nearest = dist.minCoeff();
+        if (nearest < best_t_d[i]) {
+          best_t_d[i] = nearest;
+          best_t[i] = static_cast<int>(std::find(dist.data(), dist.data() + nt, nearest) - dist.data());
         }
+        const auto nearer = dist < bs_d;
+        bs = nearer.select(i, bs);
+        bs_d = nearer.select(dist, bs_d);
       }
     }
   });
