@@ -153,13 +153,41 @@ TEST(Fpfh, IsThePlainDefinitionsBitForBit) {
   const Normals normals = EstimateNormals(cloud, index, normal_r, Eigen::Vector3f(2, 1.5f, 1));
   std::vector<int> keys;
   for (int i = 0; i < static_cast<int>(cloud.size()); i += 3) keys.push_back(i);
-  for (const int max_neighbors : {5, 40}) {
+  for (const int max_neighbors : {5, 40, 1000}) {  // strides > 1, mixed, all 1
     const FeatureMatrix fast = ComputeFpfh(cloud, normals, index, feature_r, max_neighbors, keys);
     const FeatureMatrix plain = PlainFpfh(cloud, normals, index, feature_r, max_neighbors, keys);
     ASSERT_EQ(fast.rows(), plain.rows());
     EXPECT_TRUE(fast == plain) << "max_neighbors " << max_neighbors << ": largest difference "
                                << (fast - plain).cwiseAbs().maxCoeff();
     EXPECT_GT(fast.rowwise().sum().minCoeff(), 299.0f);  // every key has a histogram
+  }
+}
+
+TEST(Fpfh, TiedPairsAndFarCoordinatesAreThePlainDefinitions) {
+  // A lattice on z = 0 with normals exactly up: every pair's two angles tie (both 0), so neither
+  // point is PCL's source and each side's features are its own; some points lifted and tilted.
+  PointCloud cloud;
+  Normals normals;
+  for (int x = 0; x < 30; ++x) {
+    for (int y = 0; y < 30; ++y) {
+      const bool lifted = (x * 7 + y * 3) % 11 == 0;
+      cloud.emplace_back(0.1f * x, 0.1f * y, lifted ? 0.05f : 0.0f);
+      normals.push_back(lifted ? Eigen::Vector3f(0.6f, 0, 0.8f) : Eigen::Vector3f(0, 0, 1));
+    }
+  }
+  std::vector<int> keys;
+  for (int i = 0; i < static_cast<int>(cloud.size()); i += 2) keys.push_back(i);
+  // The same scene far from the origin (coordinates of 5 km, rounding at 0.5 mm).
+  PointCloud far = cloud;
+  for (Eigen::Vector3f& p : far) p += Eigen::Vector3f(5000, -3000, 0);
+  for (const PointCloud* c : {&cloud, &far}) {
+    const VoxelHashIndex index(*c, 0.35);
+    for (const int max_neighbors : {8, 1000}) {
+      const FeatureMatrix fast = ComputeFpfh(*c, normals, index, 0.35f, max_neighbors, keys);
+      const FeatureMatrix plain = PlainFpfh(*c, normals, index, 0.35f, max_neighbors, keys);
+      EXPECT_TRUE(fast == plain) << "max_neighbors " << max_neighbors << ": largest difference "
+                                 << (fast - plain).cwiseAbs().maxCoeff();
+    }
   }
 }
 
