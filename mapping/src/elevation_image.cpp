@@ -133,9 +133,12 @@ Result<void> WritePng(const RgbImage& image, const std::string& path) {
   // Up filter alone makes them zeros. libpng's default tries all five filters on every row, which
   // took half the encoding time for files as small (issue 21: an office run's six pictures,
   // 5.7 Mpixel, 217 ms -> 98 ms, 145.6 -> 145.9 kB; a terrain run's four, 3.5 Mpixel,
-  // 202 ms -> 101 ms, 451 -> 498 kB). Deflate stays at zlib's default level 6: level 3 took half
-  // as long again but made the office's files 56 % larger.
+  // 202 ms -> 101 ms, 451 -> 498 kB). Deflate at level 3, not zlib's default 6: every picture of
+  // a run (session 27, the deflate alone, level 6 -> 3) office seed 3 146 -> 68 ms and 624 -> 872
+  // kB, urban seed 1 211 -> 102 ms and 2.18 -> 2.48 MB, terrain seed 1 419 -> 205 ms and 3.9 ->
+  // 4.6 MB: half the time for 1 % more of a run's folder (20-54 MB, mostly its scans).
   png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_UP);
+  png_set_compression_level(png, 3);
   png_set_IHDR(png, info, image.width, image.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);
