@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 
 #include "pitchlab/mapping/atomic_file.hpp"
 #include "pitchlab/sensors/scan3d.hpp"
@@ -17,7 +18,7 @@ namespace {
 constexpr char kMagic[8] = {'P', 'L', 'E', 'L', 'E', 'V', '0', '1'};
 static_assert(sizeof(CellStats) == 52, "the .plem record layout is 13 packed 4-byte fields");
 
-std::uint64_t Fnv1a(const std::string& bytes) {
+std::uint64_t Fnv1a(std::string_view bytes) {
   std::uint64_t h = 1469598103934665603ull;
   for (unsigned char c : bytes) {
     h ^= c;
@@ -125,9 +126,16 @@ std::string InvalidValues(const GridGeometry& g, const GeodeticOrigin* geo,
 Result<ElevationMap> LoadElevationMap(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return Fail(Error::Code::kNotFound, path + ": cannot open: " + std::strerror(errno));
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string bytes = ss.str();
+  // Read once into a buffer of the file's size: a truth map is ~20 MB, and a stream's growing
+  // copies cost as much as the rest of the load.
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);  // a folder: an error
+  if (ec) return Fail(Error::Code::kInvalidArgument, path + ": cannot read: " + ec.message());
+  std::string bytes(static_cast<std::size_t>(size), '\0');
+  if (!in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()))) {
+    return Fail(Error::Code::kFailed, path + ": cannot read all of its " + std::to_string(size) +
+                                          " bytes");
+  }
   const auto bad = [&](const std::string& why) {
     return Fail(Error::Code::kInvalidArgument, path + ": not a pitchlab elevation map: " + why);
   };
@@ -135,7 +143,7 @@ Result<ElevationMap> LoadElevationMap(const std::string& path) {
     return bad("bad magic (expected PLELEV01)");
   std::uint64_t stored_hash = 0;
   std::memcpy(&stored_hash, bytes.data() + bytes.size() - 8, 8);
-  if (Fnv1a(bytes.substr(0, bytes.size() - 8)) != stored_hash)
+  if (Fnv1a(std::string_view(bytes).substr(0, bytes.size() - 8)) != stored_hash)
     return bad("hash mismatch (corrupt or truncated)");
   std::size_t pos = sizeof(kMagic);
   GridGeometry g;

@@ -71,6 +71,23 @@ TEST_F(CorruptMap, AnIntactMapStillLoads) {
   ASSERT_TRUE(loaded) << loaded.error().message;
 }
 
+TEST_F(CorruptMap, AFolderATruncatedAndAnEmptyFileAreRefusedByName) {
+  const auto folder = mapping::LoadElevationMap(dir_.string());
+  ASSERT_FALSE(folder);
+  EXPECT_NE(folder.error().message.find(dir_.string() + ": cannot read"), std::string::npos)
+      << folder.error().message;
+  const std::string saved = Saved(GridGeometry::FromArea(0, 0, 0.4, 0.3, 0.1));
+  fs::resize_file(saved, fs::file_size(saved) - 1);
+  const auto truncated = mapping::LoadElevationMap(saved);
+  ASSERT_FALSE(truncated);
+  EXPECT_NE(truncated.error().message.find("hash mismatch"), std::string::npos)
+      << truncated.error().message;
+  std::ofstream(dir_ / "empty.plem").close();
+  const auto empty = mapping::LoadElevationMap((dir_ / "empty.plem").string());
+  ASSERT_FALSE(empty);
+  EXPECT_NE(empty.error().message.find("bad magic"), std::string::npos) << empty.error().message;
+}
+
 TEST_F(CorruptMap, APathWithoutFinitePositionsIsNotWritten) {
   planning::Path path;
   path.waypoints = {{0.05, 0.05, 1.0}, {std::nan(""), std::nan(""), 1.0}};
