@@ -325,6 +325,7 @@ FeatureMatrix ComputeFpfh(const PointCloud& cloud, const Normals& normals,
 std::vector<Correspondence> MatchFeatures(const FeatureMatrix& source,
                                           const FeatureMatrix& target) {
   const int ns = static_cast<int>(source.rows()), nt = static_cast<int>(target.rows());
+  if (ns == 0 || nt == 0) return {};  // a side without keypoints (NARF found none) matches nothing
   std::vector<int> best_t(ns, -1), best_s(nt, -1);
   std::vector<float> best_t_d(ns, std::numeric_limits<float>::max());
   std::vector<float> best_s_d(nt, std::numeric_limits<float>::max());

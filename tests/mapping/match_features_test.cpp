@@ -59,5 +59,12 @@ TEST(MatchFeatures, FindsTheMutualNearestNeighboursOfAPlainLoopTiesToTheFirstRow
   EXPECT_GE(got.size(), 19u);
 }
 
+TEST(MatchFeatures, ASideWithoutRowsMatchesNothing) {
+  const FeatureMatrix some = FeatureMatrix::Ones(5, 36), none(0, 36);
+  EXPECT_TRUE(MatchFeatures(some, none).empty());
+  EXPECT_TRUE(MatchFeatures(none, some).empty());
+  EXPECT_TRUE(MatchFeatures(none, none).empty());
+}
+
 }  // namespace
 }  // namespace pitchlab::mapping
