@@ -441,9 +441,39 @@ SacResult FastNarfAlignment(const PointCloud& target, const PointCloud& source,
   return sac;
 }
 
-// Our FPFH + RANSAC initial alignment. When it finds nothing at the configured scale (a confined
-// scene: under a desk, between crates), it retries once at half the scale (voxel, radii, inlier
-// distance).
+// The voxels of the smaller ICP cloud when the pair is a confined scene (fewer than
+// confined_scene_voxels, backend fast), else none. The target's normals straddle a corner's edges
+// as much as the source's points do: either cloud confined makes the pair confined.
+std::optional<std::size_t> ConfinedVoxels(const Prepared& prep, const RegistrationConfig& config) {
+  const std::size_t fewest = std::min(prep.target_icp.size(), prep.source_icp.size());
+  if (config.backend != RegistrationBackend::kFast ||
+      fewest >= static_cast<std::size_t>(config.confined_scene_voxels)) {
+    return std::nullopt;
+  }
+  return fewest;
+}
+
+// Whether a pair's scene is small for its features: its smaller ICP cloud covers less surface than
+// kFeatureNeighbourhoods discs of feature_radius_m (pi (r / icp_voxel_m)^2 voxels each, 707 at the
+// defaults; the ratio, not a length, so a scaled scene is judged alike). Each feature then spans
+// a large share of the scene and they cannot tell its places apart; at half the scale the same
+// surface holds four times as many.
+constexpr double kFeatureNeighbourhoods = 5;
+bool SmallForFeatures(const Prepared& prep, const RegistrationConfig& config) {
+  const double disc = kPi * std::pow(config.feature_radius_m / config.icp_voxel_m, 2);
+  const std::size_t fewest = std::min(prep.target_icp.size(), prep.source_icp.size());
+  return static_cast<double>(fewest) < kFeatureNeighbourhoods * disc;
+}
+
+// Our FPFH + RANSAC initial alignment. When it finds nothing at the configured scale in a scene
+// small for its features (SmallForFeatures: under a desk, between crates, a room's corner, a
+// corridor's end), it retries once at half the scale (voxel, radii, inlier distance). Elsewhere
+// the retry finds little and costs much: over `bench --seeds 1..20` (office, urban, terrain;
+// session 27) every stop's smaller cloud held 3700 voxels or more, and 172 retries found 7 poses
+// (10-21 agreeing correspondences, the consensus' minimum being 10) while making a 40-55k-point
+// target's features each time (in urban, half of all FPFH work). registration_eval's pairs that
+// only the retry registered (office 0 and 33, cluttered 96, corridor 232 and 238) lie at
+// 1056-3106 voxels.
 // The feature matches the consensus ran on (keypoints, correspondences and the scale's settings),
 // kept to ask again without the prior's region (ContradictedByTheScans).
 struct FeatureMatches {
@@ -459,6 +489,7 @@ SacResult FastFeatureAlignment(const Prepared& prep, internal::TargetMemo& memo,
                                FeatureMatches& matches) {
   SacResult sac;
   for (const double scale : {1.0, 0.5}) {
+    if (scale != 1.0 && !SmallForFeatures(prep, config)) break;
     Stopwatch lap;
     RegistrationConfig c = config;
     c.feature_voxel_m *= scale;
@@ -1035,18 +1066,6 @@ struct IcpScene {
   const IcpTarget target;
   const PointCloud source;
 };
-
-// The voxels of the smaller ICP cloud when the pair is a confined scene (fewer than
-// confined_scene_voxels, backend fast), else none. The target's normals straddle a corner's edges
-// as much as the source's points do: either cloud confined makes the pair confined.
-std::optional<std::size_t> ConfinedVoxels(const Prepared& prep, const RegistrationConfig& config) {
-  const std::size_t fewest = std::min(prep.target_icp.size(), prep.source_icp.size());
-  if (config.backend != RegistrationBackend::kFast ||
-      fewest >= static_cast<std::size_t>(config.confined_scene_voxels)) {
-    return std::nullopt;
-  }
-  return fewest;
-}
 
 // What stages 3-6 work on: the input, the resolved settings and what stages 1-2 made of them.
 struct Stages {
