@@ -74,11 +74,13 @@ void VoxelHashIndex::ForCells(const Eigen::Vector3f& q, float radius_m, F&& f) c
     for (std::int64_t y = lo[1]; y <= hi[1]; ++y) {
       const Column* column = FindColumn(CellKey(x, y, 0) >> 21);
       if (!column) continue;
-      int first = column->first_cell;
-      while (first < column->end_cell && cells_[first].z < z_lo) ++first;
-      int end = first;
-      while (end < column->end_cell && cells_[end].z <= z_hi) ++end;
-      if (first < end) f(cells_[first].begin, cells_[end].begin);
+      // A column of a wall or a building holds tens of cells: searched, not walked.
+      const Cell* cells = cells_.data();
+      const Cell* first = std::lower_bound(cells + column->first_cell, cells + column->end_cell,
+                                           z_lo, [](const Cell& c, std::uint32_t z) { return c.z < z; });
+      const Cell* end = first;
+      while (end < cells + column->end_cell && end->z <= z_hi) ++end;  // at most 3 cells
+      if (first < end) f(first->begin, end->begin);
     }
   }
 }
