@@ -441,11 +441,16 @@ SacResult FastNarfAlignment(const PointCloud& target, const PointCloud& source,
   return sac;
 }
 
+// The voxels of the pair's smaller ICP cloud: how much surface both scans share at most.
+std::size_t SmallerIcpCloud(const Prepared& prep) {
+  return std::min(prep.target_icp.size(), prep.source_icp.size());
+}
+
 // The voxels of the smaller ICP cloud when the pair is a confined scene (fewer than
 // confined_scene_voxels, backend fast), else none. The target's normals straddle a corner's edges
 // as much as the source's points do: either cloud confined makes the pair confined.
 std::optional<std::size_t> ConfinedVoxels(const Prepared& prep, const RegistrationConfig& config) {
-  const std::size_t fewest = std::min(prep.target_icp.size(), prep.source_icp.size());
+  const std::size_t fewest = SmallerIcpCloud(prep);
   if (config.backend != RegistrationBackend::kFast ||
       fewest >= static_cast<std::size_t>(config.confined_scene_voxels)) {
     return std::nullopt;
@@ -461,8 +466,7 @@ std::optional<std::size_t> ConfinedVoxels(const Prepared& prep, const Registrati
 constexpr double kFeatureNeighbourhoods = 5;
 bool SmallForFeatures(const Prepared& prep, const RegistrationConfig& config) {
   const double disc = kPi * std::pow(config.feature_radius_m / config.icp_voxel_m, 2);
-  const std::size_t fewest = std::min(prep.target_icp.size(), prep.source_icp.size());
-  return static_cast<double>(fewest) < kFeatureNeighbourhoods * disc;
+  return static_cast<double>(SmallerIcpCloud(prep)) < kFeatureNeighbourhoods * disc;
 }
 
 // Our FPFH + RANSAC initial alignment. When it finds nothing at the configured scale in a scene

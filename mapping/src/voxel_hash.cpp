@@ -24,14 +24,12 @@ VoxelHashIndex::VoxelHashIndex(const PointCloud& cloud, double cell_m)
     points_[k] = cloud[order_[k]];
     sorted[k] = keys[order_[k]];
   }
+  std::size_t columns = 0;
   for (std::size_t k = 0; k < sorted.size(); ++k) {
     if (k == 0 || sorted[k] != sorted[k - 1]) {
       cells_.push_back({static_cast<std::uint32_t>(sorted[k] & 0x1FFFFF), static_cast<int>(k)});
+      columns += k == 0 || (sorted[k] >> 21) != (sorted[k - 1] >> 21);
     }
-  }
-  std::size_t columns = 0;
-  for (std::size_t c = 0; c < cells_.size(); ++c) {
-    columns += (c == 0 || (sorted[cells_[c].begin] >> 21) != (sorted[cells_[c - 1].begin] >> 21));
   }
   std::size_t size = 16;
   while (size < 2 * columns) size *= 2;  // load factor <= 0.5
