@@ -31,6 +31,8 @@
 #include <nlohmann/json.hpp>
 
 #include "pitchlab/mission/app_config.hpp"
+#include "bench_compare.hpp"
+#include "bench_records.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "interrupt.hpp"
@@ -39,6 +41,7 @@
 #include "pitchlab/worlds/world_catalog.hpp"
 #include "pitchlab/mission/run_config.hpp"
 #include "pitchlab/mission/run_folder.hpp"
+#include "sweep_statistics.hpp"
 #include "world_paths.hpp"
 
 namespace pitchlab::apps {
@@ -46,7 +49,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-using json = nlohmann::ordered_json;  // records keep their field order
+using json = BenchRecord;
 
 constexpr auto kPollPeriod = std::chrono::milliseconds(20);
 // How long an interrupted bench waits for its runs to remove their staging folders (a run's is at
@@ -134,11 +137,17 @@ CliArgs BenchArgs() {
       .Flag("round-trip",
             "every run drives to its world's default goal (through --via) and back to the start")
       .Flag("summarize", "merge the runs.jsonl of the given folders into one summary; no runs")
+      .Flag("compare",
+            "how the second of two bench folders differs from the first, world by world: each "
+            "metric's medians, the change with its 95 % bootstrap interval and a permutation "
+            "test's p-value, success with Fisher's exact test; no runs")
       .Flag("merge", "same as --summarize")
       .Flag("json", "print the summary as JSON on stdout (the table goes to stderr)")
       .Flag("quiet", "no progress on stderr")
-      .Positionals("[DIR...]", "with --summarize: bench folders (or runs.jsonl files) to merge", 0,
-                   1 << 20);
+      .Positionals("[DIR...]",
+                   "with --summarize: bench folders (or runs.jsonl files) to merge; with "
+                   "--compare: two of them, A then B",
+                   0, 1 << 20);
   return args;
 }
 
@@ -291,24 +300,6 @@ std::vector<BenchRun> ShardRuns(const std::vector<BenchWorld>& worlds,
 std::string RecordKey(const json& record) {
   return record.value("world", std::string()) + "-s" +
          std::to_string(record.value("seed", std::uint64_t{0}));
-}
-
-/// Every parseable record of `path` (none when it is missing); a torn last line is skipped.
-std::vector<json> ReadRecords(const fs::path& path) {
-  std::vector<json> records;
-  std::ifstream in(path);
-  std::string line;
-  for (int number = 1; std::getline(in, line); ++number) {
-    if (line.empty()) continue;
-    json record = json::parse(line, nullptr, /*allow_exceptions=*/false);
-    if (record.is_object() && record.contains("world") && record.contains("seed")) {
-      records.push_back(std::move(record));
-    } else {
-      std::fprintf(stderr, "bench: %s line %d is not a run record; ignored\n",
-                   path.string().c_str(), number);
-    }
-  }
-  return records;
 }
 
 /// runs.jsonl opened for appending whole lines; each Append reaches the file before it returns.
@@ -647,32 +638,9 @@ void RunSweep(const SweepSettings& s, const std::vector<BenchRun>& pending, Reco
 
 // ---- summary --------------------------------------------------------------------------------
 
-std::vector<double> Numbers(const std::vector<const json*>& records, const char* key) {
-  std::vector<double> v;
-  for (const json* r : records) {
-    if (r->contains(key) && (*r)[key].is_number()) v.push_back((*r)[key].get<double>());
-  }
-  return v;
-}
-
-json Median(std::vector<double> v) {
+json Median(const std::vector<double>& v) {
   if (v.empty()) return json();
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-// Each run's false hazard cells per cell compared [%], where the run reported them.
-std::vector<double> FalseHazardPercent(const std::vector<const json*>& records) {
-  std::vector<double> v;
-  for (const json* r : records) {
-    const json& f = r->value("false_hazard_cells", json());
-    const json& n = r->value("map_cells_compared", json());
-    if (f.is_number() && n.is_number() && n.get<double>() > 0) {
-      v.push_back(100.0 * f.get<double>() / n.get<double>());
-    }
-  }
-  return v;
+  return apps::Median(v);
 }
 
 // Null when no record has the value (runs without loop closure).
@@ -821,8 +789,7 @@ int SummarizeFolders(const CliArgs& args) {
   std::vector<json> records;
   std::vector<std::string> sources;
   for (const std::string& item : args.positionals()) {
-    const fs::path file = fs::is_directory(item) ? fs::path(item) / "runs.jsonl" : fs::path(item);
-    if (!fs::is_regular_file(file)) throw CliError("no runs.jsonl at '" + file.string() + "'");
+    const fs::path file = RecordsFile(item, "--summarize");
     std::vector<json> more = ReadRecords(file);
     for (json& r : more) r["bench_dir"] = file.parent_path().string();
     records.insert(records.end(), more.begin(), more.end());
@@ -921,6 +888,16 @@ int Sweep(const CliArgs& args) {
 int RunBench(int argc, char** argv) {
   CliArgs args = BenchArgs();
   if (!args.Parse(argc, argv)) return 0;
+  if (args.Flagged("compare")) {
+    if (args.Flagged("summarize") || args.Flagged("merge")) {
+      throw CliError("--compare and --summarize are two different modes: give one");
+    }
+    if (args.positionals().size() != 2) {
+      throw CliError("--compare needs two bench folders (A then B), got " +
+                     std::to_string(args.positionals().size()));
+    }
+    return CompareSweeps(args.positionals()[0], args.positionals()[1], args.Flagged("json"));
+  }
   if (args.Flagged("summarize") || args.Flagged("merge")) return SummarizeFolders(args);
   return Sweep(args);
 }

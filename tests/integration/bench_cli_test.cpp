@@ -263,5 +263,60 @@ TEST_F(BenchCli, BadInputGivesAClearErrorBeforeAnyRunStarts) {
   EXPECT_NE(missing.err.find("no runs.jsonl"), std::string::npos) << missing.err;
 }
 
+// `--compare A B` on two recorded sweeps (no runs): the same runs twice show no change; a world
+// whose runs all got slower and half of them failed shows the change, its interval and p-values
+// that tell it apart; a world in one sweep only is named, not compared.
+TEST_F(BenchCli, CompareTellsTwoSweepsApartWorldByWorld) {
+  const fs::path a = dir_ / "compare_a", b = dir_ / "compare_b";
+  fs::create_directories(a);
+  fs::create_directories(b);
+  std::ofstream ra(a / "runs.jsonl"), rb(b / "runs.jsonl");
+  for (int seed = 1; seed <= 20; ++seed) {
+    const json run = {{"world", "yard"},         {"seed", seed},
+                      {"success", true},         {"wall_time_s", 10.0 + seed % 5},
+                      {"false_hazard_cells", 3}, {"map_cells_compared", 1000}};
+    ra << run.dump() << "\n";
+    json slower = run;
+    slower["wall_time_s"] = 100.0 + seed % 5;
+    slower["success"] = seed % 2 == 0;
+    rb << slower.dump() << "\n";
+  }
+  rb << json({{"world", "gully"}, {"seed", 1}, {"success", true}}).dump() << "\n";
+  ra.close();
+  rb.close();
+  const CliResult same = Exec("--compare " + a.string() + " " + a.string() + " --json");
+  ASSERT_EQ(same.exit_code, 0) << same.err;
+  const json s = json::parse(same.out)["worlds"]["yard"];
+  EXPECT_EQ(s["metrics"]["wall_time_s"]["change"].get<double>(), 0.0);
+  EXPECT_EQ(s["metrics"]["wall_time_s"]["p_value"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(s["metrics"]["false_hazard_percent"]["median_a"].get<double>(), 0.3);
+  EXPECT_EQ(s["success"]["p_value"].get<double>(), 1.0);
+
+  const CliResult apart = Exec("--compare " + a.string() + " " + b.string() + " --json");
+  ASSERT_EQ(apart.exit_code, 0) << apart.err;
+  const json report = json::parse(apart.out);
+  const json& wall = report["worlds"]["yard"]["metrics"]["wall_time_s"];
+  EXPECT_DOUBLE_EQ(wall["change"].get<double>(), 90.0);
+  EXPECT_LT(wall["p_value"].get<double>(), 0.001);
+  EXPECT_GE(wall["interval_95"][0].get<double>(), 86.0);  // 100 - 14 at the least
+  EXPECT_LE(wall["interval_95"][1].get<double>(), 94.0);
+  const json& success = report["worlds"]["yard"]["success"];
+  EXPECT_EQ(success["a"].get<int>(), 20);
+  EXPECT_EQ(success["b"].get<int>(), 10);
+  EXPECT_LT(success["p_value"].get<double>(), 0.001);
+  EXPECT_EQ(report["worlds"]["gully"]["runs_a"].get<int>(), 0);
+  EXPECT_FALSE(report["worlds"]["gully"].contains("metrics"));
+  // The table, on stderr beside --json, names what it compares.
+  EXPECT_NE(apart.err.find("wall per run [s]"), std::string::npos) << apart.err;
+  EXPECT_NE(apart.err.find("(Fisher)"), std::string::npos) << apart.err;
+
+  const CliResult one = Exec("--compare " + a.string());
+  EXPECT_EQ(one.exit_code, 2);
+  EXPECT_NE(one.err.find("--compare needs two bench folders"), std::string::npos) << one.err;
+  const CliResult missing = Exec("--compare " + a.string() + " " + (dir_ / "nowhere").string());
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("no runs.jsonl"), std::string::npos) << missing.err;
+}
+
 }  // namespace
 }  // namespace pitchlab
