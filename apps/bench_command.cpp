@@ -114,8 +114,10 @@ CliArgs BenchArgs() {
       "summary per world is printed and written to DIR/summary.json. With --shard K/N\n"
       "only runs whose index % N == K-1 are run, e.g. --shard\n"
       "$SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT; merge the shards' folders with\n"
-      "--summarize DIR1 DIR2 ... . Exit 0 when every run of the shard is recorded\n"
-      "(failed runs are results, see the summary); 2 on bad input.");
+      "--summarize DIR1 DIR2 ... . `--compare A B` says whether sweep B differs from\n"
+      "sweep A, world by world (medians, intervals, p-values; no runs). Exit 0 when every\n"
+      "run of the shard is recorded (failed runs are results, see the summary); 2 on bad\n"
+      "input.");
   args.Option("worlds", "W1,W2,...", "built-in worlds (" + BuiltinWorldNames() + ") or MJCF files",
               "office,urban,terrain,gully")
       .Option("seeds", "A..B|S1,S2,...", "seeds: ranges and lists, e.g. 1..20 or 1,5,9 or 1..3,7",
