@@ -299,11 +299,6 @@ std::vector<BenchRun> ShardRuns(const std::vector<BenchWorld>& worlds,
 
 // ---- runs.jsonl -----------------------------------------------------------------------------
 
-std::string RecordKey(const json& record) {
-  return record.value("world", std::string()) + "-s" +
-         std::to_string(record.value("seed", std::uint64_t{0}));
-}
-
 /// runs.jsonl opened for appending whole lines; each Append reaches the file before it returns.
 class RecordLog {
  public:
@@ -704,15 +699,10 @@ json SummaryRow(const std::string& world, const std::vector<const json*>& record
 
 /// Rows per world (sorted by name) and one over everything; a run recorded twice counts once.
 json Summarize(const std::vector<json>& records, const std::vector<std::string>& sources) {
-  std::map<std::string, const json*> unique;  // key -> first record
   std::size_t duplicates = 0;
-  for (const json& r : records) duplicates += !unique.emplace(RecordKey(r), &r).second;
-  std::map<std::string, std::vector<const json*>> by_world;
+  const RunsByWorld by_world = UniqueRunsByWorld(records, &duplicates);
   std::vector<const json*> all;
-  for (const auto& [key, r] : unique) {
-    by_world[(*r)["world"].get<std::string>()].push_back(r);
-    all.push_back(r);
-  }
+  for (const auto& [world, rs] : by_world) all.insert(all.end(), rs.begin(), rs.end());
   json rows = json::array();
   for (const auto& [world, rs] : by_world) rows.push_back(SummaryRow(world, rs));
   if (duplicates > 0) {

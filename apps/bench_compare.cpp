@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <map>
 #include <vector>
 
 #include "bench_records.hpp"
@@ -34,14 +33,6 @@ const Metric kMetrics[] = {
     {"forbidden_cells_crossed", "forbidden cells crossed"},
     {"hazard_cells_crossed", "hazard cells crossed"},
 };
-
-using ByWorld = std::map<std::string, std::vector<const json*>>;
-
-ByWorld GroupByWorld(const std::vector<json>& records) {
-  ByWorld out;
-  for (const json& r : records) out[r.value("world", std::string("?"))].push_back(&r);
-  return out;
-}
 
 std::vector<double> Values(const std::vector<const json*>& runs, const Metric& m) {
   return std::string(m.key) == kFalseHazards ? FalseHazardPercent(runs) : Numbers(runs, m.key);
@@ -124,20 +115,16 @@ void PrintTable(const json& report, std::FILE* out) {
 int CompareSweeps(const std::string& a, const std::string& b, bool as_json) {
   const fs::path file_a = RecordsFile(a, "--compare"), file_b = RecordsFile(b, "--compare");
   const std::vector<json> records_a = ReadRecords(file_a), records_b = ReadRecords(file_b);
-  const ByWorld world_a = GroupByWorld(records_a), world_b = GroupByWorld(records_b);
-  std::map<std::string, bool> worlds;
-  for (const auto& [w, runs] : world_a) worlds[w] = true;
-  for (const auto& [w, runs] : world_b) worlds[w] = true;
+  // A run recorded twice counts once, as in the sweep's own summary.
+  RunsByWorld world_a = UniqueRunsByWorld(records_a), world_b = UniqueRunsByWorld(records_b);
   json report = {{"a", file_a.string()},
                  {"b", file_b.string()},
                  {"resamples", kResamples},
                  {"seed", kSeed},
                  {"worlds", json::object()}};
-  const std::vector<const json*> none;
-  for (const auto& [w, unused] : worlds) {
-    const auto ia = world_a.find(w), ib = world_b.find(w);
-    const std::vector<const json*>& ra = ia == world_a.end() ? none : ia->second;
-    const std::vector<const json*>& rb = ib == world_b.end() ? none : ib->second;
+  for (const auto& [w, runs] : world_b) world_a[w];  // every world of either: empty in A if not
+  for (const auto& [w, ra] : world_a) {
+    const std::vector<const json*>& rb = world_b[w];
     if (ra.empty() || rb.empty()) {
       report["worlds"][w] = {{"runs_a", ra.size()}, {"runs_b", rb.size()}};
     } else {

@@ -1,5 +1,6 @@
 #include "bench_records.hpp"
 
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 
@@ -24,6 +25,23 @@ std::vector<BenchRecord> ReadRecords(const fs::path& path) {
     }
   }
   return records;
+}
+
+std::string RecordKey(const BenchRecord& record) {
+  return record.value("world", std::string()) + "-s" +
+         std::to_string(record.value("seed", std::uint64_t{0}));
+}
+
+RunsByWorld UniqueRunsByWorld(const std::vector<BenchRecord>& records, std::size_t* duplicates) {
+  std::map<std::string, const BenchRecord*> unique;  // key -> first record
+  std::size_t repeated = 0;
+  for (const BenchRecord& r : records) repeated += !unique.emplace(RecordKey(r), &r).second;
+  if (duplicates) *duplicates = repeated;
+  RunsByWorld by_world;
+  for (const auto& [key, r] : unique) {
+    by_world[r->value("world", std::string())].push_back(r);
+  }
+  return by_world;
 }
 
 fs::path RecordsFile(const std::string& item, const char* option) {

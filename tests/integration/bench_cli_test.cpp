@@ -263,9 +263,10 @@ TEST_F(BenchCli, BadInputGivesAClearErrorBeforeAnyRunStarts) {
   EXPECT_NE(missing.err.find("no runs.jsonl"), std::string::npos) << missing.err;
 }
 
-// `--compare A B` on two recorded sweeps (no runs): the same runs twice show no change; a world
-// whose runs all got slower and half of them failed shows the change, its interval and p-values
-// that tell it apart; a world in one sweep only is named, not compared.
+// `--compare A B` on two recorded sweeps (no runs; a run recorded twice counts once): the same
+// runs twice show no change; a world whose runs all got slower and half of them failed shows the
+// change, its interval and p-values that tell it apart; a world in one sweep only is named, not
+// compared.
 TEST_F(BenchCli, CompareTellsTwoSweepsApartWorldByWorld) {
   const fs::path a = dir_ / "compare_a", b = dir_ / "compare_b";
   fs::create_directories(a);
@@ -282,11 +283,15 @@ TEST_F(BenchCli, CompareTellsTwoSweepsApartWorldByWorld) {
     rb << slower.dump() << "\n";
   }
   rb << json({{"world", "gully"}, {"seed", 1}, {"success", true}}).dump() << "\n";
+  // A resumed sweep's second record of a run: the first counts, as in the summary.
+  ra << json({{"world", "yard"}, {"seed", 3}, {"success", false}, {"wall_time_s", 1000.0}}).dump()
+     << "\n";
   ra.close();
   rb.close();
   const CliResult same = Exec("--compare " + a.string() + " " + a.string() + " --json");
   ASSERT_EQ(same.exit_code, 0) << same.err;
   const json s = json::parse(same.out)["worlds"]["yard"];
+  EXPECT_EQ(s["runs_a"].get<int>(), 20);
   EXPECT_EQ(s["metrics"]["wall_time_s"]["change"].get<double>(), 0.0);
   EXPECT_EQ(s["metrics"]["wall_time_s"]["p_value"].get<double>(), 1.0);
   EXPECT_DOUBLE_EQ(s["metrics"]["false_hazard_percent"]["median_a"].get<double>(), 0.3);
