@@ -269,6 +269,7 @@ class Mission {
   // Of the odometry distance, how much was driven on level ground (kLevelTilt_rad): in total, and
   // at the last merged scan [m].
   double level_distance_m_ = 0, merged_level_m_ = 0;
+  int last_plan_stop_ = -1;             // the last stop that planned, on grid_
   bool last_stop_turned_only_ = false;  // the previous stop only turned to look ahead
   bool closing_look_ = false;           // ClosingLook's stop is under way
   bool backed_off_ = false;             // the last drive ended backing off from a tilt
@@ -317,6 +318,10 @@ MissionResult Mission::Run(const Eigen::Isometry3d& T_world_start) {
   result_.loop_counts = builder_.loop_closures();
   result_.loop_closures = builder_.accepted_loops();
   SetFinalPoses();
+  if (!result_.success && last_plan_stop_ >= 0) {
+    result_.last_plan_stop = last_plan_stop_;
+    result_.last_plan_grid = std::move(grid_);
+  }
   return std::move(result_);
 }
 
@@ -677,6 +682,7 @@ tl::expected<planning::Path, planning::NoPath> Mission::PlanOn(
 }
 
 void Mission::Plan(StopRecord& stop) {
+  last_plan_stop_ = stop.index;
   sensors::Stopwatch watch;
   mapping::ComputeLayersInto(result_.elevation, config_.layers, layers_);
   for (const FeltHazard& f : felt_) MarkFelt(layers_, f);

@@ -86,6 +86,25 @@ mapping::ElevationMap PictureRegion(const mapping::ElevationMap& map,
   return out;
 }
 
+// last_plan.png of a failed run: the grid its last plan was made on, that plan, and the run's
+// tracks (estimated orange, true blue): where the robot meant to go and where it went.
+void WriteLastPlanPicture(RunFolder& folder, const MissionResult& r, const MapWindow& window,
+                          const FigureMarks& marks, const std::vector<Eigen::Vector2d>& est,
+                          const std::vector<Eigen::Vector2d>& tru) {
+  const planning::TraversabilityGrid& grid = r.last_plan_grid;
+  const mapping::GridGeometry& g = grid.geometry;
+  const auto stop = std::find_if(r.stops.begin(), r.stops.end(),
+                                 [&](const StopRecord& s) { return s.index == r.last_plan_stop; });
+  if (stop == r.stops.end() || grid.blocked.size() != g.cell_count()) return;
+  mapping::ImageOptions options;
+  options.pixels_per_cell = FigurePixelsPerCell(g, window);
+  mapping::RgbImage image = RenderTraversability(grid, options);
+  if (stop->plan) planning::DrawPath(*stop->plan, g, image);
+  DrawPolyline(image, g, est, 255, 140, 0);
+  DrawPolyline(image, g, tru, 30, 80, 255);
+  Write(ComposeMapFigure(image, g, window, marks), folder.File("last_plan.png"));
+}
+
 }  // namespace
 
 std::vector<Eigen::Vector2d> TrajectoryXy(const MissionResult& r, bool truth) {
@@ -148,6 +167,7 @@ void WriteRunPictures(RunFolder& folder, const RunContext& c, const MissionResul
   const planning::TraversabilityGrid estimated = planning::BuildTraversability(layers, c.planner);
   Write(ComposeMapFigure(RenderTraversability(estimated, options), g, window, marks),
         folder.File("traversability.png"));
+  if (!r.success && r.last_plan_stop >= 0) WriteLastPlanPicture(folder, r, window, marks, est, tru);
   if (!truth) return;
   const planning::TraversabilityGrid true_grid = truth_pictures.get();
   // The picture of map_hazards: the same grids ScoreRun compares (same layers, same planner).

@@ -21,8 +21,10 @@ std::vector<Eigen::Vector2d> TrajectoryXy(const MissionResult& result, bool trut
 
 /// Writes elevation.png (estimated map, every plan in red, estimated trajectory orange, true
 /// blue, colour bar), traversability.png and, with `truth`: truth_elevation.png (true optimal
-/// path red, true trajectory blue), truth_traversability.png and hazard_errors.png. Throws
-/// std::runtime_error naming the file on a write failure.
+/// path red, true trajectory blue), truth_traversability.png and hazard_errors.png. A failed run
+/// also gets last_plan.png: the traversability its last plan was made on (the mission's own grid,
+/// MissionResult::last_plan_grid), that plan in red, and the run's tracks (estimated orange, true
+/// blue). Throws std::runtime_error naming the file on a write failure.
 void WriteRunPictures(RunFolder& folder, const RunContext& context, const MissionResult& result,
                       const mapping::ElevationLayers& layers, const mapping::ElevationLayers* truth,
                       const std::optional<planning::Path>& truth_optimum);

@@ -123,6 +123,14 @@ RunReportInput GatherRunReport(const RunFolder& folder, const RunContext& c, con
                            "metrics). " +
                                HazardErrorsLegend()});
   }
+  if (std::filesystem::exists(in.folder / "last_plan.png")) {
+    in.pictures.push_back(
+        {"last_plan.png", "the last plan of the failed run, on the grid it was made on",
+         "Stop " + std::to_string(r.last_plan_stop) +
+             "'s traversability as the mission planned on it (its refuted gaps and recoveries "
+             "included), its plan (red) and the run's tracks: estimated (orange), true (blue)." +
+             marks});
+  }
   in.trajectories = {{"estimated", "#e08000", TrajectoryXy(r, false), false},
                      {"true", "#1e50ff", TrajectoryXy(r, true), true}};
   in.markers = {{"start", "#111111", c.start.head<2>()}, {"goal", "#d01010", c.goal}};

@@ -2,6 +2,7 @@
 
 #include <sys/wait.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <png.h>
 #include <yaml-cpp/yaml.h>
 #include <nlohmann/json.hpp>
 
@@ -120,6 +122,7 @@ TEST_F(RunCli, AMissionAroundABlockReachesTheGoalAndWritesEveryOutput) {
                           "truth_traversability.png", "hazard_errors.png"}) {
     EXPECT_EQ(Slurp(run / png).substr(1, 3), "PNG") << png;
   }
+  EXPECT_FALSE(fs::exists(run / "last_plan.png"));  // a failed run's picture
   for (const char* csv : {"trajectory_estimated.csv", "trajectory_true.csv"}) {
     const std::string text = Slurp(run / csv);
     EXPECT_EQ(text.rfind("stamp_s,x_m,y_m,z_m", 0), 0u) << csv;
@@ -141,6 +144,56 @@ struct BadRun {
 
 // The README's main job runs `pitchlab run` with no --out in a fresh clone: the default
 // runs/<world>-s<seed>-<time> is created with its missing runs/ folder (it once was refused).
+struct Rgb8 {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgb;
+  int Count(std::uint8_t r, std::uint8_t g, std::uint8_t b) const {
+    int n = 0;
+    for (std::size_t k = 0; k + 2 < rgb.size(); k += 3) {
+      n += rgb[k] == r && rgb[k + 1] == g && rgb[k + 2] == b;
+    }
+    return n;
+  }
+};
+
+Rgb8 ReadPng(const fs::path& file) {
+  png_image image{};
+  image.version = PNG_IMAGE_VERSION;
+  Rgb8 out;
+  if (!png_image_begin_read_from_file(&image, file.c_str())) return out;
+  image.format = PNG_FORMAT_RGB;
+  out.rgb.resize(PNG_IMAGE_SIZE(image));
+  if (!png_image_finish_read(&image, nullptr, out.rgb.data(), 0, nullptr)) return {};
+  out.width = static_cast<int>(image.width);
+  out.height = static_cast<int>(image.height);
+  return out;
+}
+
+// A run that fails shows the grid its last plan was made on, that plan and where the robot went
+// (estimated and true tracks): here the stop limit ends the run at its second stop's plan.
+TEST_F(RunCli, AFailedRunShowsItsLastPlanOnTheGridItWasMadeOn) {
+  std::ofstream(dir_ / "two_stops.yaml") << "run: {max_stops: 2}\n";
+  const fs::path run = dir_ / "ok_two_stops";
+  const CliResult r = Exec("run --world " + kYard.string() + " --seed 3 --json --quiet --config " +
+                           (dir_ / "two_stops.yaml").string() + " --out " + run.string());
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  const nlohmann::json metrics = nlohmann::json::parse(Slurp(run / "metrics.json"));
+  ASSERT_FALSE(metrics["success"].get<bool>());
+  EXPECT_NE(metrics["reason"].get<std::string>().find("stop limit"), std::string::npos);
+  const Rgb8 last = ReadPng(run / "last_plan.png"), map = ReadPng(run / "traversability.png");
+  ASSERT_GT(last.width, 0);
+  // The same window and scale as the run's other pictures.
+  EXPECT_EQ(last.width, map.width);
+  EXPECT_EQ(last.height, map.height);
+  // The plan in red (planning::DrawPath), the true track in blue; the final map's picture has
+  // neither.
+  EXPECT_GT(last.Count(230, 20, 20), 100);
+  EXPECT_GT(last.Count(30, 80, 255), 10);
+  EXPECT_EQ(map.Count(230, 20, 20), 0);
+  EXPECT_EQ(map.Count(30, 80, 255), 0);
+  EXPECT_NE(Slurp(run / "report.html").find("last_plan.png"), std::string::npos);
+}
+
 TEST_F(RunCli, WithoutOutTheRunGoesToANewRunsFolderInTheWorkingFolder) {
   const fs::path cwd = dir_ / "ok_default_out";
   fs::create_directories(cwd);

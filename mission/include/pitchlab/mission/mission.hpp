@@ -205,6 +205,11 @@ struct MissionResult {
   /// With calibrate_mount: the mount the first scan's floor gave, or why there is none.
   std::optional<mapping::MountFromFloor> mount_calibration;
   std::string mount_calibration_note;
+  /// When the run failed: the last stop that planned (StopRecord::index; -1 none) and the grid it
+  /// planned on, as the mission had it (its refuted gaps, a recovery's relaxed cells), which the
+  /// run's traversability.png, rebuilt from the final map, does not show. Empty on success.
+  int last_plan_stop = -1;
+  planning::TraversabilityGrid last_plan_grid;
 };
 
 /// Called after each stop is planned (for output as it happens) and with progress text.
