@@ -2,7 +2,6 @@
 
 #include <sys/wait.h>
 
-#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -10,7 +9,6 @@
 #include <vector>
 
 #include <gtest/gtest.h>
-#include <png.h>
 #include <yaml-cpp/yaml.h>
 #include <nlohmann/json.hpp>
 
@@ -18,6 +16,7 @@
 #include "pitchlab/sensors/scan_pcd.hpp"
 
 #include "cli_support.hpp"
+#include "png_pixels.hpp"
 
 namespace pitchlab {
 namespace {
@@ -25,6 +24,8 @@ namespace {
 namespace fs = std::filesystem;
 using cli_test::CliResult;
 using cli_test::Slurp;
+using test_support::ReadPng;
+using test_support::Rgb8;
 
 const fs::path kYard = fs::path(PITCHLAB_SOURCE_DIR) / "tests/data/worlds/yard.xml";
 
@@ -142,33 +143,6 @@ struct BadRun {
   std::string args, message;
 };
 
-// The README's main job runs `pitchlab run` with no --out in a fresh clone: the default
-// runs/<world>-s<seed>-<time> is created with its missing runs/ folder (it once was refused).
-struct Rgb8 {
-  int width = 0, height = 0;
-  std::vector<std::uint8_t> rgb;
-  int Count(std::uint8_t r, std::uint8_t g, std::uint8_t b) const {
-    int n = 0;
-    for (std::size_t k = 0; k + 2 < rgb.size(); k += 3) {
-      n += rgb[k] == r && rgb[k + 1] == g && rgb[k + 2] == b;
-    }
-    return n;
-  }
-};
-
-Rgb8 ReadPng(const fs::path& file) {
-  png_image image{};
-  image.version = PNG_IMAGE_VERSION;
-  Rgb8 out;
-  if (!png_image_begin_read_from_file(&image, file.c_str())) return out;
-  image.format = PNG_FORMAT_RGB;
-  out.rgb.resize(PNG_IMAGE_SIZE(image));
-  if (!png_image_finish_read(&image, nullptr, out.rgb.data(), 0, nullptr)) return {};
-  out.width = static_cast<int>(image.width);
-  out.height = static_cast<int>(image.height);
-  return out;
-}
-
 // A run that fails shows the grid its last plan was made on, that plan and where the robot went
 // (estimated and true tracks): here the stop limit ends the run at its second stop's plan.
 TEST_F(RunCli, AFailedRunShowsItsLastPlanOnTheGridItWasMadeOn) {
@@ -187,13 +161,15 @@ TEST_F(RunCli, AFailedRunShowsItsLastPlanOnTheGridItWasMadeOn) {
   EXPECT_EQ(last.height, map.height);
   // The plan in red (planning::DrawPath), the true track in blue; the final map's picture has
   // neither.
-  EXPECT_GT(last.Count(230, 20, 20), 100);
-  EXPECT_GT(last.Count(30, 80, 255), 10);
-  EXPECT_EQ(map.Count(230, 20, 20), 0);
-  EXPECT_EQ(map.Count(30, 80, 255), 0);
+  EXPECT_GT(last.Count({230, 20, 20}), 100);
+  EXPECT_GT(last.Count({30, 80, 255}), 10);
+  EXPECT_EQ(map.Count({230, 20, 20}), 0);
+  EXPECT_EQ(map.Count({30, 80, 255}), 0);
   EXPECT_NE(Slurp(run / "report.html").find("last_plan.png"), std::string::npos);
 }
 
+// The README's main job runs `pitchlab run` with no --out in a fresh clone: the default
+// runs/<world>-s<seed>-<time> is created with its missing runs/ folder (it once was refused).
 TEST_F(RunCli, WithoutOutTheRunGoesToANewRunsFolderInTheWorkingFolder) {
   const fs::path cwd = dir_ / "ok_default_out";
   fs::create_directories(cwd);

@@ -1,8 +1,6 @@
 // report.html in a real browser (Debian's chromium, headless, software WebGL): what a reader sees
 // at 1366 and 1920 px, checked in the page's layout and in the screenshot's pixels, and the 3D
 // view checked by what it drew. Skipped only when chromium is not installed.
-#include <png.h>
-
 #include <array>
 #include <cstdio>
 #include <fstream>
@@ -13,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "png_pixels.hpp"
 #include "run_report.hpp"
 #include "synthetic_report.hpp"
 
@@ -88,29 +87,8 @@ std::string Unescape(std::string s) {
   return s;
 }
 
-struct Rgb8 {
-  int width = 0, height = 0;
-  std::vector<std::uint8_t> rgb;
-  int Count(std::array<int, 3> c) const {
-    int n = 0;
-    for (std::size_t k = 0; k + 2 < rgb.size(); k += 3)
-      n += rgb[k] == c[0] && rgb[k + 1] == c[1] && rgb[k + 2] == c[2];
-    return n;
-  }
-};
-
-Rgb8 ReadPng(const fs::path& file) {
-  png_image image{};
-  image.version = PNG_IMAGE_VERSION;
-  Rgb8 out;
-  if (!png_image_begin_read_from_file(&image, file.c_str())) return out;
-  image.format = PNG_FORMAT_RGB;
-  out.rgb.resize(PNG_IMAGE_SIZE(image));
-  if (!png_image_finish_read(&image, nullptr, out.rgb.data(), 0, nullptr)) return {};
-  out.width = static_cast<int>(image.width);
-  out.height = static_cast<int>(image.height);
-  return out;
-}
+using test_support::ReadPng;
+using test_support::Rgb8;
 
 // Chromium on the page; returns its standard output, its standard error in `err`.
 std::string RunChromium(const fs::path& page, const fs::path& profile, int width_px,
