@@ -138,12 +138,19 @@ struct Weakness {
   bool any() const { return !translations.empty() || !rotation_axes.empty(); }
 };
 
+/// ICP's robust kernel (PointToPlaneLm), both of scale 2 cm at the robot's scale (length_scale).
+/// Huber: every pair keeps a constant pull (the scale also at least a fifth of the gate), which
+/// finding the basin needs while the pose is still far off. Cauchy: a pair r off pulls as
+/// c^2 / r beyond the scale, for the final fit at the inlier band, where a pair several
+/// centimetres off lies on another surface (fast_pipeline.cpp).
+enum class IcpKernel { kHuber, kCauchy };
+
 /// Point-to-plane ICP, each iteration a Levenberg-Marquardt step on fixed correspondences; stops
 /// when the relative error change < epsilon or after icp_max_iterations. The `frozen` directions
 /// are kept at the initial guess (solution remapping).
 IcpResult PointToPlaneLm(const IcpTarget& target, const PointCloud& source,
                          const Eigen::Isometry3d& init, const RegistrationConfig& config,
-                         const Weakness& frozen);
+                         const Weakness& frozen, IcpKernel kernel = IcpKernel::kHuber);
 
 /// Scores `T` without moving it: inliers within inlier_distance_m, RMS point-to-plane error, and
 /// the weakest/strongest eigenvalue ratio of the translation constraint (sum of n n^T).
