@@ -476,8 +476,8 @@ namespace {
 // fifth of the gate. Cauchy (IcpKernel::kCauchy) lets a pair on another surface (an overlap's
 // ragged edge, the far side of a pole) 5-10 cm off pull as c^2 / r rather than Huber's constant
 // c: summed over a partial overlap those constant pulls moved the pose along weak directions
-// (registration_eval urban pair 104: 4.4 cm / 0.31 deg off with Huber throughout; the final
-// refinement with Cauchy, registration.cpp, ends 0.8 cm / 0.07 deg off).
+// (registration_eval urban pair 104: 4.4 cm / 0.31 deg off with Huber throughout; after the
+// final refinement with Cauchy, registration.cpp, 0.8 cm / 0.07 deg).
 class RobustKernel {
  public:
   RobustKernel(IcpKernel kind, double length_scale, double gate)

@@ -1316,12 +1316,13 @@ bool ContradictedBound(const Stages& s, const FeatureMatches& matches, Progress&
 // kernel (IcpKernel): along a weak direction (an open slope's, a street's) the minimum of 3000
 // points lies where their sampling puts it, and pairs on surfaces only one scan saw pull it
 // further (registration_eval terrain pair 163: started from the true pose itself, ICP on the
-// subsample settled 4.6 cm off, on all 12000 voxels 0.8 cm). ICP creeps along such a direction by
-// under a millimetre an iteration (pair 163: 2.5 / 1.9 / 1.2 / 0.9 cm after 5 / 10 / 20 / 40),
-// and an iteration over the whole source costs about four over the subsample: kRefineIterations
-// of them add ~45 ms CPU to a mission stop's ~170. The refined pose is scored on the subsample
-// like every other pose, so its gates and covariance mean what they did, and kept when it passes
-// the same acceptance test (else the accepted pose stands).
+// subsample settled 4.6 cm off, on all 12000 voxels 0.8 cm). ICP then creeps along such a
+// direction by about a millimetre an iteration (pair 163: 2.5 / 1.9 / 1.2 / 0.9 cm after 5 / 10 /
+// 20 / 40; urban pair 104: 2.8 / 0.8 cm after 5 / 10), and an iteration over the whole source costs
+// about four over the subsample: ten add ~45 ms CPU to a terrain mission stop's ~170 (urban runs
+// about a tenth longer; benchmarks/README.md, session 30). The refined pose is scored on the
+// subsample like every other pose, so its gates and covariance mean what they did, and kept when
+// it passes the same acceptance test (else the accepted pose stands).
 constexpr int kRefineIterations = 10;
 void RefineOverTheWholeSource(const Stages& s, const Weakness& frozen, Progress& run) {
   if (s.prep.source_icp.size() <= s.scene.source.size()) return;  // ICP saw all of it
