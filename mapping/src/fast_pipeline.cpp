@@ -514,7 +514,7 @@ IcpResult PointToPlaneLm(const IcpTarget& target, const PointCloud& source,
   double gate = config.icp_max_distance_m, lambda = 1e-4, prev_mean = -1;
   // The gate shrinks to icp_min_distance_m, then to the inlier band (registration_config.hpp).
   double gate_floor = config.icp_min_distance_m;
-  const double band = std::min(gate_floor, config.inlier_distance_m);
+  const double band = InlierBand(config);
   std::vector<Pair> pairs;
   for (int iter = 0; iter < config.icp_max_iterations; ++iter) {
     FindPairs(target, source, result.T_target_source, static_cast<float>(gate), pairs);

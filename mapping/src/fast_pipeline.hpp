@@ -2,6 +2,7 @@
 // Our own implementation of the registration stages (backend "fast"): PCA normals, FPFH,
 // correspondence RANSAC with edge prerejection, point-to-plane ICP with Levenberg-Marquardt.
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -137,6 +138,12 @@ struct Weakness {
   std::vector<double> translation_ratios, rotation_ratios;
   bool any() const { return !translations.empty() || !rotation_axes.empty(); }
 };
+
+/// The gate ICP ends at (PointToPlaneLm): icp_min_distance_m, or the inlier band (inlier_distance_m)
+/// when that is narrower [m].
+inline double InlierBand(const RegistrationConfig& config) {
+  return std::min(config.icp_min_distance_m, config.inlier_distance_m);
+}
 
 /// ICP's robust kernel (PointToPlaneLm), both of scale 2 cm at the robot's scale (length_scale).
 /// Huber: every pair keeps a constant pull (the scale also at least a fifth of the gate), which

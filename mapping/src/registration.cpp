@@ -1327,8 +1327,7 @@ constexpr int kRefineIterations = 10;
 void RefineOverTheWholeSource(const Stages& s, const Weakness& frozen, Progress& run) {
   if (s.prep.source_icp.size() <= s.scene.source.size()) return;  // ICP saw all of it
   RegistrationConfig band = s.config;
-  band.icp_max_distance_m = band.icp_min_distance_m =
-      std::min(s.config.icp_min_distance_m, s.config.inlier_distance_m);
+  band.icp_max_distance_m = band.icp_min_distance_m = InlierBand(s.config);
   band.icp_max_iterations = std::min(s.config.icp_max_iterations, kRefineIterations);
   const IcpResult fine =
       PointToPlaneLm(s.scene.target, s.prep.source_icp, run.out.T_target_source, band, frozen,
@@ -1342,13 +1341,13 @@ void RefineOverTheWholeSource(const Stages& s, const Weakness& frozen, Progress&
 // 7. A success in a confined scene refined and judged again at half the scale (RefineConfined);
 // the outcome and the covariance of the pose (Conclude).
 void Finish(const Stages& s, const Verdict& verdict, Progress& run) {
-  if (run.out.success && !s.confined_voxels) {
-    RefineOverTheWholeSource(s, verdict.frozen, run);
-    run.out.timings.icp_s += run.lap.Lap();
-  }
-  if (run.out.success && s.confined_voxels) {
-    RefineConfined(s.target, s.source, s.prep.target_sensor, *s.confined_voxels, verdict.frozen,
-                   s.prior, s.config, run.out);
+  if (run.out.success) {
+    if (s.confined_voxels) {
+      RefineConfined(s.target, s.source, s.prep.target_sensor, *s.confined_voxels, verdict.frozen,
+                     s.prior, s.config, run.out);
+    } else {
+      RefineOverTheWholeSource(s, verdict.frozen, run);
+    }
     run.out.timings.icp_s += run.lap.Lap();
   }
   Conclude(run.out, verdict.ambiguous, verdict.frozen, s.prior, s.config);
