@@ -39,7 +39,7 @@ const char* StageLabel(Stage stage) {
     case Stage::kPhysicsStanding:
       return "physics while standing to scan";
     case Stage::kRayCasting:
-      return "ray casting (the scan's lines)";
+      return "ray casting (the scan's lines; wall: what the physics beside it did not hide)";
     case Stage::kRegistration:
       return "registration";
     case Stage::kMapUpdate:

@@ -247,6 +247,9 @@ class EmbreeRayCaster final : public RayCaster {
     }
   }
 
+  // Cast reads the Embree scenes only, never the mjData: static without moving geoms.
+  bool Static() const override { return moving_.empty(); }
+
   void Refresh() override {
     if (moving_.empty()) return;
     float xfm[12];

@@ -41,6 +41,15 @@ Result<Scan3D> PitchingScanSource::Acquire() {
   lines.reserve(static_cast<std::size_t>(n));
   std::vector<Eigen::Quaterniond> attitudes;
   bool attitude_known = static_cast<bool>(attitude_);
+  // The scanner's sweep, ended on every way out: its lines kept once all are in, else dropped.
+  struct Sweep {
+    LineScanner& scanner;
+    bool ended = false;
+    ~Sweep() {
+      if (!ended) scanner.EndSweep(nullptr);
+    }
+  } sweep{scanner_};
+  scanner_.BeginSweep();
   for (int k = 0; k < n; ++k) {
     const double target_rad = (pattern_.pitch_start_deg + k * step_deg) * kDegToRad;
     Result<double> encoder_rad = axis_.MoveTo(target_rad, timeout);
@@ -63,6 +72,8 @@ Result<Scan3D> PitchingScanSource::Acquire() {
     }
     if (progress_) progress_(k + 1, n);
   }
+  sweep.ended = true;
+  scanner_.EndSweep(&lines);
   if (!attitude_known) attitudes.clear();  // a line without one: the scan stays as swept
   const double sensed_rad = MaxTurnToLast(attitudes);
   if (sensed_rad < min_rotation_rad_) attitudes.clear();  // within the sensor's own error

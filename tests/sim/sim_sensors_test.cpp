@@ -2,6 +2,8 @@
 
 #include <array>
 #include <cmath>
+#include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -133,6 +135,89 @@ TEST(SimLineScanner, MixedPixelsCastsTheBeamEdgesToo) {
   ASSERT_EQ(line->status[ahead], sensors::ReadingStatus::kValid);
   EXPECT_NEAR(line->ranges_m[ahead], 3.0 - rig->sim().T_world_laser().translation().x(),
               kRangeTolerance_m);
+}
+
+// The lines of a sweep of `lines` nodding steps over -20 .. 20 deg, with the scanner's sweep begun
+// and ended around them or not; `raw` gets what NextLine handed back before EndSweep.
+std::vector<sensors::LaserLine> Sweep(SimRig& rig, int lines, bool as_sweep,
+                                      std::vector<sensors::LaserLine>* raw = nullptr) {
+  std::vector<sensors::LaserLine> out;
+  if (as_sweep) rig.scanner().BeginSweep();
+  for (int k = 0; k < lines; ++k) {
+    Result<double> encoder = rig.pitch_axis().MoveTo((-20.0 + 40.0 * k / (lines - 1)) * kDeg,
+                                                     kTimeout);
+    Result<sensors::LaserLine> line = rig.scanner().NextLine(kTimeout);
+    if (!encoder || !line) throw std::runtime_error("the sweep failed");
+    line->pitch_rad = *encoder;
+    out.push_back(std::move(*line));
+  }
+  if (raw) *raw = out;
+  if (as_sweep) rig.scanner().EndSweep(&out);
+  return out;
+}
+
+// Noise, dropouts and incidence on: every reading draws from the model's generator, so a line cast
+// out of order or from another pose would show.
+SimRigConfig NoisyConfig(CasterKind caster) {
+  SimRigConfig config = QuietConfig(caster);
+  config.lms200 = sensors::Lms200Config{};
+  config.lms200.mount_error_sigma_deg = 0.0;
+  return config;
+}
+
+TEST(SimLineScanner, ASweepCastBesideThePhysicsGivesTheLinesOfOneAtATime) {
+  auto one_by_one = MakeRig(NoisyConfig(CasterKind::kEmbree));
+  auto swept = MakeRig(NoisyConfig(CasterKind::kEmbree));
+  const std::vector<sensors::LaserLine> expected = Sweep(*one_by_one, 30, false);
+  std::vector<sensors::LaserLine> raw;
+  const std::vector<sensors::LaserLine> got = Sweep(*swept, 30, true, &raw);
+  ASSERT_EQ(got.size(), expected.size());
+  if (std::thread::hardware_concurrency() >= 2) {
+    // Handed back before their rays were cast: the casting thread made them.
+    for (const sensors::LaserLine& line : raw) EXPECT_TRUE(line.ranges_m.empty());
+  }
+  int valid = 0;
+  for (std::size_t k = 0; k < got.size(); ++k) {
+    EXPECT_EQ(got[k].stamp_s, expected[k].stamp_s) << k;
+    EXPECT_EQ(got[k].pitch_rad, expected[k].pitch_rad) << k;
+    EXPECT_EQ(got[k].duration_s, expected[k].duration_s) << k;
+    ASSERT_EQ(got[k].ranges_m.size(), expected[k].ranges_m.size()) << k;
+    EXPECT_EQ(got[k].status, expected[k].status) << k;
+    for (std::size_t i = 0; i < got[k].ranges_m.size(); ++i) {
+      if (std::isnan(expected[k].ranges_m[i])) {
+        EXPECT_TRUE(std::isnan(got[k].ranges_m[i])) << k << ' ' << i;
+      } else {
+        ++valid;
+        ASSERT_EQ(got[k].ranges_m[i], expected[k].ranges_m[i]) << k << ' ' << i;
+      }
+    }
+  }
+  EXPECT_GT(valid, 30 * 200);
+  // The scan time the physics did not hide is still counted, and every ray's CPU time.
+  EXPECT_GT(swept->scanner().line_time().cpu_s, 0.0);
+}
+
+TEST(SimLineScanner, ASweepEndsWithTheLinesItGaveOrNone) {
+  auto rig = MakeRig(NoisyConfig(CasterKind::kEmbree));
+  rig->scanner().BeginSweep();
+  Result<sensors::LaserLine> line = rig->scanner().NextLine(kTimeout);
+  ASSERT_TRUE(line) << line.error().message;
+  std::vector<sensors::LaserLine> none;
+  EXPECT_THROW(rig->scanner().EndSweep(&none), std::logic_error);
+  // A dropped sweep leaves nothing behind: the next one has its own lines only.
+  rig->scanner().BeginSweep();
+  (void)rig->scanner().NextLine(kTimeout);
+  rig->scanner().EndSweep(nullptr);
+  const std::vector<sensors::LaserLine> lines = Sweep(*rig, 3, true);
+  ASSERT_EQ(lines.size(), 3u);
+  for (const sensors::LaserLine& l : lines) EXPECT_EQ(l.ranges_m.size(), 361u);
+}
+
+TEST(SimLineScanner, MujocosRaysReadTheLiveStateSoASweepCastsEachLineAtOnce) {
+  auto rig = MakeRig(QuietConfig(CasterKind::kMujoco));
+  std::vector<sensors::LaserLine> raw;
+  Sweep(*rig, 3, true, &raw);
+  for (const sensors::LaserLine& line : raw) EXPECT_EQ(line.ranges_m.size(), 361u);
 }
 
 TEST(SimRig, TheSeedPatternTakesItsLinePeriodsPlusServoMovesOfSimulatedTime) {

@@ -34,6 +34,9 @@ class RayCaster {
                     float max_range_m, float* range_m, int* geom_id) const = 0;
   /// Re-reads the poses of geoms on moving bodies from the mjData given at construction.
   virtual void Refresh() = 0;
+  /// True when Cast reads nothing a stepping simulation writes and Refresh changes nothing (no
+  /// visible geom moves): rays may then be cast on another thread while the physics steps.
+  virtual bool Static() const { return false; }
 };
 
 /// Embree scene built from the model's planes, boxes, spheres, capsules, cylinders, ellipsoids,

@@ -3,6 +3,7 @@
 // A runtime choice made once at start-up, called once per line: virtual interfaces are right here.
 
 #include <chrono>
+#include <vector>
 
 #include "pitchlab/sensors/laser_line.hpp"
 #include "pitchlab/sensors/result.hpp"
@@ -16,6 +17,14 @@ class LineScanner {
   /// Next full sweep at the scanner's current pitch (pitch_rad left 0: the caller fills it from
   /// the encoder), or an error (timeout, device fault) after `timeout`.
   [[nodiscard]] virtual Result<LaserLine> NextLine(std::chrono::milliseconds timeout) = 0;
+  /// A sweep: lines whose readings may be made after NextLine returns them (the simulator casts a
+  /// line's rays on another core while its physics steps on). Between BeginSweep and EndSweep a
+  /// line from NextLine may hold only its stamp_s; EndSweep(&lines) completes the sweep's lines,
+  /// which `lines` holds in NextLine's order (the pitch_rad the caller set is kept), and
+  /// EndSweep(nullptr) drops them (a failed scan) and must not throw. Every BeginSweep is ended, on every way out.
+  /// A scanner that makes each line at once (the serial driver) keeps these defaults.
+  virtual void BeginSweep() {}
+  virtual void EndSweep(std::vector<LaserLine>* lines) { (void)lines; }
 };
 
 /// The pitching mount: a position-controlled servo with an encoder.

@@ -3,6 +3,7 @@
 // cast by a sensors::RayCaster, turned into readings by sensors::Lms200Model.
 
 #include <deque>
+#include <memory>
 #include <vector>
 
 #include "pitchlab/sensors/lms200.hpp"
@@ -13,6 +14,8 @@
 
 namespace pitchlab::sim {
 
+class SerialWorker;
+
 /// LineScanner on a Simulation. `caster` and `sim` must outlive it; the caster must have been
 /// built on sim.model()/sim.data() (it is Refresh()ed before every line).
 class SimLineScanner final : public sensors::LineScanner {
@@ -21,14 +24,25 @@ class SimLineScanner final : public sensors::LineScanner {
   /// Casts the line at the laser's current pose, stamps it with the sim time at its start and
   /// advances the simulation by line_period_s(). kTimeout when the period exceeds `timeout`.
   [[nodiscard]] Result<sensors::LaserLine> NextLine(std::chrono::milliseconds timeout) override;
+  /// In a sweep, with a static caster (RayCaster::Static) and a second core, a line's rays are
+  /// cast and its readings made on a thread of the scanner's own while the physics steps on
+  /// through the line and the pitch axis's next move: the same readings, in the same order, as
+  /// line by line. EndSweep rethrows what the casting threw.
+  void BeginSweep() override;
+  void EndSweep(std::vector<sensors::LaserLine>* lines) override;
+  ~SimLineScanner() override;
   const sensors::Lms200Model& model() const { return model_; }
   /// Rays reach this far: 5 % beyond the range mode's maximum, so over-range can be flagged [m].
   float cast_range_m() const;
-  /// Time spent so far making lines: casting their rays and turning ranges into readings, i.e.
-  /// all of NextLine but the physics it steps (for a run's stage breakdown).
+  /// Time spent so far making lines: casting their rays and turning ranges into readings (for a
+  /// run's stage breakdown). CPU: all of it. Wall: the time the simulation's thread spent on it or
+  /// waiting for it, i.e. not what overlapped the physics of a sweep.
   const sensors::Elapsed& line_time() const { return line_time_; }
 
  private:
+  // Casts the line at T_world_laser and turns its ranges into readings (`line`'s stamp and pitch
+  // left for the caller).
+  void MakeLine(const Eigen::Isometry3d& T_world_laser, sensors::LaserLine& line);
   void CastAt(const Eigen::Isometry3d& T_world_laser, double offset_rad, std::vector<float>& out,
               double tip_rad = 0.0);
   void CastIncidence(const Eigen::Isometry3d& T_world_laser);
@@ -47,6 +61,12 @@ class SimLineScanner final : public sensors::LineScanner {
       along_back_, across_back_, cos_incidence_;
   sensors::Elapsed line_time_;
   std::deque<BeamSet> beam_sets_;  // a deque: a set's reference stays valid as others are added
+  // The sweep's casting thread (started by the first sweep that can use it) and the lines it
+  // makes, in NextLine's order; in_sweep_: between BeginSweep and EndSweep with the thread on.
+  std::unique_ptr<SerialWorker> worker_;
+  std::deque<sensors::LaserLine> swept_;
+  bool in_sweep_ = false;
+  double sweep_cpu0_s_ = 0;  // the worker's CPU time when the sweep began [s]
 };
 
 }  // namespace pitchlab::sim
