@@ -8,7 +8,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
-#include "parallel_for.hpp"
+#include "pitchlab/mapping/parallel_for.hpp"
 #include "se3_perturbation.hpp"
 
 namespace pitchlab::mapping {
@@ -156,7 +156,7 @@ void FindPairs(const IcpTarget& target, const PointCloud& source, const Eigen::I
   PointCloud& moved = moved_buffer;
   nearest.resize(source.size());
   moved.resize(source.size());
-  internal::ParallelFor(source.size(), kPointsPerBlock, [&](std::size_t begin, std::size_t end) {
+  ParallelFor(source.size(), kPointsPerBlock, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       moved[i] = Tf * source[i];
       float d2 = 0;
@@ -226,7 +226,7 @@ Eigen::Vector3f NormalAt(const Eigen::Vector3f& p, const VoxelHashIndex& index, 
 Normals EstimateNormals(const PointCloud& cloud, const VoxelHashIndex& index, float radius_m,
                         const Eigen::Vector3f& viewpoint) {
   Normals normals(cloud.size());
-  internal::ParallelFor(cloud.size(), kPointsPerBlock, [&](std::size_t begin, std::size_t end) {
+  ParallelFor(cloud.size(), kPointsPerBlock, [&](std::size_t begin, std::size_t end) {
     std::vector<Eigen::Vector3f> nn;
     for (std::size_t i = begin; i < end; ++i) {
       normals[i] = NormalAt(cloud[i], index, radius_m, viewpoint, nn);
@@ -252,7 +252,7 @@ void LazyNormals::Make(const std::vector<int>& indices) const {
       missing_.push_back(i);
     }
   }
-  internal::ParallelFor(missing_.size(), kPointsPerBlock, [&](std::size_t begin, std::size_t end) {
+  ParallelFor(missing_.size(), kPointsPerBlock, [&](std::size_t begin, std::size_t end) {
     std::vector<Eigen::Vector3f> nn;
     for (std::size_t k = begin; k < end; ++k) {
       const int i = missing_[k];
@@ -295,7 +295,7 @@ FeatureMatrix ComputeFpfh(const PointCloud& cloud, const Normals& normals,
   const int n = static_cast<int>(cloud.size());
   std::vector<std::vector<int>> neighbors(n);
   FeatureMatrix spfh = FeatureMatrix::Zero(n, 3 * kBins);
-  internal::ParallelFor(cloud.size(), kPointsPerBlock, [&](std::size_t begin, std::size_t end) {
+  ParallelFor(cloud.size(), kPointsPerBlock, [&](std::size_t begin, std::size_t end) {
     std::vector<int> nn;
     for (std::size_t i = begin; i < end; ++i) {
       Spfh(cloud, normals, index, radius_m, max_neighbors, static_cast<int>(i), nn, neighbors[i],
@@ -303,7 +303,7 @@ FeatureMatrix ComputeFpfh(const PointCloud& cloud, const Normals& normals,
     }
   });
   FeatureMatrix fpfh = FeatureMatrix::Zero(static_cast<int>(keypoints.size()), 3 * kBins);
-  internal::ParallelFor(keypoints.size(), kPointsPerBlock, [&](std::size_t begin, std::size_t end) {
+  ParallelFor(keypoints.size(), kPointsPerBlock, [&](std::size_t begin, std::size_t end) {
     for (std::size_t row = begin; row < end; ++row) {  // own SPFH + neighbours' by 1 / d
       const int i = keypoints[row];
       if (neighbors[i].empty()) continue;
@@ -345,7 +345,7 @@ std::vector<Correspondence> MatchFeatures(const FeatureMatrix& source,
   std::vector<Eigen::ArrayXi> block_s(blocks);
   std::vector<Eigen::ArrayXf> block_s_d(blocks);
   using RowMajorXf = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  internal::ParallelFor(blocks, 1, [&](std::size_t first, std::size_t last) {
+  ParallelFor(blocks, 1, [&](std::size_t first, std::size_t last) {
     Eigen::ArrayXf dist(nt);
     for (std::size_t k = first; k < last; ++k) {
       const int b = static_cast<int>(k) * kBlock;

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "loop_closer.hpp"
-#include "parallel_for.hpp"
+#include "pitchlab/mapping/parallel_for.hpp"
 #include "pitchlab/mapping/cloud_statistics.hpp"
 
 namespace pitchlab::mapping {
@@ -113,7 +113,7 @@ Result<void> MapBuilder::CloseLoops(const PointCloud& cloud_base, MergeStep& ste
 
 void MapBuilder::PrepareNext() {
   if (trajectory_.empty() || next_target_) return;
-  const internal::SerialLoops alone;
+  const SerialLoops alone;
   auto target = std::make_unique<RegistrationTarget>(
       map_.Around(trajectory_.back().T_map_base, config_.local_map_radius_m), config_.sensor_base);
   target->Prepare(config_.registration);

@@ -1,4 +1,4 @@
-#include "parallel_for.hpp"
+#include "pitchlab/mapping/parallel_for.hpp"
 
 #include <sched.h>
 
@@ -15,7 +15,7 @@
 
 #include "pitchlab/sensors/stopwatch.hpp"
 
-namespace pitchlab::mapping::internal {
+namespace pitchlab::mapping {
 namespace {
 
 constexpr unsigned kMaxThreads = 8;  // beyond the 2-8 cores this runs on, blocks get too few
@@ -158,4 +158,4 @@ void ParallelFor(std::size_t n, std::size_t block,
 SerialLoops::SerialLoops() : was_(serial_loops) { serial_loops = true; }
 SerialLoops::~SerialLoops() { serial_loops = was_; }
 
-}  // namespace pitchlab::mapping::internal
+}  // namespace pitchlab::mapping

@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "elevation_insert.hpp"
-#include "parallel_for.hpp"
+#include "pitchlab/mapping/parallel_for.hpp"
 
 namespace pitchlab::mapping {
 namespace {
@@ -108,7 +108,7 @@ void PerScanElevationMap::Contribute(Scan& scan) const {
 // Each scan's contribution depends on that scan alone and lands in its own Scan: the threads
 // take scans in any order and the result is the same.
 void PerScanElevationMap::ContributeAll(const std::vector<Scan*>& scans) const {
-  internal::ParallelFor(
+  ParallelFor(
       scans.size(), 1,
       [&](std::size_t begin, std::size_t end) {
         for (std::size_t k = begin; k < end; ++k) Contribute(*scans[k]);

@@ -1,4 +1,4 @@
-#include "parallel_for.hpp"
+#include "pitchlab/mapping/parallel_for.hpp"
 
 #include <gtest/gtest.h>
 #include <sched.h>
@@ -10,7 +10,7 @@
 #include <thread>
 #include <vector>
 
-namespace pitchlab::mapping::internal {
+namespace pitchlab::mapping {
 namespace {
 
 // Every item is visited exactly once, whatever the block size and thread count.
@@ -160,4 +160,4 @@ TEST(ParallelFor, ConcurrentAndNestedLoopsEachFinish) {
 }
 
 }  // namespace
-}  // namespace pitchlab::mapping::internal
+}  // namespace pitchlab::mapping

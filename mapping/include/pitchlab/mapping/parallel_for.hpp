@@ -1,10 +1,11 @@
 #pragma once
-// Private: a loop whose iterations are independent, run on the machine's cores.
+// A loop whose iterations are independent, run on the machine's cores: registration's searches,
+// the map's layers and the planner's grid, a stop's work that the robot waits for.
 
 #include <cstddef>
 #include <functional>
 
-namespace pitchlab::mapping::internal {
+namespace pitchlab::mapping {
 
 /// Calls `body(begin, end)` over [0, n) in blocks of `block` items, the blocks taken in turn by up
 /// to `max_threads` threads (the caller's included; 0: one per core, at most 8). Each item must
@@ -29,4 +30,4 @@ class SerialLoops {
   bool was_;
 };
 
-}  // namespace pitchlab::mapping::internal
+}  // namespace pitchlab::mapping
