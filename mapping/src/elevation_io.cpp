@@ -168,9 +168,8 @@ Result<ElevationMap> LoadElevationMap(const std::string& path) {
   // foreign file with an infinite cell or a NaN height would plan "paths" of NaN coordinates.
   if (const std::string why = InvalidValues(g, has_geo ? &geo : nullptr, cells); !why.empty())
     return bad(why);
-  ElevationMap map(g, has_geo ? std::optional<GeodeticOrigin>(geo) : std::nullopt);
-  map.SetCells(std::move(cells));
-  return map;
+  return ElevationMap(g, std::move(cells),
+                      has_geo ? std::optional<GeodeticOrigin>(geo) : std::nullopt);
 }
 
 std::string ProjectionWkt(const std::optional<GeodeticOrigin>& origin) {

@@ -545,15 +545,28 @@ bool GridGeometry::SameAs(const GridGeometry& o) const {
          std::abs(x_min_m - o.x_min_m) < 1e-9 && std::abs(y_min_m - o.y_min_m) < 1e-9;
 }
 
-ElevationMap::ElevationMap(const GridGeometry& geometry,
-                           std::optional<GeodeticOrigin> geodetic_origin)
-    : geometry_(geometry), geodetic_origin_(geodetic_origin) {
+namespace {
+void CheckGeometry(const GridGeometry& geometry) {
   if (geometry.size_x <= 0 || geometry.size_y <= 0 || !(geometry.cell_m > 0.0)) {
     throw std::invalid_argument("elevation map: empty geometry (" +
                                 std::to_string(geometry.size_x) + " x " +
                                 std::to_string(geometry.size_y) + " cells)");
   }
+}
+}  // namespace
+
+ElevationMap::ElevationMap(const GridGeometry& geometry,
+                           std::optional<GeodeticOrigin> geodetic_origin)
+    : geometry_(geometry), geodetic_origin_(geodetic_origin) {
+  CheckGeometry(geometry);
   cells_.assign(geometry.cell_count(), CellStats{});
+}
+
+ElevationMap::ElevationMap(const GridGeometry& geometry, std::vector<CellStats> cells,
+                           std::optional<GeodeticOrigin> geodetic_origin)
+    : geometry_(geometry), geodetic_origin_(geodetic_origin) {
+  CheckGeometry(geometry);
+  SetCells(std::move(cells));
 }
 
 InsertStats ElevationMap::InsertPoints(const Eigen::Vector3f* points_m, std::size_t count,

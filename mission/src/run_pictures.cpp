@@ -81,9 +81,7 @@ mapping::ElevationMap PictureRegion(const mapping::ElevationMap& map,
     const auto row = map.cells().begin() + static_cast<std::ptrdiff_t>(g.Linear({lo_i, j}));
     cells.insert(cells.end(), row, row + region.size_x);
   }
-  mapping::ElevationMap out(region, map.geodetic_origin());
-  out.SetCells(std::move(cells));
-  return out;
+  return mapping::ElevationMap(region, std::move(cells), map.geodetic_origin());
 }
 
 // last_plan.png of a failed run: the grid its last plan was made on, that plan, and the run's

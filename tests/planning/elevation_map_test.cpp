@@ -51,6 +51,22 @@ TEST(ElevationMap, Eq2GridSizeIsAreaOverCellRounded) {
   EXPECT_LE(ElevationMap::kBytesPerCell, 64u);
 }
 
+TEST(ElevationMap, AMapMadeFromCellsHoldsThemAndChecksTheirCount) {
+  const GridGeometry g{1.0, 2.0, 0.5, 3, 2};
+  std::vector<CellStats> cells(6);
+  cells[4].count = 7;
+  cells[4].mean_z = 0.25f;
+  const ElevationMap map(g, cells, GeodeticOrigin{46.77, 23.59, 360});
+  EXPECT_EQ(map.at({1, 1}).count, 7u);
+  EXPECT_EQ(map.at({1, 1}).mean_z, 0.25f);
+  EXPECT_FALSE(map.at({0, 0}).known());
+  ASSERT_TRUE(map.geodetic_origin());
+  EXPECT_EQ(map.geodetic_origin()->height_m, 360);
+  EXPECT_THROW(ElevationMap(g, std::vector<CellStats>(5), std::nullopt), std::invalid_argument);
+  EXPECT_THROW(ElevationMap(GridGeometry{0, 0, 0.5, 0, 2}, {}, std::nullopt),
+               std::invalid_argument);
+}
+
 TEST(ElevationMap, TiltedPlaneGivesItsInclination) {
   const double bx = 0.2, by = -0.1;
   const auto plane = [&](double x, double y) { return 1.0 + bx * x + by * y; };

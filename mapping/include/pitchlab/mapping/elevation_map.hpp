@@ -165,6 +165,11 @@ class ElevationMap {
   /// An all-unknown map over `geometry`. Throws std::invalid_argument on an empty geometry.
   explicit ElevationMap(const GridGeometry& geometry,
                         std::optional<GeodeticOrigin> geodetic_origin = std::nullopt);
+  /// A map over `geometry` holding `cells` (a copy of part of another, a loaded one), without
+  /// first clearing a grid of its own. Throws std::invalid_argument on an empty geometry or when
+  /// the size does not match it.
+  ElevationMap(const GridGeometry& geometry, std::vector<CellStats> cells,
+               std::optional<GeodeticOrigin> geodetic_origin);
 
   const GridGeometry& geometry() const { return geometry_; }
   const std::optional<GeodeticOrigin>& geodetic_origin() const { return geodetic_origin_; }
