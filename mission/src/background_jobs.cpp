@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <utility>
 
+#include "pitchlab/mapping/parallel_for.hpp"
 #include "pitchlab/sensors/stopwatch.hpp"
 
 namespace pitchlab::mission {
@@ -61,6 +62,9 @@ void LowerThisThreadsPriority() {
 
 void BackgroundJobs::Run() {
   LowerThisThreadsPriority();
+  // Its loops (a stop picture's layers, the truth's) stay on this thread: the helper threads run
+  // at the mission's priority and would hand the side work the cores the mission waits for.
+  const mapping::SerialLoops alone;
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
     changed_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
