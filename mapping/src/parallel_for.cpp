@@ -1,7 +1,5 @@
 #include "pitchlab/mapping/parallel_for.hpp"
 
-#include <sched.h>
-
 #include <algorithm>
 #include <atomic>
 #include <condition_variable>
@@ -13,6 +11,7 @@
 #include <thread>
 #include <vector>
 
+#include "pitchlab/sensors/allowed_cores.hpp"
 #include "pitchlab/sensors/stopwatch.hpp"
 
 namespace pitchlab::mapping {
@@ -21,14 +20,6 @@ namespace {
 constexpr unsigned kMaxThreads = 8;  // beyond the 2-8 cores this runs on, blocks get too few
 
 thread_local bool serial_loops = false;  // SerialLoops
-
-// The cores this process may run on: its CPU affinity (taskset, a cluster job's cpuset), which
-// hardware_concurrency ignores: a run given one core of 64 would start 8 threads on it.
-unsigned Cores() {
-  cpu_set_t set;
-  if (sched_getaffinity(0, sizeof set, &set) == 0) return std::max(1, CPU_COUNT(&set));
-  return std::max(1u, std::thread::hardware_concurrency());
-}
 
 // One loop's blocks and who works on them. Helpers hold it by shared_ptr: one that starts after
 // the caller closed the job returns without touching `body`, which lives on the caller's stack.
@@ -73,7 +64,7 @@ struct Job {
 class HelperThreads {
  public:
   static HelperThreads& Get() {
-    static HelperThreads helpers(std::min(Cores(), kMaxThreads) - 1);
+    static HelperThreads helpers(std::min(sensors::AllowedCores(), kMaxThreads) - 1);
     return helpers;
   }
   ~HelperThreads() {
@@ -134,7 +125,7 @@ void ParallelFor(std::size_t n, std::size_t block,
   job->block = std::max<std::size_t>(block, 1);
   job->blocks = (n + job->block - 1) / job->block;
   job->body = &body;
-  const unsigned cores = serial_loops ? 1u : std::min(Cores(), kMaxThreads);
+  const unsigned cores = serial_loops ? 1u : std::min(sensors::AllowedCores(), kMaxThreads);
   const unsigned threads = static_cast<unsigned>(
       std::min<std::size_t>(job->blocks, max_threads > 0 ? std::min(max_threads, cores) : cores));
   for (unsigned t = 1; t < threads; ++t) {

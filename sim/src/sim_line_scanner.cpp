@@ -4,9 +4,9 @@
 #include <exception>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <utility>
 
+#include "pitchlab/sensors/allowed_cores.hpp"
 #include "serial_worker.hpp"
 
 namespace pitchlab::sim {
@@ -124,7 +124,7 @@ SimLineScanner::~SimLineScanner() = default;
 // drops by about the casting's.
 void SimLineScanner::BeginSweep() {
   in_sweep_ = false;
-  if (!caster_.Static() || std::thread::hardware_concurrency() < 2) return;
+  if (!caster_.Static() || sensors::AllowedCores() < 2) return;
   if (!worker_) worker_ = std::make_unique<SerialWorker>();
   swept_.clear();
   sweep_cpu0_s_ = worker_->cpu_s();

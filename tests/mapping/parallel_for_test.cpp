@@ -1,4 +1,5 @@
 #include "pitchlab/mapping/parallel_for.hpp"
+#include "pitchlab/sensors/allowed_cores.hpp"
 
 #include <gtest/gtest.h>
 #include <sched.h>
@@ -41,13 +42,8 @@ TEST(ParallelFor, OneThreadIsTheCallerAlone) {
   EXPECT_EQ(ids, std::set<std::thread::id>{std::this_thread::get_id()});
 }
 
-int AllowedCores() {
-  cpu_set_t set;
-  return sched_getaffinity(0, sizeof set, &set) == 0 ? CPU_COUNT(&set) : 1;
-}
-
 TEST(ParallelFor, UsesMoreThanOneThreadWhereTheMachineHasThem) {
-  if (AllowedCores() < 2) GTEST_SKIP() << "one core";
+  if (sensors::AllowedCores() < 2) GTEST_SKIP() << "one core";
   std::mutex mutex;
   std::set<std::thread::id> ids;
   std::atomic<int> arrived{0};
@@ -97,7 +93,7 @@ TEST(ParallelFor, SerialLoopsKeepTheThreadsLoopsOnItself) {
     }
     EXPECT_EQ(threads_used(20), me);
   }
-  if (AllowedCores() < 2) GTEST_SKIP() << "one core";
+  if (sensors::AllowedCores() < 2) GTEST_SKIP() << "one core";
   EXPECT_EQ(threads_used(2000).size(), 2u);
 }
 
