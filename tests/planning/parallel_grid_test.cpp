@@ -4,23 +4,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstring>
 #include <thread>
 #include <vector>
 
+#include "same_grids.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/parallel_for.hpp"
 #include "pitchlab/planning/traversability.hpp"
 
 namespace pitchlab::planning {
 namespace {
-
-// Byte-wise equality: NaN cells (unknown) compare too.
-template <typename T>
-bool SameBits(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() &&
-         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
-}
 
 // 240 x 200 cells of 0.1 m with every kind of cell: rolling ground, a slope too steep, a 0.3 m
 // step, a pit, cells seen by one point and holes never seen.
@@ -60,14 +53,7 @@ TEST(ParallelGrid, TheLayersAreThoseOfOneThread) {
     mapping::ComputeLayersInto(map, mapping::LayerConfig{}, serial);
   }
   mapping::ComputeLayersInto(map, mapping::LayerConfig{}, parallel);
-  EXPECT_TRUE(SameBits(serial.state, parallel.state));
-  EXPECT_TRUE(SameBits(serial.count, parallel.count));
-  EXPECT_TRUE(SameBits(serial.mean_z, parallel.mean_z));
-  EXPECT_TRUE(SameBits(serial.roughness, parallel.roughness));
-  EXPECT_TRUE(SameBits(serial.phi_x, parallel.phi_x));
-  EXPECT_TRUE(SameBits(serial.phi_y, parallel.phi_y));
-  EXPECT_TRUE(SameBits(serial.clearance_z, parallel.clearance_z));
-  EXPECT_TRUE(SameBits(serial.plane_residual, parallel.plane_residual));
+  same_grids::ExpectSameLayers(serial, parallel);
   int steep = 0, unknown = 0;
   for (std::size_t k = 0; k < serial.state.size(); ++k) {
     unknown += serial.state[k] == mapping::CellState::kUnknown;
@@ -87,18 +73,7 @@ TEST(ParallelGrid, TheTraversabilityIsThatOfOneThread) {
     BuildTraversabilityInto(layers, config, serial);
   }
   BuildTraversabilityInto(layers, config, parallel);
-  EXPECT_TRUE(SameBits(serial.blocked, parallel.blocked));
-  EXPECT_TRUE(SameBits(serial.enter_cost, parallel.enter_cost));
-  EXPECT_TRUE(SameBits(serial.z_m, parallel.z_m));
-  EXPECT_TRUE(SameBits(serial.moves, parallel.moves));
-  ASSERT_EQ(serial.move_cost.size(), parallel.move_cost.size());
-  EXPECT_EQ(std::memcmp(serial.move_cost.data(), parallel.move_cost.data(),
-                        serial.move_cost.size() * sizeof(MoveCosts)),
-            0);
-  EXPECT_EQ(serial.min_straight_cost, parallel.min_straight_cost);
-  EXPECT_EQ(serial.min_diagonal_cost, parallel.min_diagonal_cost);
-  EXPECT_EQ(serial.max_edge_cost, parallel.max_edge_cost);
-  EXPECT_EQ(serial.min_enter_cost, parallel.min_enter_cost);
+  same_grids::ExpectSameTraversability(serial, parallel);
   int kinds[8] = {};
   for (const Blocked b : serial.blocked) ++kinds[static_cast<int>(b) & 7];
   int present = 0;

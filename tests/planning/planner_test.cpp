@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
+#include "same_grids.hpp"
 #include "pitchlab/planning/path_io.hpp"
 #include "pitchlab/planning/planner.hpp"
 #include "pitchlab/planning/traversability.hpp"
@@ -74,12 +75,6 @@ double BglCost(const TraversabilityGrid& T, std::size_t s, std::size_t t) {
   return d[t];
 }
 
-// Bit for bit, NaN included: a reused buffer must leave nothing of what it held.
-template <typename T>
-bool SameBits(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
-
 // Rough ground with scattered unknown cells and a few spikes (steps): every layer and every
 // blocked kind has cells.
 ElevationLayers RoughLayers(int sx, int sy, unsigned seed) {
@@ -103,22 +98,10 @@ TEST(BuildTraversabilityInto, AReusedGridEqualsAFreshOne) {
   reused.occupancy_cost.assign(reused.z_m.size(), 7.0f);  // as an occupancy grid's would be
   BuildTraversabilityInto(now, second, reused);
   const TraversabilityGrid fresh = BuildTraversability(now, second);
-  EXPECT_EQ(reused.geometry.size_x, fresh.geometry.size_x);
-  EXPECT_EQ(reused.geometry.size_y, fresh.geometry.size_y);
+  // Bit for bit, NaN included: a reused buffer must leave nothing of what it held.
+  same_grids::ExpectSameTraversability(reused, fresh);
   EXPECT_EQ(reused.config.robot.width_m, fresh.config.robot.width_m);
-  EXPECT_TRUE(SameBits(reused.z_m, fresh.z_m));
-  EXPECT_TRUE(SameBits(reused.enter_cost, fresh.enter_cost));
-  EXPECT_TRUE(SameBits(reused.roughness_m, fresh.roughness_m));
-  EXPECT_TRUE(SameBits(reused.phi_x_rad, fresh.phi_x_rad));
-  EXPECT_TRUE(SameBits(reused.phi_y_rad, fresh.phi_y_rad));
   EXPECT_TRUE(reused.occupancy_cost.empty());
-  EXPECT_TRUE(SameBits(reused.blocked, fresh.blocked));
-  EXPECT_TRUE(SameBits(reused.moves, fresh.moves));
-  EXPECT_TRUE(SameBits(reused.move_cost, fresh.move_cost));
-  EXPECT_EQ(reused.min_straight_cost, fresh.min_straight_cost);
-  EXPECT_EQ(reused.min_diagonal_cost, fresh.min_diagonal_cost);
-  EXPECT_EQ(reused.max_edge_cost, fresh.max_edge_cost);
-  EXPECT_EQ(reused.min_enter_cost, fresh.min_enter_cost);
   // Both kinds of cell the first build had (hazards, unknown) are in this one too: the check
   // compared grids that differ from the first one's cell by cell.
   EXPECT_NE(std::count(fresh.blocked.begin(), fresh.blocked.end(), Blocked::kStep), 0);
@@ -135,18 +118,7 @@ TEST(ComputeLayersInto, AReusedSetOfLayersEqualsAFreshOne) {
   (void)map.InsertPoints(pts.data(), pts.size());
   mapping::ComputeLayersInto(map, {}, reused);
   const ElevationLayers fresh = mapping::ComputeLayers(map);
-  EXPECT_EQ(reused.geometry.size_x, fresh.geometry.size_x);
-  EXPECT_EQ(reused.geometry.size_y, fresh.geometry.size_y);
-  EXPECT_TRUE(SameBits(reused.state, fresh.state));
-  EXPECT_TRUE(SameBits(reused.count, fresh.count));
-  EXPECT_TRUE(SameBits(reused.mean_z, fresh.mean_z));
-  EXPECT_TRUE(SameBits(reused.min_z, fresh.min_z));
-  EXPECT_TRUE(SameBits(reused.max_z, fresh.max_z));
-  EXPECT_TRUE(SameBits(reused.roughness, fresh.roughness));
-  EXPECT_TRUE(SameBits(reused.phi_x, fresh.phi_x));
-  EXPECT_TRUE(SameBits(reused.phi_y, fresh.phi_y));
-  EXPECT_TRUE(SameBits(reused.clearance_z, fresh.clearance_z));
-  EXPECT_TRUE(SameBits(reused.plane_residual, fresh.plane_residual));
+  same_grids::ExpectSameLayers(reused, fresh);
 }
 
 TEST(Planner, SerpentineCorridorGivesItsUniqueOptimalPath) {
