@@ -7,10 +7,10 @@
 #include <thread>
 #include <vector>
 
-#include "same_grids.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/parallel_for.hpp"
 #include "pitchlab/planning/traversability.hpp"
+#include "same_grids.hpp"
 
 namespace pitchlab::planning {
 namespace {

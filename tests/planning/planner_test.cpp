@@ -13,10 +13,10 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "same_grids.hpp"
 #include "pitchlab/planning/path_io.hpp"
 #include "pitchlab/planning/planner.hpp"
 #include "pitchlab/planning/traversability.hpp"
+#include "same_grids.hpp"
 
 namespace pitchlab::planning {
 namespace {
