@@ -17,7 +17,6 @@
 #include "drive_length.hpp"
 #include "line_gaps.hpp"
 #include "optimised_elevation.hpp"
-#include "thread_priority.hpp"
 
 namespace pitchlab::mission {
 namespace {
@@ -26,7 +25,6 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kMinProgress_m = 0.05;   // less than this over stuck_timeout_s is no progress
 constexpr double kMinTurnProgress_rad = 0.1;  // ... and less turn than this
 constexpr double kStopTime_s = 0.5;       // braking before a scan
-constexpr int kPrepareNicer = 5;          // the next target's thread (PrepareNextTarget)
 constexpr double kEscapeRadius_m = 1.0;   // how far a start inside a hazard margin looks out
 constexpr double kGoalApproach_m = 2.0;   // a blocked goal farther than this: approach it
 constexpr double kFarDoubt_m = 6.0;       // beyond this a hazard may be a sparse view (recovery)
@@ -242,14 +240,9 @@ class Mission {
   // stages' stopwatches leave out: its CPU time is the registration's, added by Builder()).
   std::future<void> next_target_;
   double next_target_cpu_s_ = 0;
-  // Starts PrepareNext beside whatever the mission does until its next scan is registered, five
-  // nice values below the mission: the drive and the scan (the physics, the laser's casting
-  // thread) leave it time enough (the default run waited 4 ms for it over 18 stops), and
-  // contending with them at the same priority slowed the physics it must wait for (terrain seed
-  // 1, six runs each alternating: run 7.65 -> 7.43 s median; benchmarks/README.md, session 31).
+  // Starts PrepareNext beside whatever the mission does until its next scan is registered.
   void PrepareNextTarget() {
     next_target_ = std::async(std::launch::async, [this] {
-      LowerThisThreadsPriority(kPrepareNicer);
       builder_.PrepareNext();
       next_target_cpu_s_ = sensors::ThreadCpuSeconds();
     });
