@@ -141,9 +141,11 @@ std::string RenderRunReport(const RunReportInput& in, const Result<ThreeJs>& thr
         "of the whole run. A stage's CPU time is the mission thread's and its parallel loops' "
         "helpers'. The ground truth, each stop's files and the next stop's registration target "
         "are made on threads beside the mission: their CPU time is theirs (the target's is "
-        "registration's), their wall time only what the run waited for them. The whole run's CPU "
-        "time counts every thread; \"other\" is what no stage holds (set-up, the ray caster's "
-        "scene).");
+        "registration's), their wall time only what the run waited for them. A scan's rays are "
+        "cast on the simulated laser's own thread while the physics steps through the sweep: "
+        "ray casting's CPU time is all of it, its wall time what the scan waited for it. The "
+        "whole run's CPU time counts every thread; \"other\" is what no stage holds (set-up, "
+        "the ray caster's scene).");
     page.Table(StageHeader(), rows);
   }
 
