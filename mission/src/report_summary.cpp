@@ -58,14 +58,24 @@ const char* StageLabel(Stage stage) {
   return "?";
 }
 
-std::string Percent(const nlohmann::json& stage, const char* key) {
+// A stage's number as the table shows it: below `floor` (a stopwatch reading of work that was
+// not there, e.g. 4 us of the ground truth's wall when the mission had nothing left to wait for),
+// "< floor", not digits of timer noise.
+std::string Shown(const nlohmann::json& stage, const char* key, double scale, int digits,
+                  double floor, const char* floor_text) {
   const auto v = stage.find(key);
-  return v != stage.end() && v->is_number() ? Significant(100.0 * v->get<double>(), 2) : "-";
+  if (v == stage.end() || !v->is_number()) return "-";
+  const double x = scale * v->get<double>();
+  if (x > 0 && x < floor) return floor_text;
+  return Significant(x, digits);
+}
+
+std::string Percent(const nlohmann::json& stage, const char* key) {
+  return Shown(stage, key, 100.0, 2, 0.01, "< 0.01");
 }
 
 std::string Seconds(const nlohmann::json& stage, const char* key) {
-  const auto v = stage.find(key);
-  return v != stage.end() && v->is_number() ? Significant(v->get<double>()) : "-";
+  return Shown(stage, key, 1.0, 3, 0.001, "< 0.001");
 }
 
 }  // namespace

@@ -29,6 +29,32 @@ nlohmann::json SafeSuccess() {
           {"closest_approach_to_forbidden_m", 0.34}};
 }
 
+TEST(StageRows, TimesBelowTheTablesResolutionReadAsSuch) {
+  const nlohmann::json m = {
+      {"stages",
+       {{"ground_truth",
+         {{"wall_s", 3.84e-6}, {"cpu_s", 1.21}, {"wall_share", 5e-7}, {"cpu_share", 0.098}}},
+        {"registration",
+         {{"wall_s", 1.8449}, {"cpu_s", 3.5}, {"wall_share", 0.2391}, {"cpu_share", 0.28}}},
+        {"scoring",
+         {{"wall_s", 0.0}, {"cpu_s", 0.0651}, {"wall_share", 0.0}, {"cpu_share", 0.0053}}}}}};
+  const auto rows = StageRows(m);
+  const auto row = [&](const std::string& label_start) {
+    for (const auto& r : rows)
+      if (r[0].rfind(label_start, 0) == 0) return r;
+    return std::vector<std::string>{};
+  };
+  const std::vector<std::string> truth = row("ground truth"), registration = row("registration"),
+                                 scoring = row("scoring");
+  ASSERT_EQ(truth.size(), 5u);
+  ASSERT_EQ(registration.size(), 5u);
+  ASSERT_EQ(scoring.size(), 5u);
+  EXPECT_EQ(truth, (std::vector<std::string>{truth[0], "< 0.001", "1.21", "< 0.01", "9.8"}));
+  EXPECT_EQ(registration, (std::vector<std::string>{registration[0], "1.84", "3.50", "24", "28"}));
+  EXPECT_EQ(scoring[1], "0");  // nothing is not "below the resolution"
+  EXPECT_EQ(scoring[4], "0.53");
+}
+
 TEST(ReadOutcome, ASafeRunReachedItsGoal) {
   const Outcome o = ReadOutcome(SafeSuccess());
   EXPECT_TRUE(o.success);
