@@ -274,27 +274,25 @@ void ComputeLayersInto(const ElevationMap& map, const LayerConfig& config, Eleva
   L.plane_residual.assign(n, kNaN);
   L.point_span.assign(n, PointSpan{});
   // Each cell's layers from the map alone: rows on the cores, the same as one row after another.
-  constexpr std::size_t kRowsPerBlock = 16;  // 641-cell rows: a block is ~1 ms of a known map
-  ParallelFor(static_cast<std::size_t>(g.size_y), kRowsPerBlock,
-              [&](std::size_t j0, std::size_t j1) {
-                for (int j = static_cast<int>(j0); j < static_cast<int>(j1); ++j) {
-                  for (int i = 0; i < g.size_x; ++i) {
-                    const std::size_t k = g.Linear({i, j});
-                    const CellStats& c = map.at(k);
-                    L.clearance_z[k] = c.clearance_z;
-                    if (c.count == 0) continue;
-                    L.state[k] = CellState::kObserved;
-                    L.count[k] = c.count;
-                    L.mean_z[k] = c.mean_z;  // Eq. 2
-                    L.min_z[k] = c.min_z;
-                    L.max_z[k] = c.max_z;
-                    L.roughness[k] = Roughness(c);  // Eq. 3
-                    L.plane_residual[k] = PlaneResidual(c, config.min_spread_m);
-                    L.point_span[k] = SpanOf(c, g.cell_m);
-                    Inclination(map, i, j, config, &L.phi_x[k], &L.phi_y[k]);
-                  }
-                }
-              });
+  ParallelRows(g.size_y, [&](int j0, int j1) {
+    for (int j = j0; j < j1; ++j) {
+      for (int i = 0; i < g.size_x; ++i) {
+        const std::size_t k = g.Linear({i, j});
+        const CellStats& c = map.at(k);
+        L.clearance_z[k] = c.clearance_z;
+        if (c.count == 0) continue;
+        L.state[k] = CellState::kObserved;
+        L.count[k] = c.count;
+        L.mean_z[k] = c.mean_z;  // Eq. 2
+        L.min_z[k] = c.min_z;
+        L.max_z[k] = c.max_z;
+        L.roughness[k] = Roughness(c);  // Eq. 3
+        L.plane_residual[k] = PlaneResidual(c, config.min_spread_m);
+        L.point_span[k] = SpanOf(c, g.cell_m);
+        Inclination(map, i, j, config, &L.phi_x[k], &L.phi_y[k]);
+      }
+    }
+  });
   MarkDrops(L, config);
 }
 

@@ -89,18 +89,6 @@ Blocked StepOrSlope(const ElevationLayers& L, int i, int j, const RobotLimits& r
   return Blocked::kFree;
 }
 
-// Rows [j0, j1) of a grid pass in blocks on the machine's cores (mapping::ParallelFor): for the
-// passes where each cell's result depends only on what the pass reads, so the grid is the one a
-// single thread makes. A block of 16 641-cell rows is ~0.2-1 ms of work.
-template <typename RowsBody>
-void ForRows(int rows, RowsBody&& body) {
-  constexpr std::size_t kRowsPerBlock = 16;
-  mapping::ParallelFor(static_cast<std::size_t>(rows), kRowsPerBlock,
-                       [&](std::size_t j0, std::size_t j1) {
-                         body(static_cast<int>(j0), static_cast<int>(j1));
-                       });
-}
-
 // The hazard cells that border a non-hazard cell: the only ones a disc around them can reach
 // beyond the hazard itself.
 std::vector<std::size_t> HazardBorder(const TraversabilityGrid& T) {
@@ -226,7 +214,7 @@ void ComputeMoves(TraversabilityGrid& T) {
   const std::ptrdiff_t row = g.Linear({0, 1}) - g.Linear({0, 0});
   std::ptrdiff_t offset[8];
   for (int b = 0; b < 8; ++b) offset[b] = kMoveDi[b] + kMoveDj[b] * row;
-  ForRows(sy, [&](int j0, int j1) {
+  mapping::ParallelRows(sy, [&](int j0, int j1) {
     for (int j = j0; j < j1; ++j) {
       if (j == 0 || j == sy - 1 || sx < 3) {
         for (int i = 0; i < sx; ++i) edge_cell(i, j);
@@ -308,7 +296,7 @@ void ComputeMoveCosts(TraversabilityGrid& T) {
   const double w_length = T.config.weights.length;
   const float* z = T.z_m.data();
   const float* enter = T.enter_cost.data();
-  ForRows(g.size_y, [&](int j0, int j1) {
+  mapping::ParallelRows(g.size_y, [&](int j0, int j1) {
     double min_straight = std::numeric_limits<double>::infinity(), min_diagonal = min_straight;
     double max_edge = 0;
     for (int j = j0; j < j1; ++j)
@@ -483,7 +471,7 @@ void BuildTraversabilityInto(const ElevationLayers& L, const PlannerConfig& conf
     }
     return L.Tilt(k) > limit;
   };
-  ForRows(g.size_y, [&](int j0, int j1) {
+  mapping::ParallelRows(g.size_y, [&](int j0, int j1) {
     for (int j = j0; j < j1; ++j)
       for (int i = 0; i < g.size_x; ++i) {
         const std::size_t k = g.Linear({i, j});

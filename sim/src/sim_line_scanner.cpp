@@ -120,8 +120,9 @@ SimLineScanner::~SimLineScanner() = default;
 
 // The casting thread pays where the caster needs no Refresh between lines and a second core runs
 // it: a line's rays took as long as its physics (terrain seed 1: 0.86 s of casting, 0.46 s of
-// stepping through lines and 0.46 s of the axis's moves between them), so the sweep's wall time
-// drops by about the casting's.
+// stepping through lines and 0.46 s of the axis's moves between them). Measured over eight runs
+// each: the scan waits 0.72 -> 0.28 s for casting, its physics, sharing the cores, 0.76 -> 0.91 s
+// (benchmarks/README.md, session 31).
 void SimLineScanner::BeginSweep() {
   in_sweep_ = false;
   if (!caster_.Static() || sensors::AllowedCores() < 2) return;

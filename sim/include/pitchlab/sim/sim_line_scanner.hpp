@@ -17,7 +17,8 @@ namespace pitchlab::sim {
 class SerialWorker;
 
 /// LineScanner on a Simulation. `caster` and `sim` must outlive it; the caster must have been
-/// built on sim.model()/sim.data() (it is Refresh()ed before every line).
+/// built on sim.model()/sim.data() (it is Refresh()ed before every line cast at once; a
+/// sweep casts on its own thread only with a static caster, whose Refresh does nothing).
 class SimLineScanner final : public sensors::LineScanner {
  public:
   SimLineScanner(Simulation& sim, sensors::RayCaster& caster, const sensors::Lms200Config& config);
