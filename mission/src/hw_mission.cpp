@@ -325,7 +325,7 @@ HwMissionOutcome RunHwMission(const HwMissionSpec& spec, const std::filesystem::
   run.context = HwContext(spec, frame, settings);
   run.context.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  WriteFinalOutputs(folder, run.context, run.result, std::nullopt, nullptr, std::nullopt);
+  WriteFinalOutputs(folder, run.context, run.result, std::nullopt, nullptr);
   backend.rig.reset();
   if (hw::StopRequested()) {
     run.interrupted = "while writing the run folder";

@@ -295,16 +295,21 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
   return m;
 }
 
-void WriteFinalOutputs(RunFolder& folder, const RunContext& c, const MissionResult& r,
-                       const std::optional<RunScore>& score, const mapping::ElevationLayers* truth,
-                       const std::optional<planning::Path>& truth_optimum) {
-  WriteSummary(folder, c, r, score, WriteFinalData(folder, c, r, truth, truth_optimum));
+FinalMap MakeFinalMap(const RunContext& c, const MissionResult& r) {
+  FinalMap final_map{mapping::ComputeLayers(r.elevation, c.layers), {}};
+  final_map.grid = planning::BuildTraversability(final_map.layers, c.planner);
+  return final_map;
 }
 
-mapping::ElevationLayers WriteFinalData(RunFolder& folder, const RunContext& c,
-                                        const MissionResult& r,
-                                        const mapping::ElevationLayers* truth,
-                                        const std::optional<planning::Path>& truth_optimum) {
+void WriteFinalOutputs(RunFolder& folder, const RunContext& c, const MissionResult& r,
+                       const std::optional<RunScore>& score, const TruthMaps* truth) {
+  const FinalMap final_map = MakeFinalMap(c, r);
+  WriteFinalData(folder, c, r, final_map, truth);
+  WriteSummary(folder, c, r, score, final_map);
+}
+
+void WriteFinalData(RunFolder& folder, const RunContext& c, const MissionResult& r,
+                    const FinalMap& final_map, const TruthMaps* truth) {
   WriteTextFile(folder.File("config.yaml"), c.config_yaml);
   // The map's cloud and cells on a thread of their own beside the rest (the run waits for its
   // final files).
@@ -320,8 +325,7 @@ mapping::ElevationLayers WriteFinalData(RunFolder& folder, const RunContext& c,
     Check(sensors::WriteScanPcd(cloud, folder.File("map_cloud.pcd").string()));
     Check(mapping::SaveElevationMap(r.elevation, folder.File("elevation.plem").string()));
   });
-  const mapping::ElevationLayers layers = mapping::ComputeLayers(r.elevation, c.layers);
-  Check(mapping::WriteEsriAsciiGrid(layers, c.geodetic_origin,
+  Check(mapping::WriteEsriAsciiGrid(final_map.layers, c.geodetic_origin,
                                     folder.File("elevation.asc").string()));
   WriteTrajectoryCsv(folder.File("trajectory_estimated.csv"), r, false);
   WriteTrajectoryCsv(folder.File("trajectory_true.csv"), r, true);
@@ -329,17 +333,16 @@ mapping::ElevationLayers WriteFinalData(RunFolder& folder, const RunContext& c,
   if (c.geodetic_origin) {
     WriteTrajectoryGeoJson(folder.File("trajectories.geojson"), r, *c.geodetic_origin);
   }
-  WriteRunPictures(folder, c, r, layers, truth, truth_optimum);
+  WriteRunPictures(folder, c, r, final_map, truth);
   map_files.get();
-  return layers;
 }
 
 void WriteSummary(RunFolder& folder, const RunContext& c, const MissionResult& r,
-                  const std::optional<RunScore>& score, const mapping::ElevationLayers& layers) {
+                  const std::optional<RunScore>& score, const FinalMap& final_map) {
   const nlohmann::json metrics = RunMetrics(c, r, score);
   WriteTextFile(folder.File("metrics.json"), metrics.dump(2));
 
-  WriteRunReport(folder, c, r, metrics, layers);
+  WriteRunReport(folder, c, r, metrics, final_map);
 }
 
 }  // namespace pitchlab::mission

@@ -118,8 +118,8 @@ std::vector<Eigen::Vector2d> TrajectoryXy(const MissionResult& r, bool truth) {
 }
 
 void WriteRunPictures(RunFolder& folder, const RunContext& c, const MissionResult& r,
-                      const mapping::ElevationLayers& layers, const mapping::ElevationLayers* truth,
-                      const std::optional<planning::Path>& truth_optimum) {
+                      const FinalMap& final_map, const TruthMaps* truth) {
+  const mapping::ElevationLayers& layers = final_map.layers;
   const std::vector<Eigen::Vector2d> est = TrajectoryXy(r, false), tru = TrajectoryXy(r, true);
   std::vector<Eigen::Vector2d> keep = est;
   keep.insert(keep.end(), tru.begin(), tru.end());
@@ -135,24 +135,22 @@ void WriteRunPictures(RunFolder& folder, const RunContext& c, const MissionResul
 
   // The truth's pictures on a thread of their own beside the estimate's: the run waits for its
   // final files, and a second core halves that wait.
-  std::future<planning::TraversabilityGrid> truth_pictures;
+  std::future<void> truth_pictures;
   if (truth) {
     truth_pictures = std::async(std::launch::async, [&] {
       const sensors::WorkerThread worker;  // the run's outputs, done beside it
-      const mapping::GridGeometry& tg = truth->geometry;
+      const mapping::GridGeometry& tg = truth->layers.geometry;
       mapping::ImageOptions truth_options;
       truth_options.pixels_per_cell = FigurePixelsPerCell(tg, window);
-      planning::TraversabilityGrid true_grid = planning::BuildTraversability(*truth, c.planner);
-      Write(ComposeMapFigure(RenderTraversability(true_grid, truth_options), tg, window, marks),
+      Write(ComposeMapFigure(RenderTraversability(truth->grid, truth_options), tg, window, marks),
             folder.File("truth_traversability.png"));
-      mapping::RgbImage truth_image = mapping::RenderElevationImage(*truth, truth_options);
-      if (truth_optimum) planning::DrawPath(*truth_optimum, tg, truth_image);
+      mapping::RgbImage truth_image = mapping::RenderElevationImage(truth->layers, truth_options);
+      if (truth->optimum) planning::DrawPath(*truth->optimum, tg, truth_image);
       DrawPolyline(truth_image, tg, tru, 30, 80, 255);
       FigureMarks truth_marks = marks;
-      truth_marks.colour_bar = HeightBar(*truth);
+      truth_marks.colour_bar = HeightBar(truth->layers);
       Write(ComposeMapFigure(truth_image, tg, window, truth_marks),
             folder.File("truth_elevation.png"));
-      return true_grid;
     });
   }
   mapping::RgbImage image = mapping::RenderElevationImage(layers, options);
@@ -162,14 +160,13 @@ void WriteRunPictures(RunFolder& folder, const RunContext& c, const MissionResul
   DrawPolyline(image, g, est, 255, 140, 0);
   DrawPolyline(image, g, tru, 30, 80, 255);
   Write(ComposeMapFigure(image, g, window, height_marks), folder.File("elevation.png"));
-  const planning::TraversabilityGrid estimated = planning::BuildTraversability(layers, c.planner);
-  Write(ComposeMapFigure(RenderTraversability(estimated, options), g, window, marks),
+  Write(ComposeMapFigure(RenderTraversability(final_map.grid, options), g, window, marks),
         folder.File("traversability.png"));
   if (!r.success && r.last_plan_stop >= 0) WriteLastPlanPicture(folder, r, window, marks, est, tru);
   if (!truth) return;
-  const planning::TraversabilityGrid true_grid = truth_pictures.get();
-  // The picture of map_hazards: the same grids ScoreRun compares (same layers, same planner).
-  Write(ComposeMapFigure(RenderHazardErrors(estimated, true_grid, options), g, window, marks),
+  truth_pictures.get();
+  Write(ComposeMapFigure(RenderHazardErrors(truth->scored_estimate, truth->grid, options), g,
+                         window, marks),
         folder.File("hazard_errors.png"));
 }
 

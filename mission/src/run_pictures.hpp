@@ -20,14 +20,15 @@ namespace pitchlab::mission {
 std::vector<Eigen::Vector2d> TrajectoryXy(const MissionResult& result, bool truth);
 
 /// Writes elevation.png (estimated map, every plan in red, estimated trajectory orange, true
-/// blue, colour bar), traversability.png and, with `truth`: truth_elevation.png (true optimal
-/// path red, true trajectory blue), truth_traversability.png and hazard_errors.png. A failed run
+/// blue, colour bar), traversability.png (the grid the mission planned on) and, with `truth`:
+/// truth_elevation.png (true optimal path red, true trajectory blue), truth_traversability.png
+/// (the true grid the optimum and the score were found on) and hazard_errors.png (the cells
+/// ScoreRun counted, from the very grids it compared). A failed run
 /// also gets last_plan.png: the traversability its last plan was made on (the mission's own grid,
 /// MissionResult::last_plan_grid), that plan in red, and the run's tracks (estimated orange, true
 /// blue). Throws std::runtime_error naming the file on a write failure.
 void WriteRunPictures(RunFolder& folder, const RunContext& context, const MissionResult& result,
-                      const mapping::ElevationLayers& layers, const mapping::ElevationLayers* truth,
-                      const std::optional<planning::Path>& truth_optimum);
+                      const FinalMap& final_map, const TruthMaps* truth);
 
 /// What a stop's picture needs of the run so far, and no more: the part of the map it shows with
 /// what the layers there read (a few percent of a large map's cells: a copy the thread beside the

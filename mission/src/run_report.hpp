@@ -48,11 +48,11 @@ std::string RenderRunReport(const RunReportInput& input, const Result<ThreeJs>& 
 /// Collects the report's input from a run whose other files are already in `folder`.
 RunReportInput GatherRunReport(const RunFolder& folder, const RunContext& context,
                                const MissionResult& result, const nlohmann::json& metrics,
-                               const mapping::ElevationLayers& layers);
+                               const FinalMap& final_map);
 
 /// Writes report.html (three.js from DefaultThreeJsDir; when it is missing the page says so and
 /// a warning goes to stderr). Throws std::runtime_error naming the file on a write failure.
 void WriteRunReport(RunFolder& folder, const RunContext& context, const MissionResult& result,
-                    const nlohmann::json& metrics, const mapping::ElevationLayers& layers);
+                    const nlohmann::json& metrics, const FinalMap& final_map);
 
 }  // namespace pitchlab::mission

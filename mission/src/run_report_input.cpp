@@ -56,8 +56,8 @@ void AddStops(RunReportInput& in, const MissionResult& r) {
   }
 }
 
-Scene3D BuildRunScene(const RunContext& c, const MissionResult& r,
-                      const mapping::ElevationLayers& layers) {
+Scene3D BuildRunScene(const RunContext& c, const MissionResult& r, const FinalMap& final_map) {
+  const mapping::ElevationLayers& layers = final_map.layers;
   Scene3D scene;
   scene.cloud_m = DecimateCloud(r.map_cloud_world, kSceneMaxPoints);
   scene.true_m = Trajectory3d(r, true);
@@ -67,7 +67,7 @@ Scene3D BuildRunScene(const RunContext& c, const MissionResult& r,
   keep.push_back(c.start.head<2>());
   keep.push_back(c.goal);
   const MapWindow window = ExploredWindow(layers, keep);
-  scene.surface = BuildSurface(layers, planning::BuildTraversability(layers, c.planner), window);
+  scene.surface = BuildSurface(layers, final_map.grid, window);
   // Start at the robot's first height; the goal on the map where its cell is known, else at the
   // robot's last height.
   const double z0 = scene.estimated_m.empty() ? 0.0 : scene.estimated_m.front().z();
@@ -94,8 +94,7 @@ std::vector<std::string> FolderFiles(const std::filesystem::path& root) {
 }  // namespace
 
 RunReportInput GatherRunReport(const RunFolder& folder, const RunContext& c, const MissionResult& r,
-                               const nlohmann::json& metrics,
-                               const mapping::ElevationLayers& layers) {
+                               const nlohmann::json& metrics, const FinalMap& final_map) {
   RunReportInput in;
   in.metrics = metrics;
   in.config_yaml = c.config_yaml;
@@ -135,7 +134,7 @@ RunReportInput GatherRunReport(const RunFolder& folder, const RunContext& c, con
                      {"true", "#1e50ff", TrajectoryXy(r, true), true}};
   in.markers = {{"start", "#111111", c.start.head<2>()}, {"goal", "#d01010", c.goal}};
   AddStops(in, r);
-  in.scene_json = SceneJson(BuildRunScene(c, r, layers));
+  in.scene_json = SceneJson(BuildRunScene(c, r, final_map));
   in.files = FolderFiles(in.folder);
   in.files.push_back("report.html");
   std::sort(in.files.begin(), in.files.end());
@@ -143,13 +142,13 @@ RunReportInput GatherRunReport(const RunFolder& folder, const RunContext& c, con
 }
 
 void WriteRunReport(RunFolder& folder, const RunContext& c, const MissionResult& r,
-                    const nlohmann::json& metrics, const mapping::ElevationLayers& layers) {
+                    const nlohmann::json& metrics, const FinalMap& final_map) {
   const Result<ThreeJs> three = LoadThreeJs(DefaultThreeJsDir());
   if (!three) {
     std::cerr << "warning: report.html without its 3D view: " << three.error().message << "\n";
   }
   WriteTextFile(folder.File("report.html"),
-                RenderRunReport(GatherRunReport(folder, c, r, metrics, layers), three));
+                RenderRunReport(GatherRunReport(folder, c, r, metrics, final_map), three));
 }
 
 }  // namespace pitchlab::mission

@@ -343,25 +343,31 @@ SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesyste
   }
   stages[Stage::kGroundTruth].cpu_s += truth_cpu_s;
   stages[Stage::kOutputs].cpu_s += outputs_cpu_s;
+  run.context = SimContext(spec, settings, start, origin, rig);
+  const FinalMap final_map = [&] {
+    const sensors::ScopedTime timing(stages[Stage::kOutputs]);
+    return MakeFinalMap(run.context, run.result);
+  }();
+  // ScoreRun's grids: the final map's layers with the mission's own planner (RunContext's adds
+  // the follower's safety margin to the robot's width), as the truth's.
+  planning::TraversabilityGrid scored;
   {
     const sensors::ScopedTime timing(stages[Stage::kScoring]);
-    const planning::TraversabilityGrid final_grid = planning::BuildTraversability(
-        mapping::ComputeLayers(run.result.elevation, mission.layers), mission.planner);
+    scored = planning::BuildTraversability(final_map.layers, mission.planner);
     run.score =
-        ScoreRun(run.result, truth->grid, final_grid, start.head<2>(), goal, mission.algorithm, via);
+        ScoreRun(run.result, truth->grid, scored, start.head<2>(), goal, mission.algorithm, via);
   }
-
-  run.context = SimContext(spec, settings, start, origin, rig);
-  const mapping::ElevationLayers layers = [&] {
+  {
     const sensors::ScopedTime timing(stages[Stage::kOutputs]);
-    return WriteFinalData(folder, run.context, run.result, &truth->layers, truth->optimum);
-  }();
+    const TruthMaps truth_maps{truth->layers, truth->grid, scored, &truth->optimum};
+    WriteFinalData(folder, run.context, run.result, final_map, &truth_maps);
+  }
   // The run's time up to its summary, which holds it (metrics.json, report.html).
   const sensors::Elapsed run_time = run_clock.Read();
   run.context.wall_time_s = run_time.wall_s;
   stages += run.result.stages;
   run.context.stages = StageBreakdown{stages, run_time};
-  WriteSummary(folder, run.context, run.result, run.score, layers);
+  WriteSummary(folder, run.context, run.result, run.score, final_map);
   folder.Commit();
   run.metrics = RunMetrics(run.context, run.result, run.score);
   run.folder = folder.final_path();

@@ -403,6 +403,50 @@ TEST_P(RobotModels, TheContactBufferIsSizedForTheRobotsGeoms) {
   EXPECT_EQ(sized->model()->njmax, 300);
 }
 
+// The solver's scratch stack grows with rows times dofs (SolverStack), not as MuJoCo's default
+// 5 (njmax + nv)^2: a twentieth of it at most here. A world that sizes its stack keeps its own.
+TEST_P(RobotModels, TheSolverStackGrowsWithRowsTimesDofsNotRowsSquared) {
+  const auto sim = Simulation::FromString(kFlatWorld, "/tmp", Robot(GetParam()));
+  const mjModel* m = sim->model();
+  const long rows = m->njmax + m->nv;
+  EXPECT_EQ(m->nstack, 8 * rows * (m->nv + 10));
+  EXPECT_LT(20 * static_cast<double>(m->nstack), 5.0 * rows * rows);
+  EXPECT_EQ(sim->data()->nstack, m->nstack);
+  std::string own(kFlatWorld);
+  own.insert(own.rfind("</mujoco>"), "<size nstack=\"123456\"/>\n");
+  EXPECT_EQ(Simulation::FromString(own, "/tmp", Robot(GetParam()))->model()->nstack, 123456);
+}
+
+// The most the stack must hold: a full contact buffer over many dofs. 96 loose boxes (576 dofs,
+// past MuJoCo's sparse threshold of 60) dropped in six layers onto the floor and each other fill
+// the P3-AT's 400 contacts; every step fits the stack (else mju_error throws), with room to spare
+// (used 2.8 M of 10.4 M numbers).
+TEST(Simulation, AFullContactBufferOverHundredsOfDofsFitsTheSolverStack) {
+  std::string boxes;
+  for (int k = 0; k < 96; ++k) {
+    const double x = 3.0 + 0.25 * (k % 4), y = -0.4 + 0.25 * (k / 4 % 4),
+                 z = 0.11 + 0.22 * (k / 16);
+    char body[256];
+    std::snprintf(body, sizeof body,
+                  "<body pos=\"%.2f %.2f %.2f\"><freejoint/>"
+                  "<geom type=\"box\" size=\"0.1 0.1 0.1\" mass=\"1\"/></body>\n",
+                  x, y, z);
+    boxes += body;
+  }
+  const std::string xml =
+      "<mujoco model=\"pile\"><worldbody>"
+      "<geom name=\"floor\" type=\"plane\" size=\"10 10 0.1\"/>" +
+      boxes + "</worldbody></mujoco>";
+  const auto sim = Simulation::FromString(xml, "/tmp", Robot(P3Model::kP3AT));
+  ASSERT_GT(sim->model()->nv, 60);
+  ASSERT_NO_THROW(sim->Step(500));  // 1 s: the pile falls and settles
+  const mjData* d = sim->data();
+  EXPECT_GE(d->maxuse_con, sim->model()->nconmax * 3 / 4);  // the buffer (nearly) full
+  EXPECT_LT(2 * d->maxuse_stack, d->nstack);
+  RecordProperty("maxuse_stack", d->maxuse_stack);
+  RecordProperty("maxuse_efc", d->maxuse_efc);
+}
+
 }  // namespace
 }  // namespace pitchlab::sim
 
