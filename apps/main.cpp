@@ -10,6 +10,7 @@
 
 #include "cli_args.hpp"
 #include "commands.hpp"
+#include "huge_pages.hpp"
 #include "pitchlab/mission/cleanup_registry.hpp"
 #include "pitchlab/mission/run_folder.hpp"
 
@@ -47,6 +48,11 @@ int main(int argc, char** argv) {
   if (argc >= 2 && !std::strcmp(argv[1], "--version")) {
     std::cout << "pitchlab " << pitchlab::apps::Version() << "\n";
     return 0;
+  }
+  // The long commands' buffers on huge pages (huge_pages.hpp): before anything else, as it may
+  // start the program again.
+  if (argc >= 2 && (!std::strcmp(argv[1], "run") || !std::strcmp(argv[1], "bench"))) {
+    pitchlab::apps::UseHugePagesForLargeAllocations(argv);
   }
   // PCL prints its own diagnostics to stderr before ours reach the user; every PCL failure that
   // matters comes back to us as an error we word ourselves.
