@@ -19,6 +19,8 @@ import subprocess
 import sys
 import tempfile
 
+from ab_args import parse_two_binaries
+
 
 def parse_args():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
@@ -28,13 +30,8 @@ def parse_args():
     p.add_argument("--runs", type=int, default=3, help="runs of each binary (default 3)")
     p.add_argument("--out", help="folder for the run folders (default: a new temporary one)")
     p.epilog = "after --: arguments of `pitchlab run` (default: --world terrain --seed 1)"
-    argv = sys.argv[1:]
-    cut = argv.index("--") if "--" in argv else len(argv)
-    args = p.parse_args(argv[:cut])
-    args.run_args = argv[cut + 1:]
-    for binary in (args.a, args.b):
-        if not (os.path.isfile(binary) and os.access(binary, os.X_OK)):
-            p.error(f"{binary}: not an executable file")
+    args, passed = parse_two_binaries(p)
+    args.run_args = passed
     if args.runs < 1:
         p.error("--runs must be at least 1")
     if any(a in ("--out", "--quiet") for a in args.run_args):

@@ -22,6 +22,8 @@ import subprocess
 import sys
 import time
 
+from ab_args import parse_two_binaries
+
 
 def parse_seeds(text):
     seeds = []
@@ -48,13 +50,8 @@ def parse_args():
     p.add_argument("--jobs", type=int, default=2, help="bench --jobs (default 2)")
     p.add_argument("--out", required=True, help="folder for the two bench folders (a/, b/)")
     p.epilog = "after --: further arguments of `pitchlab bench` (e.g. --config FILE)"
-    argv = sys.argv[1:]
-    cut = argv.index("--") if "--" in argv else len(argv)
-    args = p.parse_args(argv[:cut])
-    args.bench_args = argv[cut + 1:]
-    for binary in (args.a, args.b):
-        if not (os.path.isfile(binary) and os.access(binary, os.X_OK)):
-            p.error(f"{binary}: not an executable file")
+    args, passed = parse_two_binaries(p)
+    args.bench_args = passed
     if args.chunk < 1 or args.jobs < 1:
         p.error("--chunk and --jobs must be at least 1")
     if any(a in ("--out", "--worlds", "--seeds", "--jobs") for a in args.bench_args):
