@@ -112,8 +112,9 @@ RunReportInput GatherRunReport(const RunFolder& folder, const RunContext& c, con
                            ""});
   }
   in.pictures.push_back({"traversability.png", "traversability, estimated map",
-                         "Where the planner may go, on the estimated map at the end and on the "
-                         "true map. " +
+                         "Where the planner may go, on the estimated map at the end (the robot "
+                         "widened by the follower's safety margin, as the mission planned) and on "
+                         "the true map (as scored and as the optimum was planned). " +
                              TraversabilityLegend()});
   if (truth) in.pictures.push_back({"truth_traversability.png", "traversability, true map", ""});
   if (std::filesystem::exists(in.folder / "hazard_errors.png")) {

@@ -134,8 +134,7 @@ std::string HazardErrorsLegend() {
 std::string TraversabilityLegend() {
   return "Green: free (darker costs more to enter); checkered: unknown; red: step; orange: too "
          "steep; magenta: drop; black: occupied (an occupancy grid's obstacle); pale red: closer "
-         "to a hazard than half the robot's width plus "
-         "the safety margin.";
+         "to a hazard than half the robot's width.";
 }
 
 }  // namespace pitchlab::mission
