@@ -3,10 +3,11 @@
 alternate (A, B, A, B, ...), the table holds each stage's medians, and a binary that writes no
 metrics is an error naming what it said."""
 import os
-import stat
 import subprocess
 import sys
 import tempfile
+
+from ab_test_support import write_executable
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -26,11 +27,7 @@ json.dump({{'wall_time_s': 10.0, 'real_time_factor': 40.0, 'reason': 'goal reach
 
 
 def fake(folder, name, factor):
-    path = os.path.join(folder, name)
-    with open(path, "w") as f:
-        f.write(FAKE.format(name=name, factor=factor))
-    os.chmod(path, os.stat(path).st_mode | stat.S_IXUSR)
-    return path
+    return write_executable(folder, name, FAKE.format(name=name, factor=factor))
 
 
 def main():
@@ -45,10 +42,8 @@ def main():
         row = next(line for line in done.stdout.splitlines() if line.startswith("registration"))
         # medians of 1, 2, 3 and of 10, 20, 30
         assert row.split()[1:] == ["2.00", "2.00", "20.00", "2.00"], row
-        broken = os.path.join(tmp, "broken")
-        with open(broken, "w") as f:
-            f.write("#!/bin/sh\necho 'pitchlab run: error: unknown world' >&2\nexit 2\n")
-        os.chmod(broken, 0o755)
+        broken = write_executable(
+            tmp, "broken", "#!/bin/sh\necho 'pitchlab run: error: unknown world' >&2\nexit 2\n")
         done = subprocess.run([sys.executable, os.path.join(HERE, "ab_run.py"), broken, b,
                                "--out", os.path.join(tmp, "runs2")], capture_output=True, text=True)
         assert done.returncode == 1 and "unknown world" in done.stderr, done.stderr

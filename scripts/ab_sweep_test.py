@@ -4,10 +4,11 @@ seed with a known wall time: the chunks alternate which binary goes first, each 
 gathers every chunk, the table holds the medians and their ratio, and a failing bench is an error
 naming its log."""
 import os
-import stat
 import subprocess
 import sys
 import tempfile
+
+from ab_test_support import write_executable
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -29,11 +30,7 @@ with open(os.path.join(out, 'runs.jsonl'), 'a') as f:
 
 
 def fake(folder, name, factor):
-    path = os.path.join(folder, name)
-    with open(path, "w") as f:
-        f.write(FAKE.format(name=name, factor=factor))
-    os.chmod(path, os.stat(path).st_mode | stat.S_IXUSR)
-    return path
+    return write_executable(folder, name, FAKE.format(name=name, factor=factor))
 
 
 def ab_sweep(*args):
@@ -60,10 +57,8 @@ def main():
         assert rows["office"][1:] == ["5", "6.00", "3.00", "0.500", "5", "5", "0.3000",
                                       "0.3000"], rows["office"]
         assert rows["all"][1:5] == ["10", "6.00", "3.00", "0.500"], rows["all"]
-        broken = os.path.join(tmp, "broken")
-        with open(broken, "w") as f:
-            f.write("#!/bin/sh\necho 'pitchlab bench: error: unknown world' >&2\nexit 2\n")
-        os.chmod(broken, 0o755)
+        broken = write_executable(
+            tmp, "broken", "#!/bin/sh\necho 'pitchlab bench: error: unknown world' >&2\nexit 2\n")
         done = ab_sweep(broken, b, "--out", os.path.join(tmp, "abs2"))
         assert done.returncode == 1 and "a.log" in done.stderr, done.stderr
         assert "unknown world" in open(os.path.join(tmp, "abs2", "a.log")).read()
