@@ -860,7 +860,11 @@ bool Mission::FacePath(double yaw_rad) {
 }
 
 bool Mission::TurnTo(double yaw_rad) {
-  const double start_s = probes_.now_s();
+  const double rate = config_.follower.max_yaw_rate_rps;
+  // Stuck is no progress for stuck_timeout_s (kMinTurnProgress_rad closer to the heading), not a
+  // turn that takes longer: at a configured 0.3 rad/s a half turn takes 11 s, and the 8 s total
+  // this was ended every such turn "stuck".
+  double progress_s = probes_.now_s(), closest_rad = std::numeric_limits<double>::infinity();
   while (true) {
     if (OverBudget()) return false;
     Result<sensors::Odometry> odo = base_.ReadOdometry();
@@ -870,12 +874,14 @@ bool Mission::TurnTo(double yaw_rad) {
     }
     const double error = std::remainder(yaw_rad - Yaw(Estimate(*odo)), 2.0 * kPi);
     if (std::abs(error) < kHeadingTolerance_rad) return true;
-    if (probes_.now_s() - start_s > config_.stuck_timeout_s) {
+    if (std::abs(error) < closest_rad - kMinTurnProgress_rad) {
+      closest_rad = std::abs(error);
+      progress_s = probes_.now_s();
+    } else if (probes_.now_s() - progress_s > config_.stuck_timeout_s) {
       result_.reason = "stuck: cannot turn to " + std::to_string(yaw_rad * 180 / kPi) + " deg";
       return false;
     }
-    const double omega = std::clamp(kTurnGain_per_s * error, -config_.follower.max_yaw_rate_rps,
-                                    config_.follower.max_yaw_rate_rps);
+    const double omega = std::clamp(kTurnGain_per_s * error, -rate, rate);
     Result<sensors::Odometry> next = DriveBase(0.0, omega, config_.control_period_s);
     if (!next) {
       result_.reason = "base: " + next.error().message;

@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -246,6 +248,21 @@ TEST(RunSimMission, TheFirstScansPoseHasTheTurnToTheGoalToATenthOfADegree) {
   };
   EXPECT_NEAR(yaw(*stop.T_world_base_true), 90.0, 3.0);  // TurnTo's tolerance
   EXPECT_NEAR(yaw(stop.T_world_base), yaw(*stop.T_world_base_true), 0.1);
+  fs::remove_all(dir);
+}
+
+// Stuck is no progress for stuck_timeout_s, not a turn that takes longer: at 0.15 rad/s the
+// quarter turn to the goal takes over 10 s, more than the 8 s allowed without progress, and is
+// made (until session 33 a turn was stuck after 8 s in all).
+TEST(RunSimMission, ASlowTurnThatKeepsTurningIsNotStuck) {
+  const fs::path dir = Scratch();
+  SimMissionSpec spec = FloorSpec(dir, {-4.0, 2.5});  // 90 deg left of the start (-4, 0), yaw 0
+  spec.settings.mission.max_stops = 1;
+  spec.settings.mission.follower.max_yaw_rate_rps = 0.15;
+  ASSERT_LT(spec.settings.mission.stuck_timeout_s, (M_PI / 2) / 0.15);
+  const SimMissionOutcome run = RunSimMission(spec, dir / "run");
+  ASSERT_EQ(run.result.stops.size(), 1u) << run.result.reason;
+  EXPECT_GT(run.result.stops.front().stamp_s, (M_PI / 2 - 3 * M_PI / 180) / 0.15);
   fs::remove_all(dir);
 }
 
