@@ -43,6 +43,8 @@ Result<PcdHeader> PeekPcdHeader(const std::string& path) {
   if (!in) return Fail(Error::Code::kNotFound, "cannot read PCD '" + path + "'");
   PcdHeader h;
   std::vector<double> sizes, counts;
+  std::vector<std::string> names;
+  std::vector<char> type_codes;
   std::size_t fields = 0, types = 0;
   std::optional<double> width, height, points;
   for (std::string line; std::getline(in, line);) {
@@ -66,8 +68,24 @@ Result<PcdHeader> PeekPcdHeader(const std::string& path) {
       h.data_offset = static_cast<std::uint64_t>(in.tellg());
       const std::uint64_t counted = points ? *points : width.value_or(0) * height.value_or(1);
       h.points = counted;
-      for (std::size_t i = 0; i < sizes.size(); ++i)
-        h.point_step += static_cast<std::uint64_t>(sizes[i] * (i < counts.size() ? counts[i] : 1));
+      for (std::size_t i = 0; i < fields; ++i) {
+        PcdField field{names[i], static_cast<int>(sizes[i]), type_codes.empty() ? 'F' : type_codes[i],
+                       counts.empty() ? 1 : static_cast<int>(counts[i])};
+        const bool known_size = field.type == 'F' ? (field.size == 4 || field.size == 8)
+                                                  : (field.type == 'U' || field.type == 'I') &&
+                                                        (field.size == 1 || field.size == 2 ||
+                                                         field.size == 4 || field.size == 8);
+        if (!known_size || sizes[i] != field.size || field.count < 1 ||
+            (counts.size() > i && counts[i] != field.count)) {
+          return Fail(Error::Code::kInvalidArgument,
+                      "PCD '" + path + "': field '" + field.name + "' of TYPE " + field.type +
+                          ", SIZE " + std::to_string(sizes[i]) + ", COUNT " +
+                          std::to_string(counts.empty() ? 1.0 : counts[i]) +
+                          " is none a PCD holds (F 4 or 8 bytes; U or I 1, 2, 4 or 8; COUNT >= 1)");
+        }
+        h.point_step += static_cast<std::uint64_t>(field.size) * field.count;
+        h.fields.push_back(std::move(field));
+      }
       return h;
     }
     if (f[0] == "VIEWPOINT") {
@@ -90,8 +108,15 @@ Result<PcdHeader> PeekPcdHeader(const std::string& path) {
       return Fail(Error::Code::kInvalidArgument,
                   "PCD '" + path + "': '" + line + "' is not a count of points");
     }
-    if (f[0] == "FIELDS") fields = f.size() - 1;
-    if (f[0] == "TYPE") types = f.size() - 1;
+    if (f[0] == "FIELDS") {
+      fields = f.size() - 1;
+      names.assign(f.begin() + 1, f.end());
+    }
+    if (f[0] == "TYPE") {
+      types = f.size() - 1;
+      type_codes.clear();
+      for (std::size_t i = 1; i < f.size(); ++i) type_codes.push_back(f[i].size() == 1 ? f[i][0] : '?');
+    }
     if (f[0] == "SIZE" && v) sizes = *v;
     if (f[0] == "COUNT" && v) counts = *v;
   }

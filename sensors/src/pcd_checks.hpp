@@ -1,11 +1,11 @@
 #pragma once
-// What PCL's PCD reader trusts and must not: the data section's sizes against the file's length,
-// and the VIEWPOINT's numbers. Checked before PCL reads the data, so a crafted or damaged header
-// is an error naming the file instead of a crash (a null memmove on "uncompressed size 0") or a
-// 20-second allocation (size 1e9).
+// A PCD file's header, and what must hold before its data is read: the data section's sizes
+// against the file's length, and the VIEWPOINT's numbers. Checked before any allocation, so a
+// crafted or damaged header is an error naming the file, not a 16 GB allocation ("POINTS 1e9").
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -13,12 +13,20 @@
 
 namespace pitchlab::sensors::detail {
 
-/// PCL's `data_type` codes from PCDReader::readHeader.
+/// How the data section is stored (the DATA line).
 enum class PcdData { kAscii = 0, kBinary = 1, kBinaryCompressed = 2 };
 
-/// What a PCD header promises, read by us before PCL's reader (whose readHeader already allocates
-/// POINTS x the record size, 16 GB for "POINTS 1000000000").
+/// One FIELDS entry with its SIZE, TYPE and COUNT.
+struct PcdField {
+  std::string name;
+  int size = 4;     ///< bytes of one value
+  char type = 'F';  ///< 'F' float, 'U' unsigned, 'I' signed
+  int count = 1;    ///< values per point
+};
+
+/// What a PCD header promises.
 struct PcdHeader {
+  std::vector<PcdField> fields;  ///< in record order: a record is their values, packed
   std::uint64_t points = 0;      ///< POINTS (or WIDTH x HEIGHT)
   std::uint64_t point_step = 0;  ///< sum of SIZE x COUNT [bytes]
   PcdData data = PcdData::kAscii;
@@ -28,7 +36,8 @@ struct PcdHeader {
 };
 
 /// Reads the header lines of `path` up to DATA; an error naming the file when it has no DATA
-/// line, or a number PCL would misread (a VIEWPOINT "nan" leaves PCL's values unset).
+/// line, FIELDS, SIZE, TYPE and COUNT of different lengths, a field of a type and size no PCD
+/// writer makes (F 4 or 8; U, I 1, 2, 4 or 8) or a VIEWPOINT that is not seven numbers.
 [[nodiscard]] Result<PcdHeader> PeekPcdHeader(const std::string& path);
 
 /// The data section of `path` (it starts at byte `data_offset`) can hold `points` records of

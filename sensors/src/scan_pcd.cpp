@@ -15,17 +15,15 @@
 #include <sstream>
 #include <string_view>
 
-#include <pcl/PCLPointCloud2.h>
-#include <pcl/io/pcd_io.h>
-
 #include "cloud_text.hpp"
 #include "pcd_checks.hpp"
+#include "pcd_data.hpp"
 #include "pitchlab/sensors/cloud_file.hpp"
 
 namespace pitchlab::sensors {
 namespace {
 
-// One PCD record, packed: PCL would otherwise write the alignment gap as a field named "_".
+// One PCD record, packed (FIELDS x y z range ring beam stamp).
 struct __attribute__((packed)) PackedPoint {
   float x, y, z, range;
   std::uint16_t ring, beam;
@@ -33,41 +31,38 @@ struct __attribute__((packed)) PackedPoint {
 };
 static_assert(sizeof(PackedPoint) == 28, "PCD record must have no padding");
 
-pcl::PCLPointField Field(const char* name, std::uint32_t offset, std::uint8_t type) {
-  pcl::PCLPointField f;
-  f.name = name;
-  f.offset = offset;
-  f.datatype = type;
-  f.count = 1;
-  return f;
-}
-
-pcl::PCLPointCloud2 ToCloud2(const Scan3D& scan) {
-  using F = pcl::PCLPointField;
-  pcl::PCLPointCloud2 cloud;
-  cloud.fields = {Field("x", offsetof(PackedPoint, x), F::FLOAT32),
-                  Field("y", offsetof(PackedPoint, y), F::FLOAT32),
-                  Field("z", offsetof(PackedPoint, z), F::FLOAT32),
-                  Field("range", offsetof(PackedPoint, range), F::FLOAT32),
-                  Field("ring", offsetof(PackedPoint, ring), F::UINT16),
-                  Field("beam", offsetof(PackedPoint, beam), F::UINT16),
-                  Field("stamp", offsetof(PackedPoint, stamp), F::FLOAT64)};
-  cloud.height = 1;
-  cloud.width = static_cast<std::uint32_t>(scan.points.size());
-  cloud.point_step = sizeof(PackedPoint);
-  cloud.row_step = cloud.point_step * cloud.width;
-  cloud.is_dense = true;
-  cloud.data.resize(cloud.row_step);
-  std::uint8_t* out = cloud.data.data();
+std::string Records(const Scan3D& scan) {
+  std::string data(scan.points.size() * sizeof(PackedPoint), '\0');
+  char* out = data.data();
   for (const ScanPoint& p : scan.points) {
     const PackedPoint record{p.x, p.y, p.z, p.range_m, p.line, p.beam, p.stamp_s};
     std::memcpy(out, &record, sizeof(record));
     out += sizeof(record);
   }
-  return cloud;
+  return data;
 }
 
-// pitchlab's header comments (PCL's reader skips lines starting with '#'): where the sensor stood
+// The header up to its DATA line as PCL's writer makes it (the VIEWPOINT's floats at the stream's
+// 6 digits), with pitchlab's comments after its first line.
+std::string Header(const Scan3D& scan, const std::string& comments) {
+  const Eigen::Vector3f t = scan.T_world_base.translation().cast<float>();
+  const Eigen::Quaternionf q = Eigen::Quaterniond(scan.T_world_base.rotation()).cast<float>();
+  std::ostringstream os;
+  os.imbue(std::locale::classic());
+  os << "# .PCD v0.7 - Point Cloud Data file format\n"
+     << comments << "VERSION 0.7\n"
+     << "FIELDS x y z range ring beam stamp\n"
+     << "SIZE 4 4 4 4 2 2 8\n"
+     << "TYPE F F F F U U F\n"
+     << "COUNT 1 1 1 1 1 1 1\n"
+     << "WIDTH " << scan.points.size() << "\nHEIGHT 1\n"
+     << "VIEWPOINT " << t.x() << ' ' << t.y() << ' ' << t.z() << ' ' << q.w() << ' ' << q.x()
+     << ' ' << q.y() << ' ' << q.z() << "\n"
+     << "POINTS " << scan.points.size() << "\nDATA binary\n";
+  return os.str();
+}
+
+// pitchlab's header comments (PCD readers skip lines starting with '#'): where the sensor stood
 // and what the VIEWPOINT pose is.
 constexpr const char* kOriginKey = "# sensor_origin";
 constexpr const char* kPoseKey = "# pose";
@@ -155,18 +150,8 @@ Result<void> WriteScanPcd(const Scan3D& scan, const std::string& path) {
   const fs::path target(path);
   const fs::path tmp = target.parent_path() / ("." + target.filename().string() + ".tmp" +
                                                std::to_string(::getpid()));
-  const Eigen::Vector3d t = scan.T_world_base.translation();
-  const Eigen::Quaterniond q(scan.T_world_base.rotation());
-  const Eigen::Vector4f origin(float(t.x()), float(t.y()), float(t.z()), 0.0f);
-  const pcl::PCLPointCloud2 cloud = ToCloud2(scan);
-  // PCL's writer has no place for comments: its header, our lines after its first (comment) line.
-  std::string header = pcl::PCDWriter().generateHeaderBinary(cloud, origin, q.cast<float>());
-  header.insert(header.find('\n') + 1, HeaderComments(scan));
-  header += "DATA binary\n";  // generateHeaderBinary stops before it, as writeBinary adds it
-  if (Result<void> written = WriteWhole(tmp, {header, std::string_view(reinterpret_cast<const char*>(
-                                                              cloud.data.data()),
-                                                          cloud.data.size())});
-      !written) {
+  const std::string header = Header(scan, HeaderComments(scan));
+  if (Result<void> written = WriteWhole(tmp, {header, Records(scan)}); !written) {
     return Fail(Error::Code::kFailed, "cannot write PCD '" + path + "': " + written.error().message);
   }
   std::error_code ec;
@@ -179,18 +164,14 @@ Result<void> WriteScanPcd(const Scan3D& scan, const std::string& path) {
 }
 
 Result<Scan3D> ReadScanPcd(const std::string& path) {
-  pcl::PCLPointCloud2 cloud;
-  Eigen::Vector4f origin;
-  Eigen::Quaternionf orientation;
-  int pcd_version = 0;
-  pcl::PCDReader reader;
   if (!std::filesystem::is_regular_file(path)) {
     return Fail(Error::Code::kNotFound, "no such PCD file '" + path + "'");
   }
-  // PCL's reader trusts the header: it allocates what POINTS says, crashes on a compressed size
-  // of 0 or a file without fields, leaves a VIEWPOINT "nan" unset. Check it ourselves first.
   Result<detail::PcdHeader> header = detail::PeekPcdHeader(path);
   if (!header) return tl::make_unexpected(header.error());
+  if (header->fields.empty() || header->point_step == 0) {
+    return Fail(Error::Code::kInvalidArgument, "'" + path + "' is not a readable PCD file");
+  }
   if (Result<void> sized = detail::CheckPcdDataSize(path, header->data, header->data_offset,
                                                     header->points, header->point_step);
       !sized) {
@@ -200,41 +181,36 @@ Result<Scan3D> ReadScanPcd(const std::string& path) {
       !viewpoint) {
     return tl::make_unexpected(viewpoint.error());
   }
-  int data_type = 0;
-  unsigned int data_idx = 0;
-  if (reader.readHeader(path, cloud, origin, orientation, pcd_version, data_type, data_idx) != 0 ||
-      cloud.fields.empty() || cloud.point_step == 0) {
-    return Fail(Error::Code::kInvalidArgument, "'" + path + "' is not a readable PCD file");
-  }
-  if (reader.read(path, cloud, origin, orientation, pcd_version) != 0) {
-    return Fail(Error::Code::kInvalidArgument, "'" + path + "' is not a readable PCD file");
-  }
-  // A field's offset when it has `name` and one of `types`, else -1.
-  auto offset_of = [&](const char* name, std::initializer_list<std::uint8_t> types) -> int {
-    for (const auto& f : cloud.fields) {
-      for (std::uint8_t type : types) {
-        if (f.name == name && f.datatype == type) return static_cast<int>(f.offset);
+  Result<std::vector<std::uint8_t>> records = detail::ReadPcdRecords(path, *header);
+  if (!records) return tl::make_unexpected(records.error());
+  // A field's byte offset in the record when it has `name`, one value of `type` and `size`
+  // bytes; else -1.
+  auto offset_of = [&](const char* name, char type, int size) -> int {
+    std::size_t offset = 0;
+    for (const detail::PcdField& f : header->fields) {
+      if (f.name == name && f.type == type && f.size == size && f.count == 1) {
+        return static_cast<int>(offset);
       }
+      offset += static_cast<std::size_t>(f.size) * f.count;
     }
     return -1;
   };
-  using F = pcl::PCLPointField;
   // x y z as float32 (ours, PCL's default) or float64 (Open3D, CloudCompare with doubles).
-  const bool doubles = offset_of("x", {F::FLOAT64}) >= 0;
-  const std::uint8_t xyz_type = doubles ? F::FLOAT64 : F::FLOAT32;
-  const int ox = offset_of("x", {xyz_type}), oy = offset_of("y", {xyz_type}),
-            oz = offset_of("z", {xyz_type});
+  const bool doubles = offset_of("x", 'F', 8) >= 0;
+  const int xyz_size = doubles ? 8 : 4;
+  const int ox = offset_of("x", 'F', xyz_size), oy = offset_of("y", 'F', xyz_size),
+            oz = offset_of("z", 'F', xyz_size);
   if (ox < 0 || oy < 0 || oz < 0) {
     return Fail(Error::Code::kInvalidArgument,
                 "PCD '" + path + "' has no x y z fields of one float type (4 or 8 bytes)");
   }
-  const int orange = offset_of("range", {F::FLOAT32}), oring = offset_of("ring", {F::UINT16}),
-            obeam = offset_of("beam", {F::UINT16}), ostamp = offset_of("stamp", {F::FLOAT64});
+  const int orange = offset_of("range", 'F', 4), oring = offset_of("ring", 'U', 2),
+            obeam = offset_of("beam", 'U', 2), ostamp = offset_of("stamp", 'F', 8);
   Scan3D scan;
-  const std::size_t n = std::size_t(cloud.width) * cloud.height;
+  const std::size_t n = header->points;
   scan.points.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint8_t* rec = cloud.data.data() + i * cloud.point_step;
+    const std::uint8_t* rec = records->data() + i * header->point_step;
     auto get = [rec](int off, auto& value) {
       if (off >= 0) std::memcpy(&value, rec + off, sizeof(value));
     };
@@ -255,14 +231,14 @@ Result<Scan3D> ReadScanPcd(const std::string& path) {
     get(obeam, p.beam);
     get(ostamp, p.stamp_s);
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      ++scan.no_returns;  // NaN points are how PCL marks missing returns
+      ++scan.no_returns;  // NaN points are how PCD writers mark missing returns
       continue;
     }
     scan.points.push_back(p);
   }
   if (!scan.points.empty()) scan.stamp_s = scan.points.front().stamp_s;
   scan.T_world_base = Eigen::Isometry3d::Identity();
-  // Our reading of the VIEWPOINT, checked above (PCL's leaves values it cannot parse unset).
+  // The VIEWPOINT, checked above.
   scan.T_world_base.translate(header->origin.head<3>().cast<double>());
   scan.T_world_base.rotate(header->orientation.cast<double>().normalized());
   Result<Comments> comments = ReadComments(path);
