@@ -20,6 +20,11 @@ namespace {
 // A PCD's quaternion is written from a unit one in float32 (PCL) or with a few decimals by hand
 // ("0.7071 0 0 0.7071" is 0.99999 long); 1 % off unit is neither, and 0 is no rotation at all.
 constexpr double kQuaternionNormTolerance = 0.01;
+// The most values one field may hold per point [1].
+constexpr double kMaxCount = 1 << 20;
+// LZF makes at most 264 bytes of 3 (a back reference of the longest length), so a stream of n
+// bytes decompresses to at most 88 n: a larger stated size is a damaged or crafted header.
+constexpr std::uint64_t kLzfMaxRatio = 88;
 
 tl::unexpected<Error> Corrupt(const std::string& path, const std::string& why) {
   return Fail(Error::Code::kInvalidArgument, "PCD '" + path + "' is corrupt: " + why);
@@ -54,12 +59,13 @@ Result<PcdHeader> PeekPcdHeader(const std::string& path) {
     if (f[0] == "DATA") {
       if (f.size() < 2) break;
       // What PCL's readHeader would only print about before failing: say it in the error.
-      for (const auto& [what, n] : {std::pair{"SIZE", sizes.size()}, {"TYPE", types == 0 ? fields : types},
+      for (const auto& [what, n] : {std::pair{"SIZE", sizes.size()},
+                                    {"TYPE", types == 0 ? fields : types},
                                     {"COUNT", counts.empty() ? fields : counts.size()}}) {
         if (n != fields) {
-          return Fail(Error::Code::kInvalidArgument,
-                      "PCD '" + path + "': " + what + " has " + std::to_string(n) +
-                          " entries for " + std::to_string(fields) + " FIELDS");
+          return Fail(Error::Code::kInvalidArgument, "PCD '" + path + "': " + what + " has " +
+                                                         std::to_string(n) + " entries for " +
+                                                         std::to_string(fields) + " FIELDS");
         }
       }
       h.data = f[1] == "binary"              ? PcdData::kBinary
@@ -69,8 +75,14 @@ Result<PcdHeader> PeekPcdHeader(const std::string& path) {
       const std::uint64_t counted = points ? *points : width.value_or(0) * height.value_or(1);
       h.points = counted;
       for (std::size_t i = 0; i < fields; ++i) {
-        PcdField field{names[i], static_cast<int>(sizes[i]), type_codes.empty() ? 'F' : type_codes[i],
-                       counts.empty() ? 1 : static_cast<int>(counts[i])};
+        // Within int before the casts: SIZE is at most 8, COUNT (a descriptor's length, 308 for
+        // PCL's VFH) bounded far above any writer's.
+        const double size = sizes[i] >= 1 && sizes[i] <= 8 ? sizes[i] : 0;
+        const double count = counts.empty()                             ? 1
+                             : counts[i] >= 1 && counts[i] <= kMaxCount ? counts[i]
+                                                                        : 0;
+        PcdField field{names[i], static_cast<int>(size), type_codes.empty() ? 'F' : type_codes[i],
+                       static_cast<int>(count)};
         const bool known_size = field.type == 'F' ? (field.size == 4 || field.size == 8)
                                                   : (field.type == 'U' || field.type == 'I') &&
                                                         (field.size == 1 || field.size == 2 ||
@@ -115,7 +127,8 @@ Result<PcdHeader> PeekPcdHeader(const std::string& path) {
     if (f[0] == "TYPE") {
       types = f.size() - 1;
       type_codes.clear();
-      for (std::size_t i = 1; i < f.size(); ++i) type_codes.push_back(f[i].size() == 1 ? f[i][0] : '?');
+      for (std::size_t i = 1; i < f.size(); ++i)
+        type_codes.push_back(f[i].size() == 1 ? f[i][0] : '?');
     }
     if (f[0] == "SIZE" && v) sizes = *v;
     if (f[0] == "COUNT" && v) counts = *v;
@@ -133,15 +146,15 @@ Result<void> CheckPcdDataSize(const std::string& path, PcdData type, std::uint64
   // the file: binary holds point_step bytes a point, ascii at least 2 (a digit and a separator),
   // binary_compressed at most 4 GiB uncompressed (its size word has 32 bits).
   const std::uint64_t step = std::max<std::uint64_t>(point_step, 1);
-  const std::uint64_t capacity = type == PcdData::kBinary   ? available / step
+  const std::uint64_t capacity = type == PcdData::kBinary  ? available / step
                                  : type == PcdData::kAscii ? available / 2
                                                            : UINT32_MAX / step;
   if (points > capacity) {
     if (type == PcdData::kBinary) {
       return Fail(Error::Code::kInvalidArgument,
-                  "PCD '" + path + "' is truncated: the header promises " +
-                      std::to_string(points) + " points of " + std::to_string(point_step) +
-                      " bytes, the file holds " + std::to_string(available) + " bytes of data");
+                  "PCD '" + path + "' is truncated: the header promises " + std::to_string(points) +
+                      " points of " + std::to_string(point_step) + " bytes, the file holds " +
+                      std::to_string(available) + " bytes of data");
     }
     return Corrupt(path, "the header promises " + std::to_string(points) +
                              " points, more than its " + std::to_string(available) +
@@ -161,10 +174,14 @@ Result<void> CheckPcdDataSize(const std::string& path, PcdData type, std::uint64
                              " bytes exceeds the file's remaining " +
                              std::to_string(available - sizeof(sizes)));
   }
+  if (sizes[1] > kLzfMaxRatio * std::uint64_t{sizes[0]}) {
+    return Corrupt(path, "its uncompressed size " + std::to_string(sizes[1]) +
+                             " bytes is more than LZF makes of " + std::to_string(sizes[0]));
+  }
   if (sizes[1] != data_bytes) {
     return Corrupt(path, "its uncompressed size " + std::to_string(sizes[1]) +
-                             " bytes is not the header's " + std::to_string(points) +
-                             " points x " + std::to_string(point_step) + " bytes");
+                             " bytes is not the header's " + std::to_string(points) + " points x " +
+                             std::to_string(point_step) + " bytes");
   }
   return {};
 }

@@ -30,19 +30,27 @@ bool Store(double value, char type, int size, std::uint8_t* to) {
   };
   if (type == 'U') {
     switch (size) {
-      case 1: return in(0, UINT8_MAX) && put(static_cast<std::uint8_t>(value));
-      case 2: return in(0, UINT16_MAX) && put(static_cast<std::uint16_t>(value));
-      case 4: return in(0, UINT32_MAX) && put(static_cast<std::uint32_t>(value));
-      default: return value >= 0 && value < 1.8446744073709552e19 &&
-                      put(static_cast<std::uint64_t>(value));
+      case 1:
+        return in(0, UINT8_MAX) && put(static_cast<std::uint8_t>(value));
+      case 2:
+        return in(0, UINT16_MAX) && put(static_cast<std::uint16_t>(value));
+      case 4:
+        return in(0, UINT32_MAX) && put(static_cast<std::uint32_t>(value));
+      default:
+        return value >= 0 && value < 1.8446744073709552e19 &&
+               put(static_cast<std::uint64_t>(value));
     }
   }
   switch (size) {
-    case 1: return in(INT8_MIN, INT8_MAX) && put(static_cast<std::int8_t>(value));
-    case 2: return in(INT16_MIN, INT16_MAX) && put(static_cast<std::int16_t>(value));
-    case 4: return in(INT32_MIN, INT32_MAX) && put(static_cast<std::int32_t>(value));
-    default: return value >= -9.2233720368547758e18 && value < 9.2233720368547758e18 &&
-                    put(static_cast<std::int64_t>(value));
+    case 1:
+      return in(INT8_MIN, INT8_MAX) && put(static_cast<std::int8_t>(value));
+    case 2:
+      return in(INT16_MIN, INT16_MAX) && put(static_cast<std::int16_t>(value));
+    case 4:
+      return in(INT32_MIN, INT32_MAX) && put(static_cast<std::int32_t>(value));
+    default:
+      return value >= -9.2233720368547758e18 && value < 9.2233720368547758e18 &&
+             put(static_cast<std::int64_t>(value));
   }
 }
 

@@ -56,8 +56,8 @@ std::string Header(const Scan3D& scan, const std::string& comments) {
      << "TYPE F F F F U U F\n"
      << "COUNT 1 1 1 1 1 1 1\n"
      << "WIDTH " << scan.points.size() << "\nHEIGHT 1\n"
-     << "VIEWPOINT " << t.x() << ' ' << t.y() << ' ' << t.z() << ' ' << q.w() << ' ' << q.x()
-     << ' ' << q.y() << ' ' << q.z() << "\n"
+     << "VIEWPOINT " << t.x() << ' ' << t.y() << ' ' << t.z() << ' ' << q.w() << ' ' << q.x() << ' '
+     << q.y() << ' ' << q.z() << "\n"
      << "POINTS " << scan.points.size() << "\nDATA binary\n";
   return os.str();
 }
@@ -148,11 +148,12 @@ Result<void> WriteWhole(const std::filesystem::path& path,
 Result<void> WriteScanPcd(const Scan3D& scan, const std::string& path) {
   namespace fs = std::filesystem;
   const fs::path target(path);
-  const fs::path tmp = target.parent_path() / ("." + target.filename().string() + ".tmp" +
-                                               std::to_string(::getpid()));
+  const fs::path tmp = target.parent_path() /
+                       ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()));
   const std::string header = Header(scan, HeaderComments(scan));
   if (Result<void> written = WriteWhole(tmp, {header, Records(scan)}); !written) {
-    return Fail(Error::Code::kFailed, "cannot write PCD '" + path + "': " + written.error().message);
+    return Fail(Error::Code::kFailed,
+                "cannot write PCD '" + path + "': " + written.error().message);
   }
   std::error_code ec;
   fs::rename(tmp, target, ec);

@@ -35,8 +35,9 @@ class PcdReader : public ::testing::Test {
   // A file of `header` lines (FIELDS to POINTS) and `data` after "DATA <kind>\n".
   fs::path Write(const std::string& header, const std::string& kind, const std::string& data) {
     const fs::path file = dir_ / "cloud.pcd";
-    std::ofstream(file, std::ios::binary) << "# .PCD v0.7\nVERSION 0.7\n" << header << "DATA "
-                                          << kind << "\n" << data;
+    std::ofstream(file, std::ios::binary) << "# .PCD v0.7\nVERSION 0.7\n"
+                                          << header << "DATA " << kind << "\n"
+                                          << data;
     return file;
   }
   // binary_compressed data: the two size words, then the LZF stream.
@@ -124,8 +125,7 @@ TEST_F(PcdReader, AnAsciiValueThatIsNoNumberNamesItsLine) {
 TEST_F(PcdReader, AnAsciiLineWithTooFewValuesNamesItsLine) {
   Result<Scan3D> scan = ReadScanPcd(Write(kXyz2, "ascii", "1 2 3\n\n4 5\n"));
   ASSERT_FALSE(scan);
-  EXPECT_NE(scan.error().message.find("line 14 has 2 values, its FIELDS hold 3"),
-            std::string::npos)
+  EXPECT_NE(scan.error().message.find("line 14 has 2 values, its FIELDS hold 3"), std::string::npos)
       << scan.error().message;
 }
 
@@ -138,8 +138,7 @@ TEST_F(PcdReader, AnAsciiIntegerOutOfItsFieldsRangeIsAnError) {
   for (const char* ring : {"70000", "-1", "1.5"}) {
     Result<Scan3D> scan = ReadScanPcd(Write(header, "ascii", std::string("1 2 3 ") + ring + "\n"));
     ASSERT_FALSE(scan) << ring;
-    EXPECT_NE(scan.error().message.find("field 'ring'"), std::string::npos)
-        << scan.error().message;
+    EXPECT_NE(scan.error().message.find("field 'ring'"), std::string::npos) << scan.error().message;
   }
 }
 
@@ -158,6 +157,28 @@ TEST_F(PcdReader, AFieldOfAnUnknownSizeIsAnErrorNamingIt) {
   ASSERT_FALSE(scan);
   EXPECT_NE(scan.error().message.find("field 'w' of TYPE F, SIZE 2"), std::string::npos)
       << scan.error().message;
+}
+
+// LZF makes at most 88 bytes of one (264 of a 3-byte back reference): a header whose points need
+// more from the stream it has is refused before anything that size is allocated.
+TEST_F(PcdReader, AnUncompressedSizeBeyondWhatLzfMakesIsRefused) {
+  const std::string header =
+      "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 100\nHEIGHT 1\nPOINTS 100\n";
+  Result<Scan3D> scan =
+      ReadScanPcd(Write(header, "binary_compressed", Compressed({3, 0, 0, 0, 0}, 1200)));
+  ASSERT_FALSE(scan);
+  EXPECT_NE(scan.error().message.find("more than LZF makes of 5"), std::string::npos)
+      << scan.error().message;
+}
+
+// A SIZE or COUNT beyond any writer's (here 1e12 values a point) is an error naming the field.
+TEST_F(PcdReader, AnAbsurdCountIsAnErrorNamingTheField) {
+  const std::string header =
+      "FIELDS x y z h\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1e12\nWIDTH 1\nHEIGHT 1\n"
+      "POINTS 1\n";
+  Result<Scan3D> scan = ReadScanPcd(Write(header, "ascii", "1 2 3 4\n"));
+  ASSERT_FALSE(scan);
+  EXPECT_NE(scan.error().message.find("field 'h'"), std::string::npos) << scan.error().message;
 }
 
 // Fields with several values (COUNT 3) keep the record's layout: x y z after a 3-float normal.
@@ -204,8 +225,7 @@ TEST_F(PcdReader, RandomlyDamagedFilesAreReadOrRefused) {
   std::string ascii;
   for (int i = 0; i < 50; ++i) ascii += std::to_string(i) + " " + std::to_string(i % 7) + " 1\n";
   const std::vector<std::pair<std::string, std::string>> files = {
-      {"binary_compressed",
-       Compressed(lzf, static_cast<std::uint32_t>(unpacked.size()))},
+      {"binary_compressed", Compressed(lzf, static_cast<std::uint32_t>(unpacked.size()))},
       {"binary", std::string(unpacked.begin(), unpacked.end())},
       {"ascii", ascii}};
   std::uint64_t state = 88172645463325252ull;  // xorshift64
