@@ -41,6 +41,12 @@ std::optional<std::vector<double>> Numbers(const std::vector<std::string_view>& 
   return numbers;
 }
 
+std::uint64_t FileSize(const std::string& path) {
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  return ec ? 0 : static_cast<std::uint64_t>(size);
+}
+
 }  // namespace
 
 Result<PcdHeader> PeekPcdHeader(const std::string& path) {
@@ -68,10 +74,17 @@ Result<PcdHeader> PeekPcdHeader(const std::string& path) {
                                                          std::to_string(fields) + " FIELDS");
         }
       }
+      if (f[1] != "ascii" && f[1] != "binary" && f[1] != "binary_compressed") {
+        return Fail(Error::Code::kInvalidArgument,
+                    "PCD '" + path + "': DATA '" + std::string(f[1]) +
+                        "' is none of ascii, binary, binary_compressed");
+      }
       h.data = f[1] == "binary"              ? PcdData::kBinary
                : f[1] == "binary_compressed" ? PcdData::kBinaryCompressed
                                              : PcdData::kAscii;
-      h.data_offset = static_cast<std::uint64_t>(in.tellg());
+      // The file may end with the DATA line, without a newline: no data after it, then.
+      const std::streamoff after = in.tellg();
+      h.data_offset = after >= 0 ? static_cast<std::uint64_t>(after) : FileSize(path);
       const std::uint64_t counted = points ? *points : width.value_or(0) * height.value_or(1);
       h.points = counted;
       for (std::size_t i = 0; i < fields; ++i) {

@@ -159,6 +159,26 @@ TEST_F(PcdReader, AFieldOfAnUnknownSizeIsAnErrorNamingIt) {
       << scan.error().message;
 }
 
+// Found by fuzzing (a DATA line of no known encoding, at the end of the file without a newline):
+// it had read as ascii data starting at an offset of -1, and thrown std::length_error.
+TEST_F(PcdReader, ADataLineOfNoKnownEncodingIsAnErrorNamingIt) {
+  const fs::path file = dir_ / "cloud.pcd";
+  std::ofstream(file, std::ios::binary) << "VERSION 0.7\n" << kXyz2 << "DATA binary_compress\x9b";
+  Result<Scan3D> scan = ReadScanPcd(file.string());
+  ASSERT_FALSE(scan);
+  EXPECT_NE(scan.error().message.find("is none of ascii, binary, binary_compressed"),
+            std::string::npos)
+      << scan.error().message;
+}
+
+TEST_F(PcdReader, AFileEndingWithItsDataLineHoldsNoPoints) {
+  const fs::path file = dir_ / "cloud.pcd";
+  std::ofstream(file, std::ios::binary) << "VERSION 0.7\n" << kXyz2 << "DATA ascii";
+  Result<Scan3D> scan = ReadScanPcd(file.string());
+  ASSERT_FALSE(scan);  // two points promised, none there
+  EXPECT_NE(scan.error().message.find("cloud.pcd"), std::string::npos) << scan.error().message;
+}
+
 // LZF makes at most 88 bytes of one (264 of a 3-byte back reference): a header whose points need
 // more from the stream it has is refused before anything that size is allocated.
 TEST_F(PcdReader, AnUncompressedSizeBeyondWhatLzfMakesIsRefused) {

@@ -1,8 +1,8 @@
 # cmake -DSOURCE_DIR=<tests/hw/fuzz> -DBINARY_DIR=<dir> -DCXX=<clang++> [-DRUNS=20000] -P run_short.cmake
-# Configures and builds the three hw fuzzers with clang in BINARY_DIR (incremental on later
-# runs), then runs each for RUNS inputs with a fixed seed. Prints "SKIP: ..." and exits 0 when
-# clang cannot link a fuzzer (no libclang-rt; CTest's SKIP_REGULAR_EXPRESSION marks the test
-# skipped), exits non-zero on a build failure or a finding.
+# Configures and builds the decoders' fuzzers with clang in BINARY_DIR (incremental on later
+# runs), then runs each for RUNS inputs with a fixed seed, from corpus/<fuzzer>/ where there is
+# one. Prints "SKIP: ..." and exits 0 when clang cannot link a fuzzer (no libclang-rt; CTest's
+# SKIP_REGULAR_EXPRESSION marks the test skipped), exits non-zero on a build failure or a finding.
 foreach(var SOURCE_DIR BINARY_DIR CXX)
   if(NOT DEFINED ${var})
     message(FATAL_ERROR "run_short.cmake: -D${var}=... is required")
@@ -16,7 +16,7 @@ endif()
 if(NOT DEFINED MAX_SECONDS)
   set(MAX_SECONDS 25)
 endif()
-set(fuzzers lms200 pitch_unit p2os)
+set(fuzzers lms200 pitch_unit p2os cloud)
 
 # Can clang link a fuzzer at all? (clang without its runtime is "not present" for this test.)
 file(MAKE_DIRECTORY "${BINARY_DIR}/probe")
@@ -45,8 +45,16 @@ endif()
 set(failed "")
 foreach(fuzzer ${fuzzers})
   message("hw_${fuzzer}_fuzz: ${RUNS} runs, at most ${MAX_SECONDS} s")
+  # A seed corpus (corpus/<fuzzer>/) is read from the sources; what the run adds goes to a folder
+  # of the build (libFuzzer writes into the first folder it is given).
+  set(corpus "")
+  if(IS_DIRECTORY "${SOURCE_DIR}/corpus/${fuzzer}")
+    file(REMOVE_RECURSE "${BINARY_DIR}/corpus/${fuzzer}")
+    file(MAKE_DIRECTORY "${BINARY_DIR}/corpus/${fuzzer}")
+    set(corpus "${BINARY_DIR}/corpus/${fuzzer}" "${SOURCE_DIR}/corpus/${fuzzer}")
+  endif()
   execute_process(COMMAND "${BINARY_DIR}/build/hw_${fuzzer}_fuzz" -runs=${RUNS} -seed=1
-                          -max_total_time=${MAX_SECONDS}
+                          -max_total_time=${MAX_SECONDS} ${corpus}
                   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
   string(REGEX MATCH "Done [0-9]+ runs in [0-9]+ second\\(s\\)" done "${out}")
   message("  ${done} (exit ${rc})")
