@@ -11,7 +11,8 @@
 namespace pitchlab::sensors {
 
 const char* CloudFormatsHelp() {
-  return "  .pcd        PCL point cloud (ascii/binary); VIEWPOINT = pose of the points' frame\n"
+  return "  .pcd        PCL point cloud (ascii, binary, binary_compressed);\n"
+         "              VIEWPOINT = pose of the points' frame\n"
          "  .3d         3DTK \"uos\" scan (cm, left-handed), with its .pose beside it\n"
          "  .ply        PLY (ascii, binary little/big endian): the vertex x y z\n"
          "  .xyz .txt   text, one point a line: x y z [m] (spaces, tabs or commas)\n";

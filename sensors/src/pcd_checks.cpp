@@ -155,8 +155,8 @@ Result<void> CheckPcdDataSize(const std::string& path, PcdData type, std::uint64
   const std::uint64_t file_size = std::filesystem::file_size(path, ec);
   if (ec) return Fail(Error::Code::kNotFound, "cannot read PCD '" + path + "': " + ec.message());
   const std::uint64_t available = file_size > data_offset ? file_size - data_offset : 0;
-  // PCL allocates points x point_step bytes before it reads a byte of data, so the count must fit
-  // the file: binary holds point_step bytes a point, ascii at least 2 (a digit and a separator),
+  // The reader allocates points x point_step bytes before it reads a byte of data, so the count
+  // must fit the file: binary holds point_step bytes a point, ascii at least 2 (a digit and a separator),
   // binary_compressed at most 4 GiB uncompressed (its size word has 32 bits).
   const std::uint64_t step = std::max<std::uint64_t>(point_step, 1);
   const std::uint64_t capacity = type == PcdData::kBinary  ? available / step
