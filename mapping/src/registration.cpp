@@ -419,9 +419,10 @@ Weakness DescendToBetterFits(const IcpTarget& target, const PointCloud& source,
                                               descents < kMaxDescents ? &better : nullptr);
     if (!better || !Rejection(*better, prior, config).empty()) return weak;
     std::ostringstream os;
-    os << (out.descended.empty() ? "ICP from the guess fitted " : "; then ")
-       << Percent(out.icp.inlier_ratio) << ", a probe restarted along a weak direction "
-       << Percent(better->inlier_ratio);
+    os << (out.descended.empty() ? "ICP from the guess stopped where " : "; then where ")
+       << Percent(out.icp.inlier_ratio)
+       << " of the source fitted; a probe restarted along a weak direction fitted "
+       << Percent(better->inlier_ratio) << ": moved there";
     out.descended += os.str();
     const int iterations = out.icp.iterations;
     out.icp = *better;
