@@ -115,6 +115,9 @@ struct IcpTarget {
   /// What the scan taken at the target frame's origin saw through (registration's free-space
   /// evidence); null: nothing known.
   const LazySeenSpace* seen = nullptr;
+  /// What the scan of the source being registered saw through, in the source's frame: the same
+  /// evidence the other way (the target's points placed by the inverse pose); null: nothing known.
+  const LazySeenSpace* source_seen = nullptr;
 };
 
 struct IcpResult {

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "fast_pipeline.hpp"
+#include "free_space_check.hpp"
 #include "guess_grid.hpp"
 #include "pcl_pipeline.hpp"
 #include "seen_space.hpp"
@@ -150,36 +151,11 @@ struct Prepared {
   Eigen::Vector3f target_sensor = Eigen::Vector3f::Zero(), source_sensor = Eigen::Vector3f::Zero();
 };
 
-// A probe's end is refuted by free space when at least kRefuted of the source's points lie where
-// the target's scan saw through (SeenSpace), and kRefutedOverAt times as many as at `at` (which
-// then is not contradicted). Measured on registration_eval's pairs and the tests' corridor: at
-// the truth at most 0.11 % (thin poles and chair legs one scan's beams hit and the other's pass);
-// a street's probes 1 m along either way 1.9 % and 0.8 %; the bare corridor's probes, where one
-// way shows violations (up to 2 %: its far ends), show none the other way.
-constexpr double kRefuted = 0.005;
-constexpr int kRefutedOverAt = 10;
-
-// The free-space evidence against probed poses around `at` (its own violations counted at the
-// first ask).
-class FreeSpaceCheck {
- public:
-  FreeSpaceCheck(const IcpTarget& target, const PointCloud& source, const IcpResult& at)
-      : target_(target), source_(source), at_(at) {}
-  bool Refutes(const IcpResult& probe) {
-    if (!target_.seen) return false;
-    const SeenSpace& seen = target_.seen->Get();
-    if (!at_violations_) at_violations_ = seen.Violations(source_, at_.T_target_source);
-    const int v = seen.Violations(source_, probe.T_target_source);
-    return v >= kRefuted * static_cast<double>(source_.size()) &&
-           v >= kRefutedOverAt * *at_violations_;
-  }
-
- private:
-  const IcpTarget& target_;
-  const PointCloud& source_;
-  const IcpResult& at_;
-  std::optional<int> at_violations_;
-};
+// The free-space evidence against poses around `at` (FreeSpaceCheck), from both scans' views.
+FreeSpaceCheck FreeSpaceAround(const IcpTarget& target, const PointCloud& source,
+                               const Eigen::Isometry3d& at) {
+  return FreeSpaceCheck(target.seen, source, target.source_seen, target.points, at);
+}
 
 // ICP restarted off `at` along a weak direction, one way (sign +1) or the other (-1), and whether
 // it ended away (beyond a quarter of the restart's offset), i.e. did not come back.
@@ -208,9 +184,9 @@ bool Undetermined(double direction_ratio, const IcpResult& at,
   bool free = true;
   if (direction_ratio >= config.degeneracy_ratio) {
     free = one.end.inlier_ratio >= at.inlier_ratio - kSameFit;
-  } else if (free_space.Refutes(one.end)) {
+  } else if (free_space.Refutes(one.end.T_target_source)) {
     const Probe other = probe(-1.0);
-    return other.away && !free_space.Refutes(other.end);
+    return other.away && !free_space.Refutes(other.end.T_target_source);
   }
   if (free && both_ways) probe(-1.0);
   return free;
@@ -228,7 +204,7 @@ class BetterEnd {
   BetterEnd(const IcpResult& at, FreeSpaceCheck& free_space) : at_(at), free_space_(free_space) {}
   void Offer(const IcpResult& end) {
     const double bar = best_ ? best_->inlier_ratio : at_.inlier_ratio + kSameFit;
-    if (end.inlier_ratio > bar && !free_space_.Refutes(end)) best_ = end;
+    if (end.inlier_ratio > bar && !free_space_.Refutes(end.T_target_source)) best_ = end;
   }
   const std::optional<IcpResult>& best() const { return best_; }
 
@@ -250,7 +226,7 @@ Weakness DegenerateDirections(const IcpTarget& target, const PointCloud& source,
   if (at.degeneracy >= ratio) return out;
   const Weakness weak =
       WeakDirections(target, source, at.T_target_source, config, ratio, max_per_kind);
-  FreeSpaceCheck free_space(target, source, at);
+  FreeSpaceCheck free_space = FreeSpaceAround(target, source, at.T_target_source);
   BetterEnd best(at, free_space);
   const bool both_ways = better != nullptr;
   for (std::size_t k = 0; k < weak.translations.size(); ++k) {
@@ -641,13 +617,10 @@ std::string ContradictedByTheScans(const IcpTarget& target, const PointCloud& so
       icp.inlier_ratio < kContradictionMargin * at.inlier_ratio) {
     return {};
   }
-  // More overlap is not a better pose: an alias that puts the source where the target's scan saw
+  // More overlap is not a better pose: an alias that puts one scan's points where the other's saw
   // through (FreeSpaceCheck, the probes' rule) contradicts nothing. The simulated office's zero-
   // motion alias fits 1.37x a loop's true pose 3 m on, and is refuted so.
-  IcpResult at_icp;
-  at_icp.T_target_source = at.T_target_source;
-  FreeSpaceCheck free_space(target, source, at_icp);
-  if (free_space.Refutes(icp)) return {};
+  if (FreeSpaceAround(target, source, at.T_target_source).Refutes(icp.T_target_source)) return {};
   const PoseError d = ComparePoses(icp.T_target_source, at.T_target_source);
   std::ostringstream os;
   os.precision(3);
@@ -1124,22 +1097,23 @@ SeenMargins FreeSpaceMargins(const RegistrationConfig& config) {
 
 // 2. The target as ICP queries it: its normals (PCA in icp_normal_radius_m, facing its sensor; the
 // feature clouds' normals are part of stage 3), hashes for the widest gate and for the fine ones,
-// and the free space its scan saw through; and the source points ICP moves (at most
-// icp_max_points). The free-space evidence is the target's own scan unless it is a map
-// (prior.target_scan), in 1 deg bins: two or more of a seed-pattern scan's 0.5 deg beams and
-// ~0.5 deg lines per bin, so inside the view a bin is rarely empty.
+// and the free space each scan saw through; and the source points ICP moves (at most
+// icp_max_points). The target's free space is its own scan's unless it is a map
+// (prior.target_scan), the source's its own, in 1 deg bins: two or more of a seed-pattern scan's
+// 0.5 deg beams and ~0.5 deg lines per bin, so inside the view a bin is rarely empty.
 struct IcpScene {
-  IcpScene(const Prepared& prep, internal::TargetMemo& memo, const RegistrationPrior& prior,
-           const RegistrationConfig& config)
+  IcpScene(const Prepared& prep, const PointCloud& source_scan, internal::TargetMemo& memo,
+           const RegistrationPrior& prior, const RegistrationConfig& config)
       : parts(memo.IcpParts(config, prep.target_sensor)),
         seen(prior.target_scan ? *prior.target_scan : memo.cloud(), prep.target_sensor, 1.0,
              FreeSpaceMargins(config)),
+        source_seen(source_scan, prep.source_sensor, 1.0, FreeSpaceMargins(config)),
         target{prep.target_icp, *parts.normals, *parts.coarse, *parts.fine, parts.cells.fine,
-               &seen},
+               &seen, &source_seen},
         source(EvenSubsample(prep.source_icp, config.icp_max_points)) {}
 
   const internal::TargetMemo::Icp& parts;  // hashes and normals, kept in the memo
-  const LazySeenSpace seen;
+  const LazySeenSpace seen, source_seen;
   const IcpTarget target;
   const PointCloud source;
 };
@@ -1499,7 +1473,7 @@ Result<RegistrationResult> RegisterWith(internal::TargetMemo& memo, const PointC
     return tl::make_unexpected(ok.error());
   }
   // 2. Normals of the ICP target, its search structures and the free space its scan saw.
-  const IcpScene scene(prep, memo, prior, config);
+  const IcpScene scene(prep, source, memo, prior, config);
   run.out.timings.normals_s = run.lap.Lap();
   const Stages s{memo, target, source, prior, config, prep, scene, ConfinedVoxels(prep, config)};
   // 3-4. Features, sample-consensus initial alignment, ICP from it (Levenberg-Marquardt).

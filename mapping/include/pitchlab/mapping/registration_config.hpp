@@ -150,10 +150,10 @@ struct RegistrationConfig {
   /// 24-34 mm where their local noise is 3 mm: a nodding scanner's calibration bends each scan a
   /// little differently, which no noise measured within one scan shows (mapping/README.md).
   double max_rmse_m = kAuto;
-  /// A point another pose puts this much nearer its sensor than the target scan saw in that
-  /// direction (plus 3 % of its range) lies where the target saw through [m]. auto: the larger
-  /// of 0.1 m (the LMS200's 9 cm mirror offset from the pitch axis moves a ray's origin by that
-  /// much) and three standard deviations of the pair's noise.
+  /// A point a pose puts this much nearer a scan's sensor than that scan saw in its direction
+  /// (plus 3 % of its range) lies where the scan saw through; each scan judges the other's points
+  /// [m]. auto: the larger of 0.1 m (the LMS200's 9 cm mirror offset from the pitch axis moves a
+  /// ray's origin by that much) and three standard deviations of the pair's noise.
   double free_space_margin_m = kAuto;
 
   /// Throws std::invalid_argument naming the field and value (kAuto is valid where allowed).
