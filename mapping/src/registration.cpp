@@ -1320,6 +1320,19 @@ std::string AcceptedGuessNote(RegistrationPath path, const FromGuess& g, bool se
          (g.held.any() ? HeldNote(g.tilt_off_deg) : "");
 }
 
+// Where ICP from the guess ended fitting too little, how much the guess itself fits: whether the
+// scans barely overlap there or ICP left a fit behind. ICP's own pose says little then: from a few
+// pairs, a step that lowers their cost may jump far (office missions entering a room through its
+// door: 13 pairs within the gate, a first step of 51 deg / 1.7 m, where the guess, 0.1 m off,
+// fitted 0 % too; a trust region that would stop such steps also stops those that guesses 30 deg
+// off need: benchmarks/README.md, session 35).
+std::string GuessFitNote(const Stages& s, const Start& guess, const IcpResult& icp) {
+  if (icp.inlier_ratio >= s.config.min_inlier_ratio) return {};
+  const IcpResult at = Evaluate(s.scene.target, s.scene.source, guess.T, s.config);
+  return std::string(" (the ") + ToString(guess.path) + " guess itself fits " +
+         Percent(at.inlier_ratio) + ")";
+}
+
 // 5. Non-linear ICP from the prior's guess (PriorGuess: odometry, else the constant-velocity
 // motion, the paper's guess for a robot without odometry), searched around when it was rejected.
 // The directions the feature alignment left `ambiguous` stay so (IcpFromGuess).
@@ -1336,7 +1349,8 @@ Verdict AlignFromGuess(const Stages& s, const Weakness& ambiguous, Progress& run
   Fill(run.out, g.icp, guess->path);
   if (!g.descended.empty()) run.notes.push_back(g.descended);
   if (!g.rejection.empty()) {
-    run.notes.push_back(std::string(ToString(guess->path)) + " path rejected: " + g.rejection);
+    run.notes.push_back(std::string(ToString(guess->path)) + " path rejected: " + g.rejection +
+                        GuessFitNote(s, *guess, g.icp));
     return {g.undetermined, {}};
   }
   run.out.success = true;

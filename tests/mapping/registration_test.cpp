@@ -251,6 +251,32 @@ TEST(Register, ScansWithNoOverlapAreAReportedFailureNotASuccess) {
   EXPECT_FALSE(r->reason.empty());
 }
 
+TEST(Register, ARejectedGuessSaysHowMuchTheGuessItselfFits) {
+  // The scan against itself from the true pose: every point fits there, but no fit can pass a
+  // minimum of 100 %, so the reason must tell the guess's own fit (nearly all) from ICP's.
+  const PointCloud cloud = CloudFromScan(SimulatedScan("office", -8, 0, 0));
+  RegistrationPrior prior;
+  prior.odometry = Eigen::Isometry3d::Identity();
+  RegistrationConfig config;
+  config.min_inlier_ratio = 1.0;
+  Result<RegistrationResult> r = RegisterScans(cloud, EveryOther(cloud), prior, config);
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_FALSE(r->success);
+  const std::string said = "(the odometry guess itself fits ";
+  const std::size_t at = r->reason.find(said);
+  ASSERT_NE(at, std::string::npos) << r->reason;
+  EXPECT_GT(std::stod(r->reason.substr(at + said.size())), 90.0) << r->reason;
+  // Scans of two worlds: at the guess only the ground under both sensors fits (14 %), under the
+  // minimum as ICP's result is.
+  const PointCloud terrain = CloudFromScan(SimulatedScan("terrain", 0, 0, 0));
+  Result<RegistrationResult> apart = RegisterScans(cloud, terrain, prior, {});
+  ASSERT_TRUE(apart) << apart.error().message;
+  EXPECT_FALSE(apart->success);
+  const std::size_t none = apart->reason.find(said);
+  ASSERT_NE(none, std::string::npos) << apart->reason;
+  EXPECT_LT(std::stod(apart->reason.substr(none + said.size())), 30.0) << apart->reason;
+}
+
 TEST(Register, TheCorridorTakesTheConstantVelocityFallback) {
   const ScanPair corridor = CorridorPair();
   const Eigen::Isometry3d& truth = corridor.truth;
