@@ -19,7 +19,7 @@ bool FreeSpaceCheck::Refutes(const Eigen::Isometry3d& T_target_source) {
     return true;
   }
   return source_seen_ &&
-         RefutedBy(*source_seen_, target_, T_target_source.inverse(), at_.inverse(), target_at_);
+         RefutedBy(*source_seen_, target_, T_target_source.inverse(), at_inverse_, target_at_);
 }
 
 }  // namespace pitchlab::mapping

@@ -38,7 +38,8 @@ class FreeSpaceCheck {
         source_(source),
         source_seen_(source_seen),
         target_(target),
-        at_(at) {}
+        at_(at),
+        at_inverse_(at.inverse()) {}
 
   /// Whether free space refutes T_target_source, seen from either scan.
   bool Refutes(const Eigen::Isometry3d& T_target_source);
@@ -48,7 +49,7 @@ class FreeSpaceCheck {
   const PointCloud& source_;
   const LazySeenSpace* source_seen_;
   const PointCloud& target_;
-  Eigen::Isometry3d at_;
+  Eigen::Isometry3d at_, at_inverse_;  // T_source_target at `at`, for the source's view
   std::optional<int> source_at_, target_at_;  // violations at `at`, counted at the first ask
 };
 
