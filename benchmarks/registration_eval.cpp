@@ -535,10 +535,24 @@ json RunPair(const Pair& p, mapping::RegistrationPrior prior,
             {"cpu", cpu_s}}}};
 }
 
+// A pose as `pitchlab register --prior` reads it: x,y,z [m], roll,pitch,yaw [deg] (yaw, then
+// pitch, then roll, as PoseFromXyzRpyDeg composes them), to 9 digits.
+std::string PriorText(const Eigen::Isometry3d& T) {
+  const Eigen::Matrix3d R = T.linear();
+  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+  const double roll = std::atan2(R(2, 1), R(2, 2)), yaw = std::atan2(R(1, 0), R(0, 0));
+  char text[160];
+  std::snprintf(text, sizeof text, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", T(0, 3), T(1, 3), T(2, 3),
+                roll / kDeg, pitch / kDeg, yaw / kDeg);
+  return text;
+}
+
 json PairInfo(const Pair& p, double level_m, double level_deg, const Eigen::Isometry3d& guess) {
   const mapping::PoseError motion = mapping::ComparePoses(p.truth, Eigen::Isometry3d::Identity());
   const mapping::PoseError offset = mapping::ComparePoses(guess, p.truth);
   const Eigen::Vector3d tt = p.truth.translation();
+  char bound[64];
+  std::snprintf(bound, sizeof bound, "%g,%g", level_m, level_deg);
   return {
       {"pair", p.id},
       {"truth_xyz_yaw", {tt.x(), tt.y(), tt.z(), std::atan2(p.truth(1, 0), p.truth(0, 0)) / kDeg}},
@@ -549,6 +563,9 @@ json PairInfo(const Pair& p, double level_m, double level_deg, const Eigen::Isom
       {"level", {level_m, level_deg}},
       {"guess_offset_m", offset.translation_m},
       {"guess_offset_deg", offset.rotation_deg},
+      // The run with the prior replayed from --dump-pairs' files:
+      // pitchlab register pair_ID_source.pcd pair_ID_target.pcd --prior GUESS --prior-error BOUND
+      {"replay", {{"prior", PriorText(guess)}, {"prior_error", bound}}},
       {"overlap", p.overlap},
       {"points", {p.target.cloud.size(), p.source.cloud.size()}},
       {"icp_voxels", {p.icp_voxels[0], p.icp_voxels[1]}}};
