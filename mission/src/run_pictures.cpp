@@ -37,6 +37,35 @@ void DrawPolyline(mapping::RgbImage& image, const mapping::GridGeometry& g,
   }
 }
 
+// A 3 px ring of `radius_m` about each of `places_m` [m], one for each group of places within
+// twice the radius of the first: an unsafe stretch is found on a whole map's picture at a glance.
+void RingPlaces(mapping::RgbImage& image, const mapping::GridGeometry& g,
+                const std::vector<Eigen::Vector2d>& places_m, double radius_m, std::uint8_t r,
+                std::uint8_t gr, std::uint8_t b) {
+  std::vector<Eigen::Vector2d> centres;
+  for (const Eigen::Vector2d& p : places_m) {
+    if (std::any_of(centres.begin(), centres.end(),
+                    [&](const Eigen::Vector2d& c) { return (c - p).norm() < 2 * radius_m; })) {
+      continue;
+    }
+    centres.push_back(p);
+  }
+  const double radius_px = radius_m / g.cell_m * image.pixels_per_cell;
+  const int reach = static_cast<int>(std::ceil(radius_px)) + 2;
+  for (const Eigen::Vector2d& c : centres) {
+    const Eigen::Vector2d at = mapping::MapToPixel(g, image, c.x(), c.y());
+    for (int dy = -reach; dy <= reach; ++dy)
+      for (int dx = -reach; dx <= reach; ++dx)
+        if (std::abs(std::hypot(dx, dy) - radius_px) <= 1.5) {
+          image.Set(static_cast<int>(at.x()) + dx, static_cast<int>(at.y()) + dy, r, gr, b);
+        }
+  }
+}
+
+// A forbidden crossing's ring: 1 m across, twice the P3-AT's length, found at a glance on a whole
+// map's picture and still pointing at the 0.1 m cells crossed.
+constexpr double kCrossingRing_m = 0.5;
+
 // The part of `map` a stop's picture shows, with what its layers there depend on. Made from the
 // whole map every stop, the layers and the image were 45 % of a terrain run's page faults (641 x
 // 641 cells, a few percent of them seen), on the thread beside the robot. The picture's window
@@ -142,7 +171,10 @@ void WriteRunPictures(RunFolder& folder, const RunContext& c, const MissionResul
       const mapping::GridGeometry& tg = truth->layers.geometry;
       mapping::ImageOptions truth_options;
       truth_options.pixels_per_cell = FigurePixelsPerCell(tg, window);
-      Write(ComposeMapFigure(RenderTraversability(truth->grid, truth_options), tg, window, marks),
+      mapping::RgbImage truth_grid = RenderTraversability(truth->grid, truth_options);
+      DrawPolyline(truth_grid, tg, tru, 30, 80, 255);
+      RingPlaces(truth_grid, tg, truth->forbidden_crossed_at, kCrossingRing_m, 30, 80, 255);
+      Write(ComposeMapFigure(truth_grid, tg, window, marks),
             folder.File("truth_traversability.png"));
       mapping::RgbImage truth_image = mapping::RenderElevationImage(truth->layers, truth_options);
       if (truth->optimum) planning::DrawPath(*truth->optimum, tg, truth_image);

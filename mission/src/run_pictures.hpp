@@ -22,7 +22,8 @@ std::vector<Eigen::Vector2d> TrajectoryXy(const MissionResult& result, bool trut
 /// Writes elevation.png (estimated map, every plan in red, estimated trajectory orange, true
 /// blue, colour bar), traversability.png (the grid the mission planned on) and, with `truth`:
 /// truth_elevation.png (true optimal path red, true trajectory blue), truth_traversability.png
-/// (the true grid the optimum and the score were found on) and hazard_errors.png (the cells
+/// (the true grid the optimum and the score were found on, the true trajectory blue, ringed where
+/// it crossed forbidden cells: TruthMaps::forbidden_crossed_at) and hazard_errors.png (the cells
 /// ScoreRun counted, from the very grids it compared). A failed run
 /// also gets last_plan.png: the traversability its last plan was made on (the mission's own grid,
 /// MissionResult::last_plan_grid), that plan in red, and the run's tracks (estimated orange, true

@@ -116,7 +116,12 @@ RunReportInput GatherRunReport(const RunFolder& folder, const RunContext& c, con
                          "widened by the follower's safety margin, as the mission planned) and on "
                          "the true map (as scored and as the optimum was planned). " +
                              TraversabilityLegend()});
-  if (truth) in.pictures.push_back({"truth_traversability.png", "traversability, true map", ""});
+  if (truth) {
+    in.pictures.push_back({"truth_traversability.png",
+                           "traversability, true map, true trajectory (blue; ringed where it "
+                           "crossed forbidden cells)",
+                           ""});
+  }
   if (std::filesystem::exists(in.folder / "hazard_errors.png")) {
     in.pictures.push_back({"hazard_errors.png", "hazard errors of the final map",
                            "Where the final map's hazards are wrong (map_hazards in the "

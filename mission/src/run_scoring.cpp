@@ -142,8 +142,9 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
   s.driven_cost_on_true_map = on_truth.cost;
   s.forbidden_cells_crossed = on_truth.forbidden_cells;
   for (std::size_t i = 1; i < driven.cells.size(); ++i) {  // the start excluded, as above
-    const planning::Blocked b = truth.blocked[truth.geometry.Linear(driven.cells[i])];
-    s.crossed_as.Count(b);
+    const std::size_t k = truth.geometry.Linear(driven.cells[i]);
+    s.crossed_as.Count(truth.blocked[k]);
+    if (!truth.Free(k)) s.forbidden_crossed_at.push_back(truth.geometry.CenterOf(driven.cells[i]));
   }
   s.hazard_cells_crossed = s.crossed_as.Total();
   auto optimum = PlanRoute(truth, start_m, via_m, goal_m, algorithm);

@@ -359,7 +359,8 @@ SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesyste
   }
   {
     const sensors::ScopedTime timing(stages[Stage::kOutputs]);
-    const TruthMaps truth_maps{truth->layers, truth->grid, scored, &truth->optimum};
+    const TruthMaps truth_maps{truth->layers, truth->grid, scored, &truth->optimum,
+                               run.score.forbidden_crossed_at};
     WriteFinalData(folder, run.context, run.result, final_map, &truth_maps);
   }
   // The run's time up to its summary, which holds it (metrics.json, report.html).

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "pitchlab/mapping/elevation_layers.hpp"
+#include "pitchlab/mapping/elevation_map.hpp"
 #include "pitchlab/mission/run_scoring.hpp"
 
 namespace pitchlab::mission {
@@ -42,6 +44,40 @@ TEST(ScoreRun, MissedTooSteepCellsReportTheMapsAndTheTruthsTilt) {
   EXPECT_EQ(s.missed_steep_tilt_unknown, 1u);
   EXPECT_NEAR(s.missed_steep_map_tilt_deg, 12.0, 1e-4);   // the upper median of 10 and 12
   EXPECT_NEAR(s.missed_steep_true_tilt_deg, 25.0, 1e-4);  // of 20, 25 and 30
+}
+
+// A 4 x 2 m floor of 0.1 m cells with a box 0.3 m tall (x 2.0-2.4, y 1.2-2.0), a P3-AT's
+// traversability of it, and a true track along y = 1.05: 0.15 m from the box, closer than half the
+// robot's width (0.25 m), so the cells beside the box it drives over are forbidden. The score says
+// where: one place a cell, each a forbidden cell under the track, all beside the box.
+TEST(ScoreRun, SaysWhereTheRunCrossedForbiddenCells) {
+  mapping::ElevationMap map(mapping::GridGeometry::FromArea(0, 0, 4, 2, 0.1));
+  std::vector<Eigen::Vector3f> points;
+  for (double y = 0.025; y < 2; y += 0.05)
+    for (double x = 0.025; x < 4; x += 0.05) {
+      const bool box = x > 2.0 && x < 2.4 && y > 1.2;
+      points.emplace_back(float(x), float(y), box ? 0.3f : 0.0f);
+    }
+  (void)map.InsertPoints(points.data(), points.size());
+  const planning::TraversabilityGrid truth =
+      planning::BuildTraversability(mapping::ComputeLayers(map), planning::PlannerConfig{});
+  MissionResult run;
+  for (double x = 0.2; x <= 3.8; x += 0.05) {
+    TrajectorySample s;
+    s.T_world_base_true = Eigen::Isometry3d(Eigen::Translation3d(x, 1.05, 0));
+    run.trajectory.push_back(s);
+  }
+  const RunScore s =
+      ScoreRun(run, truth, truth, {0.2, 1.05}, {3.8, 1.05}, planning::Algorithm::kAStar);
+  ASSERT_GT(s.forbidden_cells_crossed, 0u);
+  EXPECT_EQ(s.hazard_cells_crossed, 0u);  // beside the box, never on it
+  ASSERT_EQ(s.forbidden_crossed_at.size(), s.forbidden_cells_crossed);
+  for (const Eigen::Vector2d& at : s.forbidden_crossed_at) {
+    EXPECT_FALSE(truth.Free(truth.geometry.Linear(truth.geometry.IndexOf(at.x(), at.y()))));
+    EXPECT_NEAR(at.y(), 1.05, 1e-9);  // the cell's centre: the track's row
+    EXPECT_GT(at.x(), 2.0 - 0.25 - 0.1);
+    EXPECT_LT(at.x(), 2.4 + 0.25 + 0.1);
+  }
 }
 
 }  // namespace

@@ -65,12 +65,14 @@ FinalMap MakeFinalMap(const RunContext& context, const MissionResult& result);
 
 /// What a simulated run knows besides the map: the true map's layers, the grids ScoreRun compared
 /// (the true map's and the final map's, both with the mission's own planner: the robot's width
-/// without RunContext's safety margin) and the true optimal path (null: not known).
+/// without RunContext's safety margin), the true optimal path (null: not known) and where the run
+/// crossed truly forbidden cells (RunScore::forbidden_crossed_at; empty: nowhere).
 struct TruthMaps {
   const mapping::ElevationLayers& layers;
   const planning::TraversabilityGrid& grid;
   const planning::TraversabilityGrid& scored_estimate;
   const planning::Path* optimum;
+  std::vector<Eigen::Vector2d> forbidden_crossed_at;
 };
 
 /// Everything written at the end (see the file comment), report.html last. `truth` is null on

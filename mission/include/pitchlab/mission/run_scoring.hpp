@@ -4,6 +4,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "pitchlab/mission/mission.hpp"
 #include "pitchlab/planning/planner.hpp"
@@ -42,6 +43,9 @@ struct RunScore {
   double driven_cost_on_true_map = 0;       ///< the true trajectory's cells, costed by Eq. 5
   std::optional<double> cost_ratio;         ///< driven / optimal (>= 1 up to discretisation)
   std::size_t forbidden_cells_crossed = 0;  ///< truly forbidden cells under the true trajectory
+  /// Their centres, in the order driven (one per count above) [m]: where a run that was unsafe
+  /// was, for its pictures.
+  std::vector<Eigen::Vector2d> forbidden_crossed_at;
   /// Of those, cells that are a true step, drop or too steep themselves (the rest are within half
   /// the robot's width of one, or unknown in the truth) [1].
   std::size_t hazard_cells_crossed = 0;
