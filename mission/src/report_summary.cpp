@@ -134,7 +134,8 @@ Outcome ReadOutcome(const nlohmann::json& m) {
       n && n->get<std::size_t>() > (hazard ? hazard->get<std::size_t>() : 0)) {
     o.safety.push_back("it drove over " +
                        Count(n->get<std::size_t>(), "forbidden cell", "forbidden cells") +
-                       " (closer to a true hazard than half the robot's width)");
+                       " (closer to a true hazard than half the robot's width; ringed on the true "
+                       "traversability picture)");
   }
   if (const auto* d = At(m, "closest_approach_to_forbidden_m"); d && d->get<double>() < kTouch_m) {
     o.safety.push_back("its centre came " + Significant(d->get<double>(), 2) +
