@@ -187,6 +187,11 @@ int RunEmulate(int argc, char** argv) {
   mission::AppConfig config =
       mission::LoadAppConfig(args.Has("config") ? std::optional(args.Get("config")) : std::nullopt);
   const auto world_path = worlds::ResolveWorld(args.Get("world"), WorldsDir());
+  // Before the devices exist: a signal while they are made (the world loads for a second or two)
+  // then ends the wait below at once, and their destructors remove the pseudo-terminals' links
+  // and folders; the default action would kill the process and leave them (/tmp/pitchlab-hw-*).
+  std::signal(SIGINT, [](int) { g_interrupted = true; });
+  std::signal(SIGTERM, [](int) { g_interrupted = true; });
   SimulatedDevices devices(world_path.string(), config, pitch_baud, base_baud);
   const nlohmann::json paths = devices.Paths();
   // What the paths are, on stderr, before the paths: stdout stays the three paths (or the JSON)
@@ -208,8 +213,6 @@ int RunEmulate(int argc, char** argv) {
               << "pitch_unit " << paths["pitch_unit"].get<std::string>() << "\n"
               << "base       " << paths["base"].get<std::string>() << std::endl;
   }
-  std::signal(SIGINT, [](int) { g_interrupted = true; });
-  std::signal(SIGTERM, [](int) { g_interrupted = true; });
   while (!g_interrupted) std::this_thread::sleep_for(std::chrono::milliseconds(100));
   return 0;
 }

@@ -26,15 +26,22 @@ constexpr int kIdlePeriodMs = 5;
 EmulatedDevice::EmulatedDevice(std::string name, int baud, std::string link_path)
     : name_(std::move(name)), baud_(baud), link_path_(std::move(link_path)) {
   if (link_path_.empty()) {
-    char dir[] = "/tmp/pitchlab-hw-XXXXXX";
-    if (::mkdtemp(dir) == nullptr) {
-      throw std::runtime_error("emulator " + name_ +
-                               ": cannot create a folder under /tmp: " + std::strerror(errno));
+    std::error_code no_tmp;
+    const std::filesystem::path tmp = std::filesystem::temp_directory_path(no_tmp);  // TMPDIR
+    std::string dir = (no_tmp ? std::filesystem::path("/tmp") : tmp) / "pitchlab-hw-XXXXXX";
+    if (::mkdtemp(dir.data()) == nullptr) {
+      throw std::runtime_error("emulator " + name_ + ": cannot create the folder " + dir + ": " +
+                               std::strerror(errno));
     }
-    link_path_ = std::string(dir) + "/" + name_;
+    link_path_ = dir + "/" + name_;
     own_link_dir_ = true;
   }
-  OpenPty();
+  try {
+    OpenPty();
+  } catch (...) {  // no destructor runs: the folder made above goes here
+    if (own_link_dir_) ::rmdir(std::filesystem::path(link_path_).parent_path().c_str());
+    throw;
+  }
 }
 
 EmulatedDevice::~EmulatedDevice() {

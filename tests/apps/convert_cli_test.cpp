@@ -13,6 +13,7 @@
 #include "commands.hpp"
 #include "pitchlab/sensors/cloud_file.hpp"
 #include "pitchlab/sensors/scan_pcd.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab::apps {
 namespace {
@@ -38,19 +39,12 @@ int Convert(std::vector<std::string> args) {
 
 class ConvertCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("pitchlab_convert_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
   std::string Write(const std::string& name, const std::string& text) {
     std::ofstream(dir_ / name) << text;
     return (dir_ / name).string();
   }
   std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
+  const test_support::ScopedTempDir dir_{"convert"};
 };
 
 TEST_F(ConvertCli, ThreeDtkScanBecomesAPcdWithTheSamePointsPoseAndOrigin) {
@@ -103,7 +97,7 @@ TEST_F(ConvertCli, BadInputExitsOneAndWritesNothing) {
   EXPECT_EQ(Convert({Path("scan002.3d"), "--out", out}), 1);
   EXPECT_EQ(Convert({Path("missing.ply"), "--out", out}), 1);
   EXPECT_FALSE(fs::exists(out));
-  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 2);
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_.path()), fs::directory_iterator()), 2);
 }
 
 TEST_F(ConvertCli, ExistingOutputIsRefusedAndLeftAlone) {

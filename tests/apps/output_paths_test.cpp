@@ -1,7 +1,5 @@
 #include "output_paths.hpp"
 
-#include <unistd.h>
-
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -10,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "cli_args.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab::apps {
 namespace {
@@ -20,20 +19,10 @@ namespace fs = std::filesystem;
 // fresh clone, and goes back afterwards.
 class OutputPaths : public ::testing::Test {
  protected:
-  void SetUp() override {
-    home_ = fs::current_path();
-    dir_ = fs::temp_directory_path() /
-           ("pitchlab_outputpaths_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    fs::current_path(dir_);
-  }
-  void TearDown() override {
-    fs::current_path(home_);
-    fs::remove_all(dir_);
-  }
-  fs::path home_, dir_;
+  void SetUp() override { fs::current_path(dir_.path()); }
+  void TearDown() override { fs::current_path(home_); }  // before dir_ goes
+  const fs::path home_ = fs::current_path();
+  const test_support::ScopedTempDir dir_{"outputpaths"};
 };
 
 TEST_F(OutputPaths, ANewFolderInAMissingRelativeFolderIsFine) {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "fuzz/cloud_input.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab::fuzz {
 namespace {
@@ -27,8 +28,7 @@ std::vector<std::uint8_t> Bytes(const fs::path& file) {
 
 TEST(CloudFuzzContract, EverySeedIsReadWithinTheContract) {
   const fs::path corpus = fs::path(PITCHLAB_SOURCE_DIR) / "tests/hw/fuzz/corpus/cloud";
-  const fs::path dir = fs::temp_directory_path() / "pitchlab_cloud_contract_test";
-  fs::create_directories(dir);
+  const test_support::ScopedTempDir dir("cloud_contract");
   int seeds = 0, read = 0;
   for (const fs::directory_entry& e : fs::directory_iterator(corpus)) {
     const std::vector<std::uint8_t> bytes = Bytes(e.path());
@@ -43,14 +43,12 @@ TEST(CloudFuzzContract, EverySeedIsReadWithinTheContract) {
     ++seeds;
     read += scan.has_value();
   }
-  fs::remove_all(dir);
   EXPECT_GE(seeds, 9);  // one of each format and encoding
   EXPECT_EQ(read, seeds);
 }
 
 TEST(CloudFuzzContract, TheFirstBytePicksTheFormat) {
-  const fs::path dir = fs::temp_directory_path() / "pitchlab_cloud_contract_format";
-  fs::create_directories(dir);
+  const test_support::ScopedTempDir dir("cloud_contract_format");
   const std::string stem = (dir / "in").string();
   const std::uint8_t xyz[] = {2, '1', ' ', '2', ' ', '3', '\n'};
   const std::string path = WriteCloudInput(xyz, sizeof(xyz), stem);
@@ -63,7 +61,6 @@ TEST(CloudFuzzContract, TheFirstBytePicksTheFormat) {
   EXPECT_EQ(WriteCloudInput(uos, sizeof(uos), stem), stem + ".3d");
   EXPECT_TRUE(fs::exists(stem + ".pose"));  // the 3DTK reader needs its pose
   EXPECT_EQ(WriteCloudInput(uos, 0, stem), "");
-  fs::remove_all(dir);
 }
 
 TEST(CloudFuzzContract, TheCheckReportsEveryBreach) {

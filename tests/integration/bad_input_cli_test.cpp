@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_support.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab {
 namespace {
@@ -33,17 +34,13 @@ constexpr const char* kBenchStarted = "bench: start";
 
 class BadInputCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = cli_test::FreshTestDir("pitchlab_bad_input");
-    fs::create_directories(dir_ / "scratch");
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  void SetUp() override { fs::create_directories(dir_ / "scratch"); }
 
   CliResult Exec(const std::string& args) { return cli_test::RunPitchlab(args, dir_ / "scratch"); }
   // Everything in dir_ but the scratch folder and the inputs a test wrote: what a command left.
   std::vector<std::string> Left(const std::vector<std::string>& inputs = {}) const {
     std::vector<std::string> left;
-    for (const auto& e : fs::directory_iterator(dir_)) {
+    for (const auto& e : fs::directory_iterator(dir_.path())) {
       const std::string name = e.path().filename().string();
       if (name != "scratch" && std::find(inputs.begin(), inputs.end(), name) == inputs.end())
         left.push_back(name);
@@ -74,7 +71,7 @@ class BadInputCli : public ::testing::Test {
   }
   std::string Out(const std::string& name) const { return (dir_ / name).string(); }
 
-  fs::path dir_;
+  const test_support::ScopedTempDir dir_{"bad_input"};
 };
 
 TEST_F(BadInputCli, VersionPrintsTheProjectVersion) {
@@ -106,7 +103,7 @@ TEST_F(BadInputCli, OutputPathsAreCheckedBeforeTheWork) {
   EXPECT_EQ(r.err.find("Success"), std::string::npos) << r.err;  // no stale errno
   EXPECT_EQ(r.err.find(kScanStarted), std::string::npos) << r.err;
 
-  r = Exec("scan --world office --out " + dir_.string());  // a folder
+  r = Exec("scan --world office --out " + dir_.path().string());  // a folder
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("is a folder"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find(kScanStarted), std::string::npos) << r.err;

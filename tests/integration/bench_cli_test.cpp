@@ -3,11 +3,11 @@
 // re-run sweep resumes, and bad input fails before any run starts.
 
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_support.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab {
 namespace {
@@ -46,18 +47,18 @@ std::multiset<std::string> RunIds(const std::vector<json>& records) {
 class BenchCli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = fs::temp_directory_path() / ("pitchlab_bench_cli_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    scratch_.emplace("bench_cli");
+    dir_ = scratch_->path();
   }
-  static void TearDownTestSuite() { fs::remove_all(dir_); }
+  static void TearDownTestSuite() { scratch_.reset(); }
 
   static CliResult Exec(const std::string& args) {
     return cli_test::RunPitchlab("bench " + args, dir_);
   }
-  static fs::path dir_;
+  // The suite's folder, from its set-up to its tear-down (or the end of the process).
+  static inline std::optional<test_support::ScopedTempDir> scratch_;
+  static inline fs::path dir_;
 };
-fs::path BenchCli::dir_;
 
 // The counts of a summary row, without the timings that differ from sweep to sweep.
 json Counts(const json& row) {

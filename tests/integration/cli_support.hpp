@@ -2,15 +2,12 @@
 // What the CLI integration tests share: running the pitchlab binary and reading files back.
 
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
-
-#include <gtest/gtest.h>
 
 namespace pitchlab::cli_test {
 
@@ -26,17 +23,6 @@ inline std::string Slurp(const std::filesystem::path& path) {
   std::ostringstream os;
   os << in.rdbuf();
   return os.str();
-}
-
-/// An empty scratch folder for the running test: <tmp>/<prefix>_<pid>_<test name>.
-inline std::filesystem::path FreshTestDir(const std::string& prefix) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() /
-      (prefix + "_" + std::to_string(::getpid()) + "_" +
-       ::testing::UnitTest::GetInstance()->current_test_info()->name());
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
 }
 
 /// Runs `pitchlab <args>`; stdout and stderr go through files in `scratch_dir`.

@@ -32,6 +32,7 @@
 #include "pitchlab/mapping/elevation_io.hpp"
 
 #include "cli_support.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab {
 namespace {
@@ -177,22 +178,12 @@ bool Soon(Pred pred) {
 
 class HwRunCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("pitchlab_hw_run_cli_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    if (!HasFailure()) fs::remove_all(dir_);
-  }
-  CliResult Exec(const std::string& args) const {
-    return cli_test::RunPitchlab(args, dir_);
-  }
+  CliResult Exec(const std::string& args) const { return cli_test::RunPitchlab(args, dir_.path()); }
   fs::path Write(const std::string& name, const std::string& text) const {
     std::ofstream(dir_ / name) << text;
     return dir_ / name;
   }
-  fs::path dir_;
+  const test_support::ScopedTempDir dir_{"hw_run_cli"};
 };
 
 // Mean heights of the cells both maps observed (at least `min_points` each, with a vertical
@@ -340,7 +331,7 @@ TEST_F(HwRunCli, CtrlCWhileTheBaseTurnsStopsItAndLeavesNoRunFolder) {
   EXPECT_EQ(base.command(), std::make_pair(0.0, 0.0));
   EXPECT_TRUE(Soon([&] { return !lms.streaming(); })) << "LMS200 left streaming";
   EXPECT_FALSE(fs::exists(out));
-  for (const auto& entry : fs::directory_iterator(dir_)) {
+  for (const auto& entry : fs::directory_iterator(dir_.path())) {
     EXPECT_EQ(entry.path().filename().string().rfind(".interrupted", 0), std::string::npos)
         << "staging folder left: " << entry.path();
   }
@@ -414,7 +405,6 @@ int Le16s(const Bytes& p, std::size_t at) { return std::int16_t(p[at] | (p[at + 
 class HwEmulate : public HwRunCli {
  protected:
   void SetUp() override {
-    HwRunCli::SetUp();
     emulators_ = std::make_unique<Emulators>(Write("emulator.yaml", kSharedConfig),
                                              dir_ / "emulator.log", "");
     ASSERT_TRUE(emulators_->paths().contains("base")) << Slurp(dir_ / "emulator.log");

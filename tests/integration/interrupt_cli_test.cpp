@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
@@ -20,6 +21,7 @@
 #include <gtest/gtest.h>
 
 #include "cli_support.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab {
 namespace {
@@ -39,10 +41,14 @@ struct Ended {
 
 class InterruptCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = cli_test::FreshTestDir("pitchlab_interrupt");
+  // A child still running (its test failed before signalling it) would write on into dir_
+  // while dir_ is removed: stop it first.
+  void TearDown() override {
+    for (const pid_t pid : running_) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, nullptr, 0);
+    }
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   // Starts `pitchlab args...` with stderr into dir_/stderr.txt; `max_file_bytes` > 0 limits the
   // size of any file it writes (a full disk, portably: writes past it fail with EFBIG).
@@ -64,6 +70,7 @@ class InterruptCli : public ::testing::Test {
       ::execv(argv[0], argv.data());
       ::_exit(127);
     }
+    if (pid > 0) running_.push_back(pid);
     return pid;
   }
   // Waits until a hidden staging folder whose name starts with `prefix` exists under `folder`.
@@ -88,17 +95,20 @@ class InterruptCli : public ::testing::Test {
   Ended Wait(pid_t pid) {
     int status = 0;
     ::waitpid(pid, &status, 0);
+    running_.erase(std::remove(running_.begin(), running_.end(), pid), running_.end());
     return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(dir_ / "stderr.txt")};
   }
 
-  fs::path dir_;
+  const test_support::ScopedTempDir dir_{"interrupt"};
+  std::vector<pid_t> running_;
 };
 
 TEST_F(InterruptCli, RunRemovesItsStagingFolderAndSaysSoOnEitherSignal) {
   for (const int signal : {SIGINT, SIGTERM}) {
     const fs::path out = dir_ / ("run" + std::to_string(signal));
     const pid_t pid = Start({"run", "--world", kYard.string(), "--out", out.string()});
-    ASSERT_TRUE(StagingAppears(dir_, "." + out.filename().string())) << Slurp(dir_ / "stderr.txt");
+    ASSERT_TRUE(StagingAppears(dir_.path(), "." + out.filename().string()))
+        << Slurp(dir_ / "stderr.txt");
     ::kill(pid, signal);
     const Ended e = Wait(pid);
     EXPECT_EQ(e.exit_code, 128 + signal) << e.err;
@@ -108,7 +118,7 @@ TEST_F(InterruptCli, RunRemovesItsStagingFolderAndSaysSoOnEitherSignal) {
     EXPECT_NE(e.err.find("removed the unfinished output folder '" + out.string() + "'"),
               std::string::npos)
         << e.err;
-    EXPECT_TRUE(Staging(dir_, "." + out.filename().string()).empty());
+    EXPECT_TRUE(Staging(dir_.path(), "." + out.filename().string()).empty());
     EXPECT_FALSE(fs::exists(out));
   }
 }
@@ -123,7 +133,7 @@ TEST_F(InterruptCli, AFullDiskDuringARunNamesTheFileAndLeavesNothing) {
   EXPECT_NE(e.err.find("cannot write PCD '" + (out / "stops").string()), std::string::npos)
       << e.err;
   EXPECT_NE(e.err.find(std::strerror(EFBIG)), std::string::npos) << e.err;
-  EXPECT_TRUE(Staging(dir_, ".run").empty());
+  EXPECT_TRUE(Staging(dir_.path(), ".run").empty());
   EXPECT_FALSE(fs::exists(out));
 }
 

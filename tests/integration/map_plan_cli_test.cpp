@@ -6,10 +6,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
-
-#include <unistd.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -19,6 +18,7 @@
 #include "pitchlab/planning/occupancy_grid.hpp"
 
 #include "cli_support.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab {
 namespace {
@@ -32,9 +32,8 @@ class MapPlanCli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     // Per process: CTest runs each test of the suite in its own process, in parallel.
-    dir_ = fs::temp_directory_path() / ("pitchlab_cli_map_plan_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    scratch_.emplace("cli_map_plan");
+    dir_ = scratch_->path();
     const CliResult scan =
         Run("scan --world office --json --quiet --out " + (dir_ / "office.pcd").string());
     ASSERT_EQ(scan.exit_code, 0) << scan.err;
@@ -44,7 +43,7 @@ class MapPlanCli : public ::testing::Test {
     map_run_ = Run("map " + (dir_ / "office.pcd").string() +
                    " --world office --cell 0.1 --json --out " + (dir_ / "map").string());
   }
-  static void TearDownTestSuite() { fs::remove_all(dir_); }
+  static void TearDownTestSuite() { scratch_.reset(); }
 
   static CliResult Run(const std::string& args) {
     return cli_test::RunPitchlab(args, dir_);
@@ -53,6 +52,8 @@ class MapPlanCli : public ::testing::Test {
     return std::to_string(x) + "," + std::to_string(y);
   }
 
+  // The suite's folder, from its set-up to its tear-down (or the end of the process).
+  static inline std::optional<test_support::ScopedTempDir> scratch_;
   static inline fs::path dir_;
   static inline double start_x_ = 0, start_y_ = 0;
   static inline CliResult map_run_;

@@ -1,10 +1,9 @@
 // `pitchlab run --via` and `--round-trip` end to end: a short office mission through waypoints
 // and back to the start, and the bad values the options refuse.
 
-#include <unistd.h>
-
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +13,7 @@
 #include "pitchlab/mapping/tum_trajectory.hpp"
 
 #include "cli_support.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab {
 namespace {
@@ -25,15 +25,15 @@ using cli_test::Slurp;
 class RouteCli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = fs::temp_directory_path() / ("pitchlab_route_cli_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    scratch_.emplace("route_cli");
+    dir_ = scratch_->path();
   }
-  static void TearDownTestSuite() { fs::remove_all(dir_); }
+  static void TearDownTestSuite() { scratch_.reset(); }
   static CliResult Exec(const std::string& args) { return cli_test::RunPitchlab(args, dir_); }
-  static fs::path dir_;
+  // The suite's folder, from its set-up to its tear-down (or the end of the process).
+  static inline std::optional<test_support::ScopedTempDir> scratch_;
+  static inline fs::path dir_;
 };
-fs::path RouteCli::dir_;
 
 // The mission's goal tolerance (MissionConfig::goal_tolerance_m's default) and the pose error a
 // registered office stop keeps within on this short stretch of corridor (issue 20: 0.17 m median

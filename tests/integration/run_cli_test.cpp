@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@
 
 #include "cli_support.hpp"
 #include "png_pixels.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab {
 namespace {
@@ -32,11 +34,10 @@ const fs::path kYard = fs::path(PITCHLAB_SOURCE_DIR) / "tests/data/worlds/yard.x
 class RunCli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = fs::temp_directory_path() / ("pitchlab_run_cli_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    scratch_.emplace("run_cli");
+    dir_ = scratch_->path();
   }
-  static void TearDownTestSuite() { fs::remove_all(dir_); }
+  static void TearDownTestSuite() { scratch_.reset(); }
 
   static CliResult Exec(const std::string& args) { return cli_test::RunPitchlab(args, dir_); }
   // Folders in the scratch folder other than the successful run's: a failed run leaves none,
@@ -48,9 +49,10 @@ class RunCli : public ::testing::Test {
     }
     return n;
   }
-  static fs::path dir_;
+  // The suite's folder, from its set-up to its tear-down (or the end of the process).
+  static inline std::optional<test_support::ScopedTempDir> scratch_;
+  static inline fs::path dir_;
 };
-fs::path RunCli::dir_;
 
 TEST_F(RunCli, AMissionAroundABlockReachesTheGoalAndWritesEveryOutput) {
   const fs::path run = dir_ / "ok_yard";

@@ -14,6 +14,7 @@
 #include "pitchlab/sensors/scan_pcd.hpp"
 
 #include "cli_support.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab {
 namespace {
@@ -24,20 +25,8 @@ using cli_test::Slurp;
 
 class ScanCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("pitchlab_cli_" + std::string(::testing::UnitTest::GetInstance()
-                                              ->current_test_info()
-                                              ->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  CliResult Run(const std::string& args) const {
-    return cli_test::RunPitchlab(args, dir_);
-  }
-  fs::path dir_;
+  CliResult Run(const std::string& args) const { return cli_test::RunPitchlab(args, dir_.path()); }
+  const test_support::ScopedTempDir dir_{"scan_cli"};
 };
 
 TEST_F(ScanCli, WritesAFullSeedScanAndAJsonSummaryWithTheTruePose) {
@@ -103,7 +92,7 @@ TEST_F(ScanCli, BadInputGivesAClearErrorANonZeroExitAndNoFile) {
   std::ofstream(dir_ / "bad_value.yaml") << "lms200: {resolution_deg: 0.3}\n";
   std::ofstream(dir_ / "bad_yaml.yaml") << "lms200: [unclosed\n";
   std::ofstream(dir_ / "bad_section.yaml") << "lazer: {}\n";
-  const std::string d = dir_.string();
+  const std::string d = dir_.path().string();
   const BadInput cases[] = {
       {"--world atlantis", "unknown world 'atlantis'"},
       {"--world urban --pose 100,0,0", "outside the world"},

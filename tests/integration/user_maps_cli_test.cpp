@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_support.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab {
 namespace {
@@ -18,11 +19,12 @@ namespace {
 namespace fs = std::filesystem;
 using cli_test::CliResult;
 using cli_test::Slurp;
+using test_support::ScopedTempDir;
 
 const std::string kDemDir = std::string(PITCHLAB_TEST_DATA_DIR) + "/dem/";
 
 TEST(UserMapsCli, PlansOnARealGeographicDemAndWritesWgs84GeoJson) {
-  const fs::path dir = cli_test::FreshTestDir("pitchlab_user_maps");
+  const ScopedTempDir dir("user_maps");
   // 1.7 km east across the West Bijou escarpment, 1 arc-second (~24 x 31 m) SRTM cells.
   const double start_lon = -104.3380, start_lat = 39.5110, goal_lon = -104.3180, goal_lat = 39.5110;
   const CliResult r = cli_test::RunPitchlab(
@@ -30,7 +32,7 @@ TEST(UserMapsCli, PlansOnARealGeographicDemAndWritesWgs84GeoJson) {
           "west_bijou_escarpment_snippet.asc --start -104.3380,39.5110 --goal "
           "-104.3180,39.5110 --json --out " +
           (dir / "p").string(),
-      dir);
+      dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_TRUE(j["found"].get<bool>());
@@ -57,7 +59,7 @@ TEST(UserMapsCli, PlansOnARealGeographicDemAndWritesWgs84GeoJson) {
 }
 
 TEST(UserMapsCli, PlansOnADemWithoutPrjInItsOwnMetres) {
-  const fs::path dir = cli_test::FreshTestDir("pitchlab_user_maps");
+  const ScopedTempDir dir("user_maps");
   // Down the West Bijou gully's western side, 67 m as the crow flies (3 m cells; the file's
   // easting/northing, no .prj; its floor and walls are steeper than the P3-AT's 19.3 deg).
   const CliResult r =
@@ -65,7 +67,7 @@ TEST(UserMapsCli, PlansOnADemWithoutPrjInItsOwnMetres) {
                                 "west_bijou_gully.asc --start 559727,4380461 --goal 559736,4380395 "
                                 "--json --out " +
                                 (dir / "p").string(),
-                            dir);
+                            dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_FALSE(j["input"]["resampled"].get<bool>());
@@ -83,7 +85,7 @@ TEST(UserMapsCli, PlansOnADemWithoutPrjInItsOwnMetres) {
 }
 
 TEST(UserMapsCli, PlansOnAMapServerOccupancyGrid) {
-  const fs::path dir = cli_test::FreshTestDir("pitchlab_user_maps");
+  const ScopedTempDir dir("user_maps");
   // 40 x 20 cells of 0.1 m, free but for a wall in column 20 (x 2.0-2.1 m) below y 1.4 m
   // (rows 0-13; image rows 6-19 from the top).
   std::ostringstream pgm;
@@ -96,7 +98,7 @@ TEST(UserMapsCli, PlansOnAMapServerOccupancyGrid) {
   const CliResult r = cli_test::RunPitchlab("plan " + (dir / "room.yaml").string() +
                                                 " --start 0.5,0.5 --goal 3.5,0.5 --json --out " +
                                                 (dir / "p").string(),
-                                            dir);
+                                            dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_TRUE(j["found"].get<bool>());
@@ -111,7 +113,7 @@ TEST(UserMapsCli, PlansOnAMapServerOccupancyGrid) {
 }
 
 TEST(UserMapsCli, BadUserMapsAreRefusedNamingFileAndLineWithNothingWritten) {
-  const fs::path dir = cli_test::FreshTestDir("pitchlab_user_maps");
+  const ScopedTempDir dir("user_maps");
   std::ofstream(dir / "bad.asc") << "ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n"
                                     "1 2\n3 oops\n";
   std::ofstream(dir / "bad.yaml") << "image: m.pgm\nresolution: 0.1\nresolution: 0.2\n";
@@ -127,7 +129,7 @@ TEST(UserMapsCli, BadUserMapsAreRefusedNamingFileAndLineWithNothingWritten) {
   };
   for (const auto& c : cases) {
     const CliResult r = cli_test::RunPitchlab(
-        "plan " + c.map + " --start 0,0 --goal 1,1 --out " + (dir / "p").string(), dir);
+        "plan " + c.map + " --start 0,0 --goal 1,1 --out " + (dir / "p").string(), dir.path());
     EXPECT_EQ(r.exit_code, c.exit_code) << c.map << "\n" << r.err;
     EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / "p")) << c.map;
@@ -135,8 +137,8 @@ TEST(UserMapsCli, BadUserMapsAreRefusedNamingFileAndLineWithNothingWritten) {
 }
 
 TEST(UserMapsCli, PlanHelpStatesEveryDefault) {
-  const fs::path dir = cli_test::FreshTestDir("pitchlab_user_maps");
-  const CliResult r = cli_test::RunPitchlab("plan --help", dir);
+  const ScopedTempDir dir("user_maps");
+  const CliResult r = cli_test::RunPitchlab("plan --help", dir.path());
   ASSERT_EQ(r.exit_code, 0);
   for (const char* text :
        {"robot p3at: step 0.089 m, inclination 19.3 deg, 0.497 m wide, 0.508 m long",

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_support.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab {
 namespace {
@@ -13,7 +14,8 @@ namespace {
 using cli_test::CliResult;
 
 TEST(WorldsCli, JsonListsEveryWorldWithItsDefaultStartAndGoal) {
-  const CliResult r = cli_test::RunPitchlab("worlds --json", cli_test::FreshTestDir("worlds"));
+  const test_support::ScopedTempDir dir("worlds");
+  const CliResult r = cli_test::RunPitchlab("worlds --json", dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json list = nlohmann::json::parse(r.out);
   ASSERT_EQ(list.size(), 6u);
@@ -33,7 +35,8 @@ TEST(WorldsCli, JsonListsEveryWorldWithItsDefaultStartAndGoal) {
 }
 
 TEST(WorldsCli, TextShowsEachWorldsStartAndGoal) {
-  const CliResult r = cli_test::RunPitchlab("worlds", cli_test::FreshTestDir("worlds"));
+  const test_support::ScopedTempDir dir("worlds");
+  const CliResult r = cli_test::RunPitchlab("worlds", dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("start x, y [m], yaw [deg]"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("goal x, y [m]"), std::string::npos) << r.out;

@@ -12,6 +12,7 @@
 #include "cli_args.hpp"
 #include "pitchlab/mapping/tum_trajectory.hpp"
 #include "pitchlab/sensors/scan_pcd.hpp"
+#include "scoped_temp_dir.hpp"
 #include "sim_scans.hpp"
 
 namespace pitchlab::apps {
@@ -37,19 +38,12 @@ std::pair<int, std::string> RunCommand(F command, std::vector<std::string> args)
 
 class Cli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("pitchlab_cli_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
   std::string Write(const sensors::Scan3D& scan, const std::string& name) {
     const std::string path = (dir_ / name).string();
     EXPECT_TRUE(sensors::WriteScanPcd(scan, path));
     return path;
   }
-  fs::path dir_;
+  const test_support::ScopedTempDir dir_{"mapping_cli"};
 };
 
 TEST_F(Cli, RegisterPrintsTheMatrixResultFieldsAndTheGroundTruthErrorAsJson) {

@@ -10,6 +10,7 @@
 
 #include "pitchlab/mapping/registration.hpp"
 #include "pitchlab/mapping/tum_trajectory.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab::mapping {
 namespace {
@@ -19,12 +20,6 @@ std::string Slurp(const std::string& path) {
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
-}
-
-std::string TempPath(const std::string& name) {
-  const std::string dir = testing::TempDir() + "tum_trajectory_test";
-  std::filesystem::create_directories(dir);
-  return dir + "/" + name;
 }
 
 std::vector<StampedPose> RandomTrajectory(unsigned seed, int n) {
@@ -63,7 +58,8 @@ TEST(TumTrajectory, ReadsALineAsTimestampPositionAndScalarLastQuaternion) {
 
 TEST(TumTrajectory, WriteThenReadGivesTheSamePoses) {
   const std::vector<StampedPose> poses = RandomTrajectory(7, 200);
-  const std::string path = TempPath("round_trip.txt");
+  const test_support::ScopedTempDir dir("tum_trajectory");
+  const std::string path = (dir / "round_trip.txt").string();
   ASSERT_TRUE(WriteTumTrajectory(path, poses));
   const auto read = ReadTumTrajectory(path);
   ASSERT_TRUE(read) << read.error().message;
@@ -118,7 +114,8 @@ TEST(TumTrajectory, ANearlyUnitQuaternionIsNormalised) {
 }
 
 TEST(TumTrajectory, AFailedWriteLeavesTheFileAsItWas) {
-  const std::string path = TempPath("kept.txt");
+  const test_support::ScopedTempDir dir("tum_trajectory");
+  const std::string path = (dir / "kept.txt").string();
   ASSERT_TRUE(WriteTumTrajectory(path, RandomTrajectory(1, 5)));
   const std::string before = Slurp(path);
   std::vector<StampedPose> backwards = RandomTrajectory(2, 5);
@@ -135,11 +132,12 @@ TEST(TumTrajectory, AFailedWriteLeavesTheFileAsItWas) {
 }
 
 TEST(TumTrajectory, UnreadableOrUnwritablePathsAreErrors) {
-  EXPECT_FALSE(ReadTumTrajectory(TempPath("does_not_exist.txt")));
-  const auto directory = ReadTumTrajectory(testing::TempDir());
+  const test_support::ScopedTempDir dir("tum_trajectory");
+  EXPECT_FALSE(ReadTumTrajectory((dir / "does_not_exist.txt").string()));
+  const auto directory = ReadTumTrajectory(dir.path().string());
   ASSERT_FALSE(directory);
   EXPECT_NE(directory.error().message.find("is a directory"), std::string::npos);
-  EXPECT_FALSE(WriteTumTrajectory(TempPath("no_such_dir/traj.txt"), RandomTrajectory(1, 2)));
+  EXPECT_FALSE(WriteTumTrajectory((dir / "no_such_dir/traj.txt").string(), RandomTrajectory(1, 2)));
 }
 
 }  // namespace

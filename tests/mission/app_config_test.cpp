@@ -1,25 +1,25 @@
 #include "pitchlab/mission/app_config.hpp"
 
-#include <cstdio>
 #include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "scoped_temp_dir.hpp"
+
 namespace pitchlab::mission {
 namespace {
 
-// LoadAppConfig reads files: one in the test's temporary folder, removed after.
+// LoadAppConfig reads files: one in a temporary folder of its own, removed after.
 class ConfigFile {
  public:
-  explicit ConfigFile(const std::string& text)
-      : path_(::testing::TempDir() + "pitchlab_app_config_test.yaml") {
+  explicit ConfigFile(const std::string& text) : path_((dir_ / "app_config.yaml").string()) {
     std::ofstream(path_) << text;
   }
-  ~ConfigFile() { std::remove(path_.c_str()); }
   const std::string& path() const { return path_; }
 
  private:
+  test_support::ScopedTempDir dir_{"app_config"};  // before path_: made first
   std::string path_;
 };
 

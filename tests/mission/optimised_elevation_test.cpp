@@ -3,8 +3,6 @@
 // with every stop's scan at its final pose, bit for bit, and not the one at the poses as they
 // were registered.
 
-#include <unistd.h>
-
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -15,6 +13,7 @@
 #include "pitchlab/mapping/per_scan_elevation_map.hpp"
 #include "pitchlab/mission/elevation_scan.hpp"
 #include "pitchlab/mission/sim_mission.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab::mission {
 namespace {
@@ -69,9 +68,7 @@ mapping::ElevationMap Rebuilt(const SimMissionSpec& spec, const MissionResult& r
 }
 
 TEST(RunSimMission, WithLoopClosureThePlannersMapIsTheOneRebuiltAtTheOptimisedPoses) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("pitchlab_optimised_elevation_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
+  const test_support::ScopedTempDir dir("optimised_elevation");
   // The office corridor (start -8, 0 facing east) to -6.5, 0, on to -4.5, 0 and back: the
   // route tests/integration/route_cli_test.cpp drives, whose stop at the far waypoint closes
   // loops to the first stops.
@@ -90,7 +87,6 @@ TEST(RunSimMission, WithLoopClosureThePlannersMapIsTheOneRebuiltAtTheOptimisedPo
   EXPECT_EQ(DifferingCells(run.result.elevation, Rebuilt(spec, run.result, true)), 0u);
   // Not vacuous: the poses as registered give another map.
   EXPECT_GT(DifferingCells(run.result.elevation, Rebuilt(spec, run.result, false)), 0u);
-  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 
 #include "png_pixels.hpp"
 #include "run_report.hpp"
+#include "scoped_temp_dir.hpp"
 #include "synthetic_report.hpp"
 
 #ifndef PITCHLAB_CHROMIUM
@@ -121,14 +122,13 @@ class ReportInBrowser : public ::testing::Test {
   };
   static void SetUpTestSuite() {
     if (std::string(PITCHLAB_CHROMIUM).empty() || !fs::exists(PITCHLAB_CHROMIUM)) return;
-    dir_ = new fs::path(fs::path(::testing::TempDir()) / "report_browser");
-    fs::remove_all(*dir_);
+    dir_ = new test_support::ScopedTempDir("report_browser");
     const Result<ThreeJs> three = LoadThreeJs(DefaultThreeJsDir());
     if (!three) {
       three_error_ = new std::string(three.error().message);
       return;
     }
-    std::string html = RenderRunReport(testing::SyntheticReport(*dir_), three);
+    std::string html = RenderRunReport(testing::SyntheticReport(dir_->path()), three);
     std::ofstream(*dir_ / "report.html", std::ios::binary) << html;
     html.insert(html.rfind("</body>"), kLayoutProbe);
     std::ofstream(*dir_ / "probed.html", std::ios::binary) << html;
@@ -144,14 +144,15 @@ class ReportInBrowser : public ::testing::Test {
     shot_err_ = new std::string(err);
   }
   static void TearDownTestSuite() {
-    if (dir_) fs::remove_all(*dir_);
+    delete dir_;  // and its folder with it
+    dir_ = nullptr;
   }
   void SetUp() override {
     if (!dir_) GTEST_SKIP() << "chromium is not installed (scripts/setup.sh installs it)";
     ASSERT_EQ(three_error_, nullptr) << *three_error_ << " (scripts/setup.sh installs libjs-three)";
   }
 
-  static inline fs::path* dir_ = nullptr;
+  static inline test_support::ScopedTempDir* dir_ = nullptr;
   static inline std::string* three_error_ = nullptr;
   static inline std::map<int, Seen>* seen_ = nullptr;
   static inline Rgb8* shot_ = nullptr;

@@ -4,6 +4,7 @@
 
 #include "pitchlab/mission/stage_times.hpp"
 #include "report_scene.hpp"
+#include "scoped_temp_dir.hpp"
 #include "synthetic_report.hpp"
 
 namespace pitchlab::mission {
@@ -13,18 +14,11 @@ namespace fs = std::filesystem;
 
 class RunReport : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::path(::testing::TempDir()) /
-           ("run_report_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
+  const test_support::ScopedTempDir dir_{"run_report"};
 };
 
 TEST_F(RunReport, AFailedRunShowsItsReasonBeforeEverythingElse) {
-  const RunReportInput in = testing::SyntheticReport(dir_, 1000, 40);
+  const RunReportInput in = testing::SyntheticReport(dir_.path(), 1000, 40);
   const std::string html = RenderRunReport(in, LoadThreeJs(DefaultThreeJsDir()));
   const std::size_t outcome = html.find("<div id=outcome class=\"outcome failed\"");
   ASSERT_NE(outcome, std::string::npos);
@@ -41,7 +35,7 @@ TEST_F(RunReport, AFailedRunShowsItsReasonBeforeEverythingElse) {
 }
 
 TEST_F(RunReport, ASuccessThatCrossedHazardsSaysSoBesideTheOutcome) {
-  RunReportInput in = testing::SyntheticReport(dir_, 1000, 40);
+  RunReportInput in = testing::SyntheticReport(dir_.path(), 1000, 40);
   in.metrics["success"] = true;
   in.metrics["reason"] = "goal reached";
   in.metrics["hazard_cells_crossed"] = 2;
@@ -57,7 +51,7 @@ TEST_F(RunReport, ASuccessThatCrossedHazardsSaysSoBesideTheOutcome) {
 }
 
 TEST_F(RunReport, WithoutThreeJsThePageSaysWhyAndHasNoViewer) {
-  const RunReportInput in = testing::SyntheticReport(dir_, 1000, 40);
+  const RunReportInput in = testing::SyntheticReport(dir_.path(), 1000, 40);
   const Result<ThreeJs> missing = LoadThreeJs(dir_ / "no_such_folder");
   ASSERT_FALSE(missing);
   EXPECT_NE(missing.error().message.find("three.min.js"), std::string::npos);
@@ -70,7 +64,7 @@ TEST_F(RunReport, WithoutThreeJsThePageSaysWhyAndHasNoViewer) {
 }
 
 TEST_F(RunReport, TabulatesWhereTheRunsTimeWentStageByStage) {
-  RunReportInput in = testing::SyntheticReport(dir_, 1000, 40);
+  RunReportInput in = testing::SyntheticReport(dir_.path(), 1000, 40);
   StageBreakdown b;
   b.run = {40.0, 32.0};
   b.stages[Stage::kPhysicsDriving] = {20.0, 16.0};
@@ -101,7 +95,7 @@ TEST_F(RunReport, TabulatesWhereTheRunsTimeWentStageByStage) {
 }
 
 TEST_F(RunReport, AHardwareRunWithoutStagesHasNoStageTable) {
-  const RunReportInput in = testing::SyntheticReport(dir_, 1000, 40);
+  const RunReportInput in = testing::SyntheticReport(dir_.path(), 1000, 40);
   ASSERT_FALSE(in.metrics.contains("stages"));
   const std::string html = RenderRunReport(in, LoadThreeJs(DefaultThreeJsDir()));
   EXPECT_EQ(html.find("<h2 id=\"stages\">"), std::string::npos);
@@ -109,7 +103,7 @@ TEST_F(RunReport, AHardwareRunWithoutStagesHasNoStageTable) {
 }
 
 TEST_F(RunReport, LinksTheRunFiles) {
-  const RunReportInput in = testing::SyntheticReport(dir_, 1000, 40);
+  const RunReportInput in = testing::SyntheticReport(dir_.path(), 1000, 40);
   const std::string html = RenderRunReport(in, LoadThreeJs(DefaultThreeJsDir()));
   EXPECT_NE(html.find("<a href=\"metrics.json\">metrics.json</a>: every metric"),
             std::string::npos);
@@ -122,7 +116,7 @@ TEST_F(RunReport, LinksTheRunFiles) {
 TEST_F(RunReport, TheLargestPageStaysUnderTenMegabytes) {
   const Result<ThreeJs> three = LoadThreeJs(DefaultThreeJsDir());
   ASSERT_TRUE(three) << three.error().message << " (scripts/setup.sh installs libjs-three)";
-  const RunReportInput in = testing::SyntheticReport(dir_, kSceneMaxPoints, 400);
+  const RunReportInput in = testing::SyntheticReport(dir_.path(), kSceneMaxPoints, 400);
   const std::string html = RenderRunReport(in, three);
   EXPECT_NE(html.find("REVISION=\"111\""), std::string::npos);  // three.js is in it
   EXPECT_LT(html.size(), 10u * 1000 * 1000);

@@ -1,7 +1,5 @@
 #include "pitchlab/mission/sim_mission.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -13,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "pitchlab/mission/stage_times.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab::mission {
 namespace {
@@ -28,14 +27,7 @@ constexpr const char* kFloorWorld = R"(<mujoco model="floor">
   <worldbody><geom name="floor" type="plane" size="6 4 0.1"/></worldbody>
 </mujoco>)";
 
-fs::path Scratch() {
-  const fs::path dir =
-      fs::temp_directory_path() / ("pitchlab_simmission_" + std::to_string(::getpid()) + "_" +
-                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+using test_support::ScopedTempDir;
 
 fs::path WriteFloorWorld(const fs::path& dir) {
   const fs::path file = dir / "floor.xml";
@@ -61,7 +53,8 @@ TEST(LoadSimMissionSpec, TheRobotModelPicksItsPlannerPreset) {
 }
 
 TEST(LoadWorldMetadata, ReadsTheWorldsBoundsAndStart) {
-  const worlds::WorldMetadata meta = LoadWorldMetadata(WriteFloorWorld(Scratch()));
+  const ScopedTempDir dir("simmission");
+  const worlds::WorldMetadata meta = LoadWorldMetadata(WriteFloorWorld(dir.path()));
   EXPECT_DOUBLE_EQ(meta.bounds.x_min_m, -5.0);
   EXPECT_DOUBLE_EQ(meta.bounds.y_max_m, 3.0);
   EXPECT_DOUBLE_EQ(meta.default_start.x_m, -4.0);
@@ -78,9 +71,9 @@ TEST(LoadWorldMetadata, AMissingFileIsAnErrorNamingIt) {
 }
 
 TEST(RunSimMission, AGoalOffTheMapIsRefusedBeforeAnyFolderIsMade) {
-  const fs::path dir = Scratch();
+  const ScopedTempDir dir("simmission");
   SimMissionSpec spec = LoadSimMissionSpec(std::nullopt);
-  spec.world_file = WriteFloorWorld(dir);
+  spec.world_file = WriteFloorWorld(dir.path());
   spec.goal_m = Eigen::Vector2d(20.0, 0.0);  // the bounds end at x = 5
   try {
     RunSimMission(spec, dir / "run");
@@ -88,14 +81,14 @@ TEST(RunSimMission, AGoalOffTheMapIsRefusedBeforeAnyFolderIsMade) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("off the map"), std::string::npos) << e.what();
   }
-  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator{}), 1)
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator{}), 1)
       << "only the world file: no run folder, no staging folder";
 }
 
 TEST(RunSimMission, NoGoalGivenAndNoneInTheWorldIsABadSpec) {
-  const fs::path dir = Scratch();
+  const ScopedTempDir dir("simmission");
   SimMissionSpec spec = LoadSimMissionSpec(std::nullopt);
-  spec.world_file = WriteFloorWorld(dir);
+  spec.world_file = WriteFloorWorld(dir.path());
   EXPECT_THROW(RunSimMission(spec, dir / "run"), std::invalid_argument);
   EXPECT_FALSE(fs::exists(dir / "run"));
 }
@@ -113,8 +106,8 @@ SimMissionSpec FloorSpec(const fs::path& dir, const Eigen::Vector2d& goal) {
 TEST(RunSimMission, ItsStageBreakdownAddsUpToTheRunWithOtherAsTheRest) {
   // Sums of up to a dozen clock readings in seconds: rounding far below the clocks' nanosecond.
   constexpr double kSumTolerance_s = 1e-9;
-  const fs::path dir = Scratch();
-  const SimMissionSpec spec = FloorSpec(dir, {-2.0, 0.0});  // 2 m ahead of the start (-4, 0)
+  const ScopedTempDir dir("simmission");
+  const SimMissionSpec spec = FloorSpec(dir.path(), {-2.0, 0.0});  // 2 m ahead of the start (-4, 0)
   const SimMissionOutcome run = RunSimMission(spec, dir / "run");
   ASSERT_TRUE(run.result.success) << run.result.reason;
   std::ifstream file(run.folder / "metrics.json");
@@ -143,7 +136,6 @@ TEST(RunSimMission, ItsStageBreakdownAddsUpToTheRunWithOtherAsTheRest) {
                           "map_update", "outputs", "ground_truth"}) {
     EXPECT_GT(stages[key]["cpu_s"].get<double>(), 0.0) << key;
   }
-  fs::remove_all(dir);
 }
 
 std::vector<fs::path> TruthFiles(const fs::path& dir) {
@@ -159,11 +151,11 @@ std::vector<fs::path> TruthFiles(const fs::path& dir) {
 // back and scores against the same truth; a corrupt file is said and replaced; another world
 // (a box on the floor) is a file of its own.
 TEST(RunSimMission, RunsOfOneWorldShareTheGroundTruthThroughItsCache) {
-  const fs::path dir = Scratch();
+  const ScopedTempDir dir("simmission");
   const fs::path cache = dir / "truth";
   int runs = 0;
   auto run = [&](std::uint64_t seed, const fs::path& world, std::string& setup) {
-    SimMissionSpec spec = FloorSpec(dir, {-2.0, 0.0});
+    SimMissionSpec spec = FloorSpec(dir.path(), {-2.0, 0.0});
     spec.world_file = world;
     spec.config = LoadSimMissionSpec(std::nullopt, seed).config;
     spec.truth_cache_dir = cache;
@@ -172,7 +164,7 @@ TEST(RunSimMission, RunsOfOneWorldShareTheGroundTruthThroughItsCache) {
     const fs::path out = dir / ("run" + std::to_string(++runs));
     return RunSimMission(spec, out, observer);
   };
-  const fs::path floor = WriteFloorWorld(dir);
+  const fs::path floor = WriteFloorWorld(dir.path());
   std::string first, second, corrupt, boxed;
   const SimMissionOutcome a = run(1, floor, first);
   ASSERT_TRUE(a.result.success) << a.result.reason;
@@ -202,15 +194,14 @@ TEST(RunSimMission, RunsOfOneWorldShareTheGroundTruthThroughItsCache) {
   ASSERT_TRUE(d.result.success) << d.result.reason;
   EXPECT_EQ(boxed.find("true surface from"), std::string::npos) << boxed;
   EXPECT_EQ(TruthFiles(cache).size(), 2u);
-  fs::remove_all(dir);
 }
 
 // Wheels on a level floor barely slip, so the registration prior's bound grows with the distance
 // at the level rate there (the office's corridors let a scan slide 0.84 m along the axis within
 // the terrain's rate, and called it success). The floor world reads level throughout.
 TEST(RunSimMission, OnALevelFloorTheOdometryBoundGrowsAtTheLevelRate) {
-  const fs::path dir = Scratch();
-  const SimMissionSpec spec = FloorSpec(dir, {-2.0, 0.0});  // 2 m ahead of the start (-4, 0)
+  const ScopedTempDir dir("simmission");
+  const SimMissionSpec spec = FloorSpec(dir.path(), {-2.0, 0.0});  // 2 m ahead of the start (-4, 0)
   const SimMissionOutcome run = RunSimMission(spec, dir / "run");
   ASSERT_TRUE(run.result.success) << run.result.reason;
   const std::vector<StopRecord>& stops = run.result.stops;
@@ -229,15 +220,15 @@ TEST(RunSimMission, OnALevelFloorTheOdometryBoundGrowsAtTheLevelRate) {
   const nlohmann::json reg = nlohmann::json::parse(file);
   EXPECT_DOUBLE_EQ(reg["prior_bound"]["translation_m"].get<double>(),
                    stops[1].prior_bound.translation_m);
-  fs::remove_all(dir);
 }
 
 // The map frame is the robot's pose at its first scan, taken from odometry after it turned to
 // face the goal. Read while the base still braked out of the turn, it missed the last fraction
 // of a degree, and every map started 0.2-0.4 deg off in yaw: 0.1-0.2 m at 30 m.
 TEST(RunSimMission, TheFirstScansPoseHasTheTurnToTheGoalToATenthOfADegree) {
-  const fs::path dir = Scratch();
-  SimMissionSpec spec = FloorSpec(dir, {-4.0, 2.5});  // 90 deg left of the start (-4, 0), yaw 0
+  const ScopedTempDir dir("simmission");
+  // 90 deg left of the start (-4, 0), yaw 0
+  SimMissionSpec spec = FloorSpec(dir.path(), {-4.0, 2.5});
   spec.settings.mission.max_stops = 1;
   const SimMissionOutcome run = RunSimMission(spec, dir / "run");
   ASSERT_EQ(run.result.stops.size(), 1u) << run.result.reason;
@@ -248,30 +239,29 @@ TEST(RunSimMission, TheFirstScansPoseHasTheTurnToTheGoalToATenthOfADegree) {
   };
   EXPECT_NEAR(yaw(*stop.T_world_base_true), 90.0, 3.0);  // TurnTo's tolerance
   EXPECT_NEAR(yaw(stop.T_world_base), yaw(*stop.T_world_base_true), 0.1);
-  fs::remove_all(dir);
 }
 
 // Stuck is no progress for stuck_timeout_s, not a turn that takes longer: at 0.15 rad/s the
 // quarter turn to the goal takes over 10 s, more than the 8 s allowed without progress, and is
 // made (until session 33 a turn was stuck after 8 s in all).
 TEST(RunSimMission, ASlowTurnThatKeepsTurningIsNotStuck) {
-  const fs::path dir = Scratch();
-  SimMissionSpec spec = FloorSpec(dir, {-4.0, 2.5});  // 90 deg left of the start (-4, 0), yaw 0
+  const ScopedTempDir dir("simmission");
+  // 90 deg left of the start (-4, 0), yaw 0
+  SimMissionSpec spec = FloorSpec(dir.path(), {-4.0, 2.5});
   spec.settings.mission.max_stops = 1;
   spec.settings.mission.follower.max_yaw_rate_rps = 0.15;
   ASSERT_LT(spec.settings.mission.stuck_timeout_s, (M_PI / 2) / 0.15);
   const SimMissionOutcome run = RunSimMission(spec, dir / "run");
   ASSERT_EQ(run.result.stops.size(), 1u) << run.result.reason;
   EXPECT_GT(run.result.stops.front().stamp_s, (M_PI / 2 - 3 * M_PI / 180) / 0.15);
-  fs::remove_all(dir);
 }
 
 // A round trip ends back at the start facing the way it came; its last stop turns to the first
 // scan's heading and scans again (Mission::ClosingLook), so the last registration meets the view
 // the map was started from. On the floor: 2 m east and back, the first scans face east.
 TEST(RunSimMission, ARoundTripEndsLookingWhereItsFirstScanLooked) {
-  const fs::path dir = Scratch();
-  SimMissionSpec spec = FloorSpec(dir, {-2.0, 0.0});
+  const ScopedTempDir dir("simmission");
+  SimMissionSpec spec = FloorSpec(dir.path(), {-2.0, 0.0});
   spec.round_trip = true;
   const SimMissionOutcome run = RunSimMission(spec, dir / "run");
   ASSERT_TRUE(run.result.success) << run.result.reason;
@@ -292,11 +282,10 @@ TEST(RunSimMission, ARoundTripEndsLookingWhereItsFirstScanLooked) {
   EXPECT_FALSE(closing.plan.has_value());
   EXPECT_LT((closing.T_world_base.translation() - first.T_world_base.translation()).head<2>().norm(),
             spec.settings.mission.goal_tolerance_m);
-  fs::remove_all(dir);
 }
 
 TEST(RunSimMission, NoWorldFileIsABadSpec) {
-  const fs::path dir = Scratch();
+  const ScopedTempDir dir("simmission");
   EXPECT_THROW(RunSimMission(LoadSimMissionSpec(std::nullopt), dir / "run"), std::invalid_argument);
 }
 

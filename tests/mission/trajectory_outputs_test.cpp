@@ -3,8 +3,6 @@
 
 #include "pitchlab/mission/trajectory_outputs.hpp"
 
-#include <unistd.h>
-
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +13,7 @@
 
 #include "pitchlab/mapping/trajectory_metrics.hpp"
 #include "pitchlab/mission/sim_mission.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab::mission {
 namespace {
@@ -25,14 +24,7 @@ namespace fs = std::filesystem;
 // back as differs from the original by rounding only (a few ulps of 1).
 constexpr double kRoundTrip = 1e-9;
 
-fs::path Scratch() {
-  const fs::path dir =
-      fs::temp_directory_path() / ("pitchlab_trajectory_" + std::to_string(::getpid()) + "_" +
-                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+using test_support::ScopedTempDir;
 
 Eigen::Isometry3d Pose(double x, double y, double yaw_rad) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
@@ -103,7 +95,7 @@ TEST(TrajectoryErrorJson, NoTruthIsNull) {
 }
 
 TEST(WriteStopTrajectories, TheTumFilesHoldEachStopAtItsScansTime) {
-  const fs::path dir = Scratch();
+  const ScopedTempDir dir("trajectory");
   MissionResult r = ShiftedRun();
   for (StopRecord& s : r.stops) s.T_world_base_final = *s.T_world_base_true;  // a loop closed
   RunFolder folder(dir / "run");
@@ -126,7 +118,7 @@ TEST(WriteStopTrajectories, TheTumFilesHoldEachStopAtItsScansTime) {
 }
 
 TEST(WriteStopTrajectories, WithoutTruthOnlyTheEstimateIsWritten) {
-  const fs::path dir = Scratch();
+  const ScopedTempDir dir("trajectory");
   MissionResult r = ShiftedRun();
   for (StopRecord& s : r.stops) s.T_world_base_true.reset();
   RunFolder folder(dir / "run");
@@ -168,7 +160,7 @@ void ExpectAte(const nlohmann::json& j, const mapping::AbsoluteTrajectoryError& 
 }
 
 TEST(RunSimMission, MetricsHoldTheTrajectoryErrorOfItsOwnTumFiles) {
-  const fs::path dir = Scratch();
+  const ScopedTempDir dir("trajectory");
   std::ofstream(dir / "floor.xml") << kFloorWorld;
   SimMissionSpec spec = LoadSimMissionSpec(std::nullopt, 5);
   spec.world_file = dir / "floor.xml";

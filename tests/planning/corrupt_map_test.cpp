@@ -13,6 +13,7 @@
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/mapping/elevation_map.hpp"
 #include "pitchlab/planning/path_io.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab {
 namespace {
@@ -23,15 +24,6 @@ using mapping::GridGeometry;
 
 class CorruptMap : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("pitchlab_corrupt_map_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   // A 4 x 3 map of a flat floor at 1 m, saved (so with a valid hash) after `edit`.
   std::string Saved(GridGeometry g, const std::function<void(std::vector<mapping::CellStats>&)>&
                                         edit = [](auto&) {}) {
@@ -44,7 +36,7 @@ class CorruptMap : public ::testing::Test {
     EXPECT_TRUE(mapping::SaveElevationMap(map, path));
     return path;
   }
-  fs::path dir_;
+  const test_support::ScopedTempDir dir_{"corrupt_map"};
 };
 
 TEST_F(CorruptMap, AnInfiniteCellSizeIsRefusedOnLoad) {
@@ -72,9 +64,9 @@ TEST_F(CorruptMap, AnIntactMapStillLoads) {
 }
 
 TEST_F(CorruptMap, AFolderATruncatedAndAnEmptyFileAreRefusedByName) {
-  const auto folder = mapping::LoadElevationMap(dir_.string());
+  const auto folder = mapping::LoadElevationMap(dir_.path().string());
   ASSERT_FALSE(folder);
-  EXPECT_NE(folder.error().message.find(dir_.string() + ": cannot read"), std::string::npos)
+  EXPECT_NE(folder.error().message.find(dir_.path().string() + ": cannot read"), std::string::npos)
       << folder.error().message;
   const std::string saved = Saved(GridGeometry::FromArea(0, 0, 0.4, 0.3, 0.1));
   fs::resize_file(saved, fs::file_size(saved) - 1);
@@ -98,7 +90,7 @@ TEST_F(CorruptMap, APathWithoutFinitePositionsIsNotWritten) {
       << c.error().message;
   EXPECT_FALSE(planning::WritePathGeoJson(path, mapping::GeodeticOrigin{46.77, 23.59, 360},
                                           geojson.string()));
-  EXPECT_TRUE(fs::is_empty(dir_)) << "a path file or its temporary was left";
+  EXPECT_TRUE(fs::is_empty(dir_.path())) << "a path file or its temporary was left";
 }
 
 TEST_F(CorruptMap, GeoJsonIsValidJsonEvenWithANonFiniteProperty) {

@@ -12,6 +12,7 @@
 #include "pitchlab/mapping/dem_io.hpp"
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab::mapping {
 namespace {
@@ -27,12 +28,7 @@ constexpr char kUtm13N[] =
     "PARAMETER[\"Central_Meridian\",-105.0],PARAMETER[\"Scale_Factor\",0.9996],"
     "PARAMETER[\"Latitude_Of_Origin\",0.0],UNIT[\"Meter\",1.0]]";
 
-fs::path TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("pitchlab_dem_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+using test_support::ScopedTempDir;
 
 void WriteText(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
 
@@ -42,7 +38,8 @@ double HeightAt(const Dem& dem, int i, int j) {
 }
 
 TEST(AsciiGrid, HandMadeGridReadsBackExactly) {
-  const fs::path asc = TempDir("exact") / "g.asc";
+  const ScopedTempDir dir("dem_exact");
+  const fs::path asc = dir / "g.asc";
   // Lower-left given as a cell centre: the corner lies half a cell (1 m) further out.
   WriteText(asc,
             "NCOLS 3\nnrows 2\nxllcenter 101\nyllcenter 51\ncellsize 2\nNODATA_value -9999\n"
@@ -75,7 +72,7 @@ TEST(AsciiGrid, HandMadeGridReadsBackExactly) {
 }
 
 TEST(AsciiGrid, BadFilesNameTheFileAndTheLine) {
-  const fs::path dir = TempDir("bad");
+  const ScopedTempDir dir("dem_bad");
   const struct {
     std::string text, where, what;
   } cases[] = {
@@ -149,7 +146,7 @@ TEST(Prj, ReadsTheThreeKindsAndRefusesOtherProjections) {
 TEST(Dem, UtmGridIsResampledOntoTheLocalEnuFrameExactlyForAPlane) {
   // A plane in UTM 13N (10 m cells, 40 x 30): bilinear resampling reproduces a plane exactly, so
   // every map cell must hold the plane's height where GeographicLib puts the cell's centre.
-  const fs::path dir = TempDir("utm");
+  const ScopedTempDir dir("dem_utm");
   const double xll = 559700, yll = 4380200, cell = 10;
   const auto plane = [&](double e, double n) { return 1700 + 0.05 * (e - xll) - 0.02 * (n - yll); };
   std::string text = "ncols 40\nnrows 30\nxllcorner 559700\nyllcorner 4380200\ncellsize 10\n";
@@ -228,7 +225,8 @@ TEST(Dem, PitchlabsOwnRasterReadsBackCellForCellInTheSameFrame) {
   for (double y = -0.75; y < 1; y += 0.5)
     for (double x = -1.75; x < 2; x += 0.5) pts.emplace_back(x, y, 0.25 * x - 0.5 * y);
   (void)map.InsertPoints(pts.data(), pts.size());
-  const fs::path asc = TempDir("own") / "elevation.asc";
+  const ScopedTempDir dir("dem_own");
+  const fs::path asc = dir / "elevation.asc";
   ASSERT_TRUE(WriteEsriAsciiGrid(ComputeLayers(map), origin, asc.string()));
   const Result<Dem> dem = LoadDem(asc.string());
   ASSERT_TRUE(dem) << dem.error().message;
@@ -241,7 +239,7 @@ TEST(Dem, PitchlabsOwnRasterReadsBackCellForCellInTheSameFrame) {
 }
 
 TEST(Dem, DegreesWithoutAPrjAreRefused) {
-  const fs::path dir = TempDir("degrees");
+  const ScopedTempDir dir("dem_degrees");
   std::ifstream in(std::string(PITCHLAB_TEST_DATA_DIR) + "/dem/SRTMGL3_boulder_240x144.asc");
   WriteText(dir / "srtm.asc", std::string((std::istreambuf_iterator<char>(in)), {}));
   const Result<Dem> dem = LoadDem((dir / "srtm.asc").string());

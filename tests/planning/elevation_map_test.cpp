@@ -16,6 +16,7 @@
 #include "pitchlab/mapping/elevation_map.hpp"
 #include "pitchlab/mapping/elevation_truth.hpp"
 #include "pitchlab/sensors/ray_caster.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab::mapping {
 namespace {
@@ -23,12 +24,7 @@ namespace {
 constexpr double kHeightTolM = 1e-5;
 constexpr double kAngleTolRad = 1e-4;
 
-std::filesystem::path TempDir(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() / ("pitchlab_elev_" + name);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
+using test_support::ScopedTempDir;
 
 // Points on a regular lattice of `step_m` over [x0, x1) x [y0, y1) at height f(x, y).
 template <typename F>
@@ -483,7 +479,7 @@ TEST(ElevationMap, WallPointsOverTheCellEdgeAboveLowerRaysAreLeftOut) {
 }
 
 TEST(ElevationMapIo, SaveLoadIsLosslessAndInsertionContinues) {
-  const auto dir = TempDir("io");
+  const ScopedTempDir dir("elev_io");
   ElevationMap map(GridGeometry::FromArea(-1, -1, 2, 2, 0.1), GeodeticOrigin{39.5, -104.3, 1500});
   auto pts = Lattice(-1, 1, -1, 0, 0.03, [](double x, double y) { return 0.1 * x * y; });
   (void)map.InsertScan(pts.data(), pts.size(), Eigen::Vector3f(0, 0, 0.5f));
@@ -512,7 +508,7 @@ TEST(ElevationMapIo, SaveLoadIsLosslessAndInsertionContinues) {
 }
 
 TEST(ElevationMapIo, EsriGridHasHeaderRowsNorthFirstAndPrj) {
-  const auto dir = TempDir("asc");
+  const ScopedTempDir dir("elev_asc");
   ElevationMap map(GridGeometry::FromArea(10, 20, 0.3, 0.2, 0.1));
   const std::vector<Eigen::Vector3f> pts = {{10.05f, 20.15f, 1.5f}, {10.25f, 20.05f, -2.0f}};
   (void)map.InsertPoints(pts.data(), pts.size());
@@ -544,7 +540,7 @@ TEST(ElevationMapIo, PrjTransverseMercatorMatchesTheLocalEnuFrame) {
 }
 
 TEST(ElevationMapIo, PngShowsUnknownAndDropsDistinctly) {
-  const auto dir = TempDir("png");
+  const ScopedTempDir dir("elev_png");
   ElevationMap map(GridGeometry::FromArea(0, 0, 1, 1, 0.1));
   auto pts = Lattice(0, 0.5, 0, 1, 0.02, [](double x, double) { return x; });
   (void)map.InsertPoints(pts.data(), pts.size());
@@ -666,7 +662,8 @@ constexpr char kScene[] = R"(
 class Scene {
  public:
   Scene() {
-    const auto file = std::filesystem::temp_directory_path() / "pitchlab_overhangs.xml";
+    const ScopedTempDir dir("overhangs");  // the file is needed only while loading
+    const auto file = dir / "overhangs.xml";
     std::ofstream(file) << kScene;
     char error[1000] = "";
     model_ = mj_loadXML(file.c_str(), nullptr, error, sizeof(error));

@@ -10,18 +10,14 @@
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/planning/occupancy_grid.hpp"
 #include "pitchlab/planning/planner.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab::planning {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("pitchlab_occ_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+using test_support::ScopedTempDir;
 
 void WriteText(const fs::path& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
@@ -37,7 +33,7 @@ std::string Yaml(const std::string& image, const std::string& extra = "") {
 std::int8_t At(const OccupancyGrid& g, int i, int j) { return g.value[g.geometry.Linear({i, j})]; }
 
 TEST(OccupancyGrid, TrinaryPgmReadsAsMapServerDoes) {
-  const fs::path dir = TempDir("trinary");
+  const ScopedTempDir dir("occ_trinary");
   // Top row (north): white, mid grey 205, black; bottom row: 250, 100, 0. p = (255 - x) / 255:
   // 0 free, 0.196 (between the thresholds) unknown, 1 occupied; 0.02 free, 0.61 unknown.
   WriteText(dir / "m.pgm", "P2\n# a comment\n3 2\n255\n254 205 0\n250 100 0\n");
@@ -58,7 +54,7 @@ TEST(OccupancyGrid, TrinaryPgmReadsAsMapServerDoes) {
 }
 
 TEST(OccupancyGrid, ScaleNegateAndRawModes) {
-  const fs::path dir = TempDir("modes");
+  const ScopedTempDir dir("occ_modes");
   // Binary P5. Scale: p = (255 - 150) / 255 = 0.4118 -> 99 (0.4118 - 0.196) / (0.65 - 0.196) =
   // 47.06 -> 47; negate: p = x / 255.
   WriteText(dir / "s.pgm", std::string("P5 2 1 255\n") + char(150) + char(255));
@@ -85,7 +81,7 @@ TEST(OccupancyGrid, ScaleNegateAndRawModes) {
 }
 
 TEST(OccupancyGrid, BadFilesNameTheFileAndTheLine) {
-  const fs::path dir = TempDir("bad");
+  const ScopedTempDir dir("occ_bad");
   WriteText(dir / "ok.pgm", "P2 2 2 255 0 0 0 0\n");
   const std::string yaml = (dir / "m.yaml").string();
   const struct {
@@ -160,7 +156,8 @@ TEST(OccupancyGrid, TraversabilityWrittenAndReadBackKeepsItsClassesAndCosts) {
   EXPECT_NEAR(FullScaleCost(config), full, 1e-12);
   EXPECT_EQ(occupancy.value[g.Linear({5, 0})], std::lround(99 * (10 * M_PI / 180) / full));
 
-  const fs::path yaml = TempDir("roundtrip") / "traversability.yaml";
+  const ScopedTempDir dir("occ_roundtrip");
+  const fs::path yaml = dir / "traversability.yaml";
   ASSERT_TRUE(WriteOccupancyGrid(occupancy, yaml.string()));
   EXPECT_TRUE(fs::exists(yaml.parent_path() / "traversability.pgm"));
   const Result<OccupancyGrid> back = LoadOccupancyGrid(yaml.string());

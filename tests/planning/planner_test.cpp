@@ -17,6 +17,7 @@
 #include "pitchlab/planning/planner.hpp"
 #include "pitchlab/planning/traversability.hpp"
 #include "same_grids.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab::planning {
 namespace {
@@ -500,8 +501,7 @@ TEST(PlannerConfig, YamlWeightsPresetsAndErrors) {
 }
 
 TEST(PathIo, CsvGeoJsonAndPicture) {
-  const auto dir = std::filesystem::temp_directory_path() / "pitchlab_path_io";
-  std::filesystem::create_directories(dir);
+  const test_support::ScopedTempDir dir("path_io");
   const ElevationLayers L = MakeLayers(30, 20, 0.1, [](int i, int) { return 0.01 * i; });
   const TraversabilityGrid T = BuildTraversability(L, PointRobot());
   const auto path = PlanPath(T, {0.25, 0.25}, {2.75, 1.75}, Algorithm::kAStar);

@@ -9,6 +9,7 @@
 #include "pitchlab/mapping/dem_io.hpp"
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab::mapping {
 namespace {
@@ -33,8 +34,7 @@ TEST(Rasters, InclinationIsTheTiltInDegreesAndRoughnessTheSpread) {
       }
   (void)map.InsertPoints(pts.data(), pts.size());
   const ElevationLayers L = ComputeLayers(map);
-  const auto dir = std::filesystem::temp_directory_path() / "pitchlab_rasters";
-  std::filesystem::create_directories(dir);
+  const test_support::ScopedTempDir dir("rasters");
   ASSERT_TRUE(WriteEsriAsciiGrid(L, std::nullopt, (dir / "inclination.asc").string(),
                                  RasterLayer::kInclination));
   ASSERT_TRUE(WriteEsriAsciiGrid(L, std::nullopt, (dir / "roughness.asc").string(),

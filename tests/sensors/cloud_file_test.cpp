@@ -8,14 +8,13 @@
 #include <limits>
 #include <tuple>
 
-#include <unistd.h>
-
 #include <gtest/gtest.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
 #include <pcl/point_types.h>
 
 #include "pitchlab/sensors/scan_pcd.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab::sensors {
 namespace {
@@ -30,19 +29,12 @@ constexpr double kPointTolM = 1e-6;
 
 class CloudFile : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("pitchlab_cloud_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
   std::string Write(const std::string& name, const std::string& bytes) {
     const fs::path path = dir_ / name;
     std::ofstream(path, std::ios::binary) << bytes;
     return path.string();
   }
-  fs::path dir_;
+  const test_support::ScopedTempDir dir_{"cloud"};
 };
 
 Eigen::Vector3d At(const ScanPoint& p) { return Eigen::Vector3d(p.x, p.y, p.z); }

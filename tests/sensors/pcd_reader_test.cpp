@@ -3,8 +3,6 @@
 // ascii data lines that are not what the header says. PCL's own writers are the peer in
 // cloud_file_test and pcd_robustness_test.
 
-#include <unistd.h>
-
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -15,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "pitchlab/sensors/scan_pcd.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab::sensors {
 namespace {
@@ -23,15 +22,6 @@ namespace fs = std::filesystem;
 
 class PcdReader : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("pitchlab_pcdreader_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   // A file of `header` lines (FIELDS to POINTS) and `data` after "DATA <kind>\n".
   fs::path Write(const std::string& header, const std::string& kind, const std::string& data) {
     const fs::path file = dir_ / "cloud.pcd";
@@ -57,7 +47,7 @@ class PcdReader : public ::testing::Test {
   static constexpr const char* kXyz2 =
       "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 1\n"
       "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\n";
-  fs::path dir_;
+  const test_support::ScopedTempDir dir_{"pcdreader"};
 };
 
 // Compressed, a field's values for every point lie together (x0 x1 y0 y1 z0 z1): one literal run

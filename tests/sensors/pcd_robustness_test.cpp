@@ -17,6 +17,7 @@
 
 #include "pitchlab/sensors/cloud_file.hpp"
 #include "pitchlab/sensors/scan_pcd.hpp"
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab::sensors {
 namespace {
@@ -25,15 +26,6 @@ namespace fs = std::filesystem;
 
 class PcdRobustness : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("pitchlab_pcdrob_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   static pcl::PointCloud<pcl::PointXYZ> Cloud(int n) {
     pcl::PointCloud<pcl::PointXYZ> cloud;
     for (int i = 0; i < n; ++i) cloud.push_back(pcl::PointXYZ(1.0f + i, 0.5f * i, -0.25f));
@@ -67,7 +59,7 @@ class PcdRobustness : public ::testing::Test {
     return file;
   }
 
-  fs::path dir_;
+  const test_support::ScopedTempDir dir_{"pcdrob"};
 };
 
 TEST_F(PcdRobustness, CompressedHeaderWithUncompressedSizeZeroIsAnErrorNotACrash) {
@@ -194,7 +186,7 @@ TEST_F(PcdRobustness, AFullDiskIsAnErrorWithItsReasonAndLeavesNothing) {
   ASSERT_EQ(::waitpid(pid, &status, 0), pid);
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 0) << "no error naming the path and 'File too large'";
-  EXPECT_TRUE(fs::is_empty(dir_)) << "a partial or temporary file was left behind";
+  EXPECT_TRUE(fs::is_empty(dir_.path())) << "a partial or temporary file was left behind";
 }
 
 }  // namespace

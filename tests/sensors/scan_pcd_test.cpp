@@ -5,18 +5,13 @@
 
 #include <gtest/gtest.h>
 
+#include "scoped_temp_dir.hpp"
+
 namespace pitchlab::sensors {
 namespace {
 
 namespace fs = std::filesystem;
-
-fs::path TempDir() {
-  fs::path dir = fs::temp_directory_path() /
-                 ("pitchlab_pcd_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-                  "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-  fs::create_directories(dir);
-  return dir;
-}
+using test_support::ScopedTempDir;
 
 Scan3D SmallScan() {
   Scan3D scan;
@@ -39,7 +34,8 @@ Scan3D SmallScan() {
 }
 
 TEST(ScanPcd, RoundTripKeepsPointsFieldsAndViewpoint) {
-  const fs::path file = TempDir() / "scan.pcd";
+  const ScopedTempDir dir("pcd");
+  const fs::path file = dir / "scan.pcd";
   const Scan3D scan = SmallScan();
   ASSERT_TRUE(WriteScanPcd(scan, file.string()));
   Result<Scan3D> back = ReadScanPcd(file.string());
@@ -61,7 +57,8 @@ TEST(ScanPcd, RoundTripKeepsPointsFieldsAndViewpoint) {
 }
 
 TEST(ScanPcd, AnUnwritableDirectoryIsAnErrorAndLeavesNoFile) {
-  const fs::path file = TempDir() / "no_such_dir" / "scan.pcd";
+  const ScopedTempDir dir("pcd");
+  const fs::path file = dir / "no_such_dir" / "scan.pcd";
   Result<void> written = WriteScanPcd(SmallScan(), file.string());
   ASSERT_FALSE(written);
   EXPECT_NE(written.error().message.find(file.string()), std::string::npos);
@@ -69,7 +66,7 @@ TEST(ScanPcd, AnUnwritableDirectoryIsAnErrorAndLeavesNoFile) {
 }
 
 TEST(ScanPcd, CorruptOrMissingFilesAreErrorsNamingThePath) {
-  const fs::path dir = TempDir();
+  const ScopedTempDir dir("pcd");
   EXPECT_FALSE(ReadScanPcd((dir / "missing.pcd").string()));
   const fs::path garbage = dir / "garbage.pcd";
   std::ofstream(garbage) << "this is not a point cloud\n\x01\x02";
@@ -79,7 +76,7 @@ TEST(ScanPcd, CorruptOrMissingFilesAreErrorsNamingThePath) {
 }
 
 TEST(ScanPcd, ATruncatedFileIsAnErrorNotACrash) {
-  const fs::path dir = TempDir();
+  const ScopedTempDir dir("pcd");
   const fs::path file = dir / "scan.pcd";
   ASSERT_TRUE(WriteScanPcd(SmallScan(), file.string()));
   std::string text;

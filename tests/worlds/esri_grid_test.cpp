@@ -154,7 +154,7 @@ TEST(EsriGrid, CorruptFilesRaiseErrorsNamingTheFileLineAndProblem) {
 }
 
 TEST(EsriGrid, MissingAndBadFilesOnDiskNameThePath) {
-  test::TempDir dir("esri_bad");
+  const test::ScopedTempDir dir("esri_bad");
   const auto bad = dir.path() / "bad.asc";
   test::WriteText(bad, "ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 nan\n");
   try {
@@ -255,11 +255,13 @@ TEST(DemWorld, TooFineACellForABigDemSaysWhichCellWorks) {
 
 TEST(Worldgen, CommandLineGivesHelpAndNonZeroExitOnBadInput) {
   const std::string exe = PITCHLAB_WORLDGEN_EXE;
+  const test::ScopedTempDir dir("cli");
   EXPECT_EQ(std::system((exe + " --help > /dev/null").c_str()), 0);
   EXPECT_NE(std::system((exe + " moon 2> /dev/null").c_str()), 0);
-  EXPECT_NE(std::system((exe + " dem --in /nonexistent.asc --out /tmp/x.xml 2> /dev/null").c_str()),
+  EXPECT_NE(std::system((exe + " dem --in /nonexistent.asc --out " + (dir / "x.xml").string() +
+                         " 2> /dev/null")
+                            .c_str()),
             0);
-  test::TempDir dir("cli");
   const auto out = dir.path() / "esc.xml";
   const std::string cmd = exe + " dem --in " +
                           (kDemDir / "west_bijou_escarpment_snippet.asc").string() +

@@ -3,6 +3,7 @@
 #include <GeographicLib/UTMUPS.hpp>
 
 #include <cmath>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -18,8 +19,8 @@ namespace {
 
 using test::DataPtr;
 using test::LoadModel;
+using test::ScopedTempDir;
 using test::SurfaceHeight;
-using test::TempDir;
 
 constexpr double kMeshTolerance_m = 0.003;  // float32 data, 6-decimal MJCF numbers
 constexpr double kPi = 3.14159265358979323846;
@@ -54,7 +55,7 @@ TEST(Heightfield, RowsRunSouthToNorthAndColumnsWestToEast) {
       grid.At(ix, iy) = 5.0 + 0.1 * ix + ((ix >= 8 && iy >= 5) ? 2.0 : 0.0);
     }
   }
-  TempDir dir("orientation");
+  const ScopedTempDir dir("orientation");
   const auto xml = dir.path() / "tilted.xml";
   WriteHeightfieldWorld(grid, WorldMetadata{}, "orientation test", xml);
   auto model = LoadModel(xml);
@@ -128,7 +129,7 @@ TEST(Heightfield, GullySurfaceMatchesTheRawDemAtItsCellCentres) {
   gully.cell_m = 0.5;
   DemWorldConfig config = GullyDemConfig(gully);
   config.relief_seed.reset();
-  TempDir dir("gully_raw");
+  const ScopedTempDir dir("gully_raw");
   const auto xml = dir.path() / "gully_smooth.xml";
   GenerateDemWorld(config, xml);
   auto model = LoadModel(xml);
@@ -164,7 +165,7 @@ TEST(Heightfield, GeneratedWorldsAreTheSameBytesFromTheSameSeed) {
   small.size_m = 12.0;
   small.cell_m = 0.2;
   small.goal_x_m = -4.0, small.goal_y_m = 4.0;
-  TempDir a("seed_a"), b("seed_b"), c("seed_c");
+  const ScopedTempDir a("seed_a"), b("seed_b"), c("seed_c");
   GenerateTerrainWorld(small, a.path());
   GenerateTerrainWorld(small, b.path());
   small.seed += 1;
@@ -177,7 +178,7 @@ TEST(Heightfield, GeneratedWorldsAreTheSameBytesFromTheSameSeed) {
 }
 
 TEST(Heightfield, ADefaultGoalOffTheWorldIsRefusedNamingItAndNothingIsWritten) {
-  TempDir dir("gully_goal");
+  const ScopedTempDir dir("gully_goal");
   GullyConfig gully;
   gully.dem_path = std::filesystem::path(PITCHLAB_WORLDS_SOURCE_DIR) / "data/west_bijou_gully.asc";
   gully.cell_m = 0.5;                // coarse: the check does not depend on the resolution
@@ -196,14 +197,14 @@ TEST(Heightfield, ADefaultGoalOffTheWorldIsRefusedNamingItAndNothingIsWritten) {
 }
 
 TEST(Heightfield, BuiltWorldsEqualAFreshRunOfTheDefaultGenerators) {
-  TempDir dir("defaults");
+  const ScopedTempDir dir("defaults");
   GenerateTerrainWorld(TerrainConfig{}, dir.path());
   GullyConfig gully;
   gully.dem_path = std::filesystem::path(PITCHLAB_WORLDS_SOURCE_DIR) / "data/west_bijou_gully.asc";
   GenerateGullyWorld(gully, dir.path());
   GullyConfig other = gully;
   other.relief_seed += 1;
-  TempDir other_dir("gully_other");
+  const ScopedTempDir other_dir("gully_other");
   GenerateGullyWorld(other, other_dir.path());
   const std::filesystem::path built(PITCHLAB_WORLDS_DIR);
   for (const char* file : {"terrain.xml", "terrain_hfield.bin", "gully.xml", "gully_hfield.bin"}) {

@@ -8,8 +8,9 @@
 #include <fstream>
 #include <iterator>
 #include <memory>
-#include <random>
 #include <string>
+
+#include "scoped_temp_dir.hpp"
 
 namespace pitchlab::worlds::test {
 
@@ -43,20 +44,7 @@ inline double SurfaceHeight(const mjModel* m, mjData* d, double x, double y,
 }
 
 /// A fresh, empty folder under the system temp dir, removed with the object.
-class TempDir {
- public:
-  explicit TempDir(const std::string& tag) {
-    std::random_device device;
-    path_ = std::filesystem::temp_directory_path() /
-            ("pitchlab_worlds_" + tag + "_" + std::to_string(device()));
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() { std::filesystem::remove_all(path_); }
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
+using test_support::ScopedTempDir;
 
 /// The whole file as bytes.
 inline std::string ReadBytes(const std::filesystem::path& path) {

@@ -130,7 +130,7 @@ TEST(WorldCatalog, AnyExistingXmlPathIsAWorldAndAMissingOneIsAnError) {
 }
 
 ModelPtr LoadString(const std::string& xml) {
-  test::TempDir dir("inline");
+  const test::ScopedTempDir dir("inline");
   test::WriteText(dir.path() / "w.xml", xml);
   return LoadModel(dir.path() / "w.xml");
 }

@@ -45,7 +45,8 @@ struct DeviceStats {
 /// stays valid across Unplug()/Replug() (like a udev name), so a driver can reconnect.
 class EmulatedDevice {
  public:
-  /// Creates the pty and the symlink `link_path` (empty: a fresh name under /tmp). Throws
+  /// Creates the pty and the symlink `link_path` (empty: a fresh folder TMPDIR/pitchlab-hw-*,
+  /// /tmp without TMPDIR, removed with the device or when the pty cannot be made). Throws
   /// std::runtime_error naming the path when the pty or the link cannot be made.
   EmulatedDevice(std::string name, int baud, std::string link_path = "");
   virtual ~EmulatedDevice();
