@@ -33,7 +33,9 @@ CliArgs ScanArgs() {
       .Option("pose", "x,y,yaw", "start pose: metres, metres, degrees (default: the world's start)")
       .Option("config", "FILE.yaml", "rig configuration (see README)")
       .Option("robot", "p3at|p3dx", "robot model, overrides the config's robot.model")
-      .Option("caster", "embree|mujoco", "ray caster: Embree, or MuJoCo mj_ray as reference",
+      .Option("caster", "embree|mujoco",
+              "ray caster: Embree, or MuJoCo mj_ray as reference (not on a heightfield with more "
+              "rows than columns, such as the gully's, which MuJoCo 2.2.2's mj_ray reads past)",
               "embree")
       .Option("out", "FILE.pcd", "where to write the scan")
       .Flag("json", "print the summary as JSON on stdout")

@@ -6,6 +6,7 @@
 #include <limits>
 #include <memory>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "pitchlab/sensors/ray_caster.hpp"
@@ -66,6 +67,28 @@ class MujocoRayCaster final : public RayCaster {
   const mjData* data_;
 };
 
+// MuJoCo 2.2.2's mj_rayHfield reads the profile of a heightfield's side walls normal to x at
+// data[row * nrow + col] instead of data[row * ncol + col] (engine_ray.c, "check viable sides of
+// top box"): with more rows than columns that reads past the field, by up to (nrow - 1)(nrow -
+// ncol) heights (the gully's 900 x 134: 2.7 MB), for every ray that meets such a wall. Those rays
+// read garbage, and where the read leaves the mapped heap the process dies (a test's scan of the
+// gully crashed inside mj_rayHfield). A field that mj_ray would read past is refused, naming it.
+void CheckHeightfieldsMjRayCanRead(const mjModel* model, const RayCasterOptions& options) {
+  const std::vector<char> excluded = detail::ExcludedGeoms(model, options);
+  for (int g = 0; g < model->ngeom; ++g) {
+    if (excluded[g] || model->geom_type[g] != mjGEOM_HFIELD) continue;
+    const int h = model->geom_dataid[g];
+    const int nrow = model->hfield_nrow[h], ncol = model->hfield_ncol[h];
+    if (nrow <= ncol) continue;
+    const char* name = model->names + model->name_hfieldadr[h];
+    throw std::runtime_error(
+        "the MuJoCo ray caster cannot cast on heightfield '" + std::string(name) + "' (" +
+        std::to_string(nrow) + " rows x " + std::to_string(ncol) +
+        " columns): MuJoCo 2.2.2's mj_ray reads past a heightfield with more rows than columns; "
+        "use the Embree caster (the default)");
+  }
+}
+
 }  // namespace
 
 std::unique_ptr<RayCaster> MakeMujocoRayCaster(const mjModel_* model, const mjData_* data,
@@ -73,6 +96,7 @@ std::unique_ptr<RayCaster> MakeMujocoRayCaster(const mjModel_* model, const mjDa
   if (model == nullptr || data == nullptr) {
     throw std::runtime_error("MakeMujocoRayCaster: model and data must not be null");
   }
+  CheckHeightfieldsMjRayCanRead(model, options);
   return std::make_unique<MujocoRayCaster>(model, data, options);
 }
 

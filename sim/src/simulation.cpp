@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 
@@ -67,19 +69,23 @@ std::string DirOf(const std::string& path) {
   return dir;
 }
 
-// Writes the composed text to a private temp file, loads it and removes the file again.
+// Compiles the composed text from memory, through MuJoCo's virtual file system: no temp file that
+// a kill mid-load would leave behind (a test's interrupted runs left the yard's composed text in
+// /tmp), and no need of a writable TMPDIR. The asset paths in the text are absolute
+// (ComposeWorldXml), and MuJoCo reads files the VFS does not hold from disk.
 mjModel* LoadComposed(const std::string& xml, const std::string& source) {
-  const char* tmpdir = std::getenv("TMPDIR");
-  std::string path =
-      std::string(tmpdir && *tmpdir ? tmpdir : "/tmp") + "/pitchlab_world_XXXXXX.xml";
-  const int fd = mkstemps(path.data(), 4);
-  if (fd < 0) throw std::runtime_error("world " + source + ": cannot create a temp file " + path);
-  const bool written = write(fd, xml.data(), xml.size()) == static_cast<ssize_t>(xml.size());
-  close(fd);
+  static constexpr char kName[] = "pitchlab_composed_world.xml";
+  const auto vfs = std::make_unique<mjVFS>();  // ~2 MB of name slots: not on the stack
+  mj_defaultVFS(vfs.get());
+  if (xml.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()) ||
+      mj_makeEmptyFileVFS(vfs.get(), kName, static_cast<int>(xml.size())) != 0) {
+    throw std::runtime_error("world " + source + ": its composed text (" +
+                             std::to_string(xml.size()) + " bytes) does not fit MuJoCo's VFS");
+  }
+  std::memcpy(vfs->filedata[mj_findFileVFS(vfs.get(), kName)], xml.data(), xml.size());
   char error[1024] = "";
-  mjModel* model = written ? mj_loadXML(path.c_str(), nullptr, error, sizeof error) : nullptr;
-  unlink(path.c_str());
-  if (!written) throw std::runtime_error("world " + source + ": cannot write temp file " + path);
+  mjModel* model = mj_loadXML(kName, vfs.get(), error, sizeof error);
+  mj_deleteVFS(vfs.get());
   if (model == nullptr) {
     // The user's file, not our composition, is what the message names: MuJoCo's own error
     // (element, attribute, line of the composed text) says what it could not take.

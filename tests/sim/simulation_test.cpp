@@ -3,11 +3,11 @@
 #include "pitchlab/sim/sim_base.hpp"
 
 #include <dirent.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -20,6 +20,7 @@
 
 #include "pitchlab/sim/robot_model.hpp"
 #include "pitchlab/sim/world.hpp"
+#include "scoped_temp_dir.hpp"
 #include "sim_test_worlds.hpp"
 
 namespace pitchlab::sim {
@@ -28,6 +29,7 @@ namespace {
 using testing::kFlatWorld;
 using testing::kWallWorld;
 using testing::kBoxFloorWorld;
+using test_support::ScopedTempDir;
 
 constexpr double kGroundTolerance_m = 0.005;  // tyre/contact softness sag
 constexpr double kMountTolerance_m = 0.005;
@@ -46,14 +48,11 @@ INSTANTIATE_TEST_SUITE_P(Sim, RobotModels, ::testing::Values(P3Model::kP3AT, P3M
 
 TEST_P(RobotModels, RobotDocumentLoadsInMujocoWithAllNamedElements) {
   const std::string xml = RobotMjcfDocument(Robot(GetParam()));
-  char path[] = "/tmp/pitchlab_robot_test_XXXXXX.xml";
-  const int fd = mkstemps(path, 4);
-  ASSERT_GE(fd, 0);
-  ASSERT_EQ(write(fd, xml.data(), xml.size()), static_cast<ssize_t>(xml.size()));
-  close(fd);
+  const ScopedTempDir dir("robot_test");
+  const std::string path = (dir / "robot.xml").string();
+  ASSERT_TRUE(std::ofstream(path) << xml << std::flush);
   char error[1000] = "";
-  mjModel* m = mj_loadXML(path, nullptr, error, sizeof error);
-  unlink(path);
+  mjModel* m = mj_loadXML(path.c_str(), nullptr, error, sizeof error);
   ASSERT_NE(m, nullptr) << error;
   EXPECT_GE(mj_name2id(m, mjOBJ_BODY, kRobotBody), 0);
   EXPECT_GE(mj_name2id(m, mjOBJ_SITE, kBaseLinkSite), 0);
@@ -72,13 +71,10 @@ TEST_P(RobotModels, RobotDocumentLoadsInMujocoWithAllNamedElements) {
 TEST(Simulation, LoadedP3AtTipsForwardOnlyWellPastItsRatedGrade) {
   const std::string xml = RobotMjcfDocument(Robot(P3Model::kP3AT));
   char error[1000] = "";
-  char path[] = "/tmp/pitchlab_robot_tip_XXXXXX.xml";
-  const int fd = mkstemps(path, 4);
-  ASSERT_GE(fd, 0);
-  ASSERT_EQ(write(fd, xml.data(), xml.size()), static_cast<ssize_t>(xml.size()));
-  close(fd);
-  mjModel* m = mj_loadXML(path, nullptr, error, sizeof error);
-  unlink(path);
+  const ScopedTempDir dir("robot_tip");
+  const std::string path = (dir / "robot.xml").string();
+  ASSERT_TRUE(std::ofstream(path) << xml << std::flush);
+  mjModel* m = mj_loadXML(path.c_str(), nullptr, error, sizeof error);
   ASSERT_NE(m, nullptr) << error;
   mjData* d = mj_makeData(m);
   mj_forward(m, d);
@@ -123,6 +119,22 @@ TEST(Simulation, ReadsThePitchlabCustomFields) {
   EXPECT_NEAR((*w.default_start)[2], M_PI / 2, 1e-12);
   ASSERT_TRUE(w.geodetic_origin);
   EXPECT_NEAR(sim->timestep_s(), 0.002, 1e-12);
+}
+
+// The world with the robot added is compiled from memory: a temp folder that cannot be written
+// (full, read-only, or not there) stops no run, and a run killed while its world loads leaves no
+// file behind (until session 36 the composed text went through TMPDIR/pitchlab_world_*.xml).
+TEST(Simulation, LoadsAWorldWithoutATempFolder) {
+  const char* old = std::getenv("TMPDIR");
+  const std::string saved = old ? old : "";
+  ::setenv("TMPDIR", "/nonexistent/pitchlab_no_temp_folder", 1);
+  std::unique_ptr<Simulation> sim;
+  EXPECT_NO_THROW(sim = Simulation::FromString(kFlatWorld, "/tmp", Robot(P3Model::kP3DX)));
+  old ? ::setenv("TMPDIR", saved.c_str(), 1) : ::unsetenv("TMPDIR");
+  ASSERT_TRUE(sim);
+  EXPECT_EQ(sim->world().description, "flat test floor");
+  Result<Eigen::Isometry3d> pose = sim->PlaceRobot(1.0, 2.0, 0.0);
+  EXPECT_TRUE(pose) << pose.error().message;
 }
 
 TEST(Simulation, PlacementInsideAnObstacleIsAClearError) {
@@ -188,12 +200,10 @@ TEST(Simulation, PlacementOnAnEvenSlopeSettlesTiltedLikeTheSlope) {
 }
 
 // A plane rising 20 deg towards +x as a MuJoCo heightfield (the terrain's contact type), written
-// to a fresh folder: MuJoCo's binary hfield is int32 rows, int32 columns, then float32 heights.
-std::string SlopeHeightfieldDir() {
-  char dir[] = "/tmp/pitchlab_hslope_XXXXXX";
-  if (mkdtemp(dir) == nullptr) throw std::runtime_error("mkdtemp failed");
+// to `dir`: MuJoCo's binary hfield is int32 rows, int32 columns, then float32 heights.
+void WriteSlopeHeightfield(const std::filesystem::path& dir) {
   constexpr std::int32_t kN = 81;
-  std::ofstream out(std::string(dir) + "/slope.bin", std::ios::binary);
+  std::ofstream out(dir / "slope.bin", std::ios::binary);
   out.write(reinterpret_cast<const char*>(&kN), sizeof kN);
   out.write(reinterpret_cast<const char*>(&kN), sizeof kN);
   for (int row = 0; row < kN; ++row) {
@@ -202,7 +212,6 @@ std::string SlopeHeightfieldDir() {
       out.write(reinterpret_cast<const char*>(&h), sizeof h);
     }
   }
-  return dir;
 }
 
 // 8 m across, 8 m x tan(20 deg) = 2.912 m high.
@@ -219,9 +228,11 @@ constexpr char kSlopeHeightfieldWorld[] = R"(
 // (simulation.cpp) holds it to 0.2-0.3 mm, a tenth of the LMS200's 5 mm range noise and under
 // its 10 mm resolution.
 TEST(Simulation, StoppedOnATwentyDegreeHeightfieldSlopeTheRobotStaysPut) {
-  const std::string dir = SlopeHeightfieldDir();
+  const ScopedTempDir dir("hslope");
+  WriteSlopeHeightfield(dir.path());
   for (const double yaw : {0.0, M_PI, M_PI / 2}) {  // facing uphill, downhill, across
-    auto sim = Simulation::FromString(kSlopeHeightfieldWorld, dir, Robot(P3Model::kP3AT));
+    auto sim =
+        Simulation::FromString(kSlopeHeightfieldWorld, dir.path().string(), Robot(P3Model::kP3AT));
     SimBase base(*sim);
     ASSERT_TRUE(sim->PlaceRobot(0.0, 0.0, yaw));
     ASSERT_TRUE(base.Drive(0.15, 0.0, 1.0));
@@ -232,7 +243,6 @@ TEST(Simulation, StoppedOnATwentyDegreeHeightfieldSlopeTheRobotStaysPut) {
     constexpr double kCreep_m = 0.0005;
     EXPECT_LT((sim->T_world_base().translation() - before).norm(), kCreep_m) << "yaw " << yaw;
   }
-  std::filesystem::remove_all(dir);
 }
 
 // Held for a scan on the same slope (Simulation::HoldStill), the robot does not move at all, the
@@ -240,11 +250,13 @@ TEST(Simulation, StoppedOnATwentyDegreeHeightfieldSlopeTheRobotStaysPut) {
 // as immovable in both), and on release the contacts are back and the robot settles where the
 // one that was never held is.
 TEST(Simulation, HeldOnTheSlopeOnlyThePitchJointMovesAndReleaseRestoresTheContacts) {
-  const std::string dir = SlopeHeightfieldDir();
+  const ScopedTempDir dir("hslope");
+  WriteSlopeHeightfield(dir.path());
   std::vector<std::unique_ptr<Simulation>> sims;
   std::vector<std::unique_ptr<SimBase>> bases;
   for (int i = 0; i < 2; ++i) {
-    sims.push_back(Simulation::FromString(kSlopeHeightfieldWorld, dir, Robot(P3Model::kP3AT)));
+    sims.push_back(
+        Simulation::FromString(kSlopeHeightfieldWorld, dir.path().string(), Robot(P3Model::kP3AT)));
     bases.push_back(std::make_unique<SimBase>(*sims.back()));
     ASSERT_TRUE(sims.back()->PlaceRobot(0.0, 0.0, 0.0));
     ASSERT_TRUE(bases.back()->Stop(3.0));
@@ -281,7 +293,6 @@ TEST(Simulation, HeldOnTheSlopeOnlyThePitchJointMovesAndReleaseRestoresTheContac
   constexpr double kCreep_m = 0.0005;
   EXPECT_LT((held.T_world_base().translation() - free.T_world_base().translation()).norm(),
             kCreep_m);
-  std::filesystem::remove_all(dir);
 }
 
 // A robot still driving is not held: HoldStill refuses and the physics goes on.
@@ -314,7 +325,8 @@ TEST(Simulation, PlacementOffTheWorldIsAClearError) {
 }
 
 TEST(Simulation, BrokenWorldThrowsWithThePathAndMujocosMessage) {
-  const std::string path = "/tmp/pitchlab_sim_test_broken.xml";
+  const ScopedTempDir dir("sim_test");
+  const std::string path = (dir / "broken.xml").string();
   std::ofstream(path) << "<mujoco><worldbody><geom type=\"sphere\"/></worldbody></mujoco>";
   try {
     Simulation sim(path, Robot(P3Model::kP3DX));
@@ -323,7 +335,6 @@ TEST(Simulation, BrokenWorldThrowsWithThePathAndMujocosMessage) {
     EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("size"), std::string::npos) << e.what();
   }
-  std::remove(path.c_str());
   EXPECT_THROW(Simulation("/nonexistent/world.xml", Robot(P3Model::kP3DX)), std::runtime_error);
 }
 
@@ -336,9 +347,8 @@ int CountFiles(const std::string& dir) {
 }
 
 TEST(Simulation, HeightfieldFileResolvesAgainstTheWorldFolderWhichStaysUntouched) {
-  char dir[] = "/tmp/pitchlab_world_dir_XXXXXX";
-  ASSERT_NE(mkdtemp(dir), nullptr);
-  const std::string world_dir = dir;
+  const ScopedTempDir dir("world_dir");
+  const std::string world_dir = dir.path().string();
   {
     std::ofstream hf(world_dir + "/flat.bin", std::ios::binary);
     const int32_t rows = 3, cols = 3;
@@ -359,9 +369,6 @@ TEST(Simulation, HeightfieldFileResolvesAgainstTheWorldFolderWhichStaysUntouched
     EXPECT_NEAR(pose->translation().z(), 0.2, 0.01);  // hfield at z = 0.2, all heights 0
   }
   EXPECT_EQ(CountFiles(world_dir), before);
-  std::remove((world_dir + "/flat.bin").c_str());
-  std::remove((world_dir + "/terrain.xml").c_str());
-  rmdir(dir);
 }
 
 TEST(ComposeWorldXml, MakesRelativeAssetPathsAbsoluteAndKeepsAbsoluteOnes) {

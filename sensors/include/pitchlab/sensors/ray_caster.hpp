@@ -46,7 +46,9 @@ class RayCaster {
 std::unique_ptr<RayCaster> MakeEmbreeRayCaster(const mjModel_* model, const mjData_* data,
                                                const RayCasterOptions& options = {});
 
-/// Reference caster: one mj_ray call per ray. Same contract as the Embree caster.
+/// Reference caster: one mj_ray call per ray. Same contract as the Embree caster; also throws
+/// std::runtime_error naming a visible heightfield with more rows than columns, which MuJoCo
+/// 2.2.2's mj_ray reads past (the gully's).
 std::unique_ptr<RayCaster> MakeMujocoRayCaster(const mjModel_* model, const mjData_* data,
                                                const RayCasterOptions& options = {});
 
