@@ -25,6 +25,7 @@ constexpr int kIdlePeriodMs = 5;
 
 EmulatedDevice::EmulatedDevice(std::string name, int baud, std::string link_path)
     : name_(std::move(name)), baud_(baud), link_path_(std::move(link_path)) {
+  std::string made_dir;  // the folder made here, if any
   if (link_path_.empty()) {
     std::error_code no_tmp;
     const std::filesystem::path tmp = std::filesystem::temp_directory_path(no_tmp);  // TMPDIR
@@ -33,13 +34,14 @@ EmulatedDevice::EmulatedDevice(std::string name, int baud, std::string link_path
       throw std::runtime_error("emulator " + name_ + ": cannot create the folder " + dir + ": " +
                                std::strerror(errno));
     }
+    made_dir = dir;
     link_path_ = dir + "/" + name_;
     own_link_dir_ = true;
   }
   try {
     OpenPty();
   } catch (...) {  // no destructor runs: the folder made above goes here
-    if (own_link_dir_) ::rmdir(std::filesystem::path(link_path_).parent_path().c_str());
+    if (!made_dir.empty()) ::rmdir(made_dir.c_str());
     throw;
   }
 }

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cstdlib>
+#include <exception>
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
@@ -52,26 +53,36 @@ TEST(EmulatedDeviceFolder, LivesUnderTmpdirAndGoesWithTheDevice) {
   EXPECT_EQ(Entries(dir.path()), 0);
 }
 
-// No file descriptor left for the pseudo-terminal (the soft limit at the lowest free number):
-// the constructor throws naming the emulator, and the folder it had made is gone.
+// One file descriptor left where the pseudo-terminal needs two (the soft limit one above the
+// lowest free number): the constructor throws naming the emulator, and the folder it had made is
+// gone. A device is made and dropped first: UBSan's vptr check validates a type it has not seen
+// by reading /proc/self/maps, which it cannot open without a descriptor, and would report the
+// device as having an invalid vptr; seen once, the answer is cached.
 TEST(EmulatedDeviceFolder, ADeviceThatCannotBeMadeLeavesNoFolder) {
   const test_support::ScopedTempDir dir("emulated_device");
   const ScopedTmpdir tmpdir(dir.path());
+  { const PitchUnitEmulator seen(sensors::PitchUnitConfig{}); }
   rlimit before{};
   ASSERT_EQ(::getrlimit(RLIMIT_NOFILE, &before), 0);
   const int lowest_free = ::dup(0);
   ASSERT_GE(lowest_free, 0);
   ::close(lowest_free);
-  rlimit none = before;
-  none.rlim_cur = static_cast<rlim_t>(lowest_free);
-  ASSERT_EQ(::setrlimit(RLIMIT_NOFILE, &none), 0);
-  std::string message;
+  rlimit one = before;
+  one.rlim_cur = static_cast<rlim_t>(lowest_free) + 1;
+  ASSERT_EQ(::setrlimit(RLIMIT_NOFILE, &one), 0);
+  std::exception_ptr failure;  // read once the limit is back (UBSan: the same as above)
   try {
     const PitchUnitEmulator board(sensors::PitchUnitConfig{});
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  ASSERT_EQ(::setrlimit(RLIMIT_NOFILE, &before), 0);
+  std::string message;
+  try {
+    if (failure) std::rethrow_exception(failure);
   } catch (const std::runtime_error& e) {
     message = e.what();
   }
-  ASSERT_EQ(::setrlimit(RLIMIT_NOFILE, &before), 0);
   EXPECT_NE(message.find("openpty"), std::string::npos) << message;
   EXPECT_EQ(Entries(dir.path()), 0);
 }
