@@ -137,6 +137,19 @@ TEST(Simulation, LoadsAWorldWithoutATempFolder) {
   EXPECT_TRUE(pose) << pose.error().message;
 }
 
+// An <include>d part of a world, named relative to the world's folder, is part of it (through a
+// temp file MuJoCo 2.2.2 refused it: "No directory").
+TEST(Simulation, AnIncludedFileIsPartOfTheWorld) {
+  const ScopedTempDir dir("simulation");
+  ASSERT_TRUE(std::ofstream(dir / "part.xml") << R"(<mujoco><worldbody>
+    <geom name="included_box" type="box" pos="5 0 0.5" size="0.5 0.5 0.5"/>
+  </worldbody></mujoco>)" << std::flush);
+  const auto sim = Simulation::FromString(R"(<mujoco><include file="part.xml"/><worldbody>
+    <geom name="floor" type="plane" size="10 10 0.1"/></worldbody></mujoco>)",
+                                          dir.path().string(), Robot(P3Model::kP3DX));
+  EXPECT_GE(mj_name2id(sim->model(), mjOBJ_GEOM, "included_box"), 0);
+}
+
 TEST(Simulation, PlacementInsideAnObstacleIsAClearError) {
   auto sim = Simulation::FromString(kFlatWorld, "/tmp", Robot(P3Model::kP3AT));
   Result<Eigen::Isometry3d> pose = sim->PlaceRobot(5.0, 0.0, 0.0);
