@@ -75,7 +75,13 @@ std::string DirOf(const std::string& path) {
 // (ComposeWorldXml), and MuJoCo reads files the VFS does not hold from disk.
 mjModel* LoadComposed(const std::string& xml, const std::string& source) {
   static constexpr char kName[] = "pitchlab_composed_world.xml";
-  const auto vfs = std::make_unique<mjVFS>();  // ~2 MB of name slots: not on the stack
+  // ~2 MB of name slots, not on the stack; its file freed also when mj_loadXML throws (our
+  // mju_user_error handler throws).
+  const auto free_vfs = [](mjVFS* v) {
+    mj_deleteVFS(v);
+    delete v;
+  };
+  const std::unique_ptr<mjVFS, decltype(free_vfs)> vfs(new mjVFS, free_vfs);
   mj_defaultVFS(vfs.get());
   if (xml.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()) ||
       mj_makeEmptyFileVFS(vfs.get(), kName, static_cast<int>(xml.size())) != 0) {
@@ -85,7 +91,6 @@ mjModel* LoadComposed(const std::string& xml, const std::string& source) {
   std::memcpy(vfs->filedata[mj_findFileVFS(vfs.get(), kName)], xml.data(), xml.size());
   char error[1024] = "";
   mjModel* model = mj_loadXML(kName, vfs.get(), error, sizeof error);
-  mj_deleteVFS(vfs.get());
   if (model == nullptr) {
     // The user's file, not our composition, is what the message names: MuJoCo's own error
     // (element, attribute, line of the composed text) says what it could not take.
