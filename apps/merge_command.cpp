@@ -4,14 +4,15 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "cli_args.hpp"
 #include "cloud_input.hpp"
 #include "commands.hpp"
+#include "pitchlab/mapping/atomic_file.hpp"
 #include "pitchlab/mapping/map_builder.hpp"
 #include "pitchlab/mapping/trajectory_metrics.hpp"
 #include "pitchlab/mapping/tum_trajectory.hpp"
@@ -118,23 +119,19 @@ nlohmann::json LoopClosuresJson(const mapping::MapBuilder& builder,
   return out;
 }
 
-void WriteTrajectory(const std::string& path, const std::vector<std::string>& files,
-                     const std::vector<mapping::TrajectoryPose>& trajectory) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream csv(tmp);
-    if (!csv) throw std::runtime_error(path + ": cannot be written");
-    csv << "scan,file,x_m,y_m,z_m,qw,qx,qy,qz\n";
-    csv.precision(9);
-    for (const mapping::TrajectoryPose& p : trajectory) {
-      const Eigen::Vector3d t = p.T_map_base.translation();
-      const Eigen::Quaterniond q(p.T_map_base.rotation());
-      csv << p.scan_index << "," << files[p.scan_index] << "," << t.x() << "," << t.y() << ","
-          << t.z() << "," << q.w() << "," << q.x() << "," << q.y() << "," << q.z() << "\n";
-    }
-    if (!csv.flush()) throw std::runtime_error(path + ": write failed");
+// The trajectory as CSV: a header, then one line a merged scan.
+std::string TrajectoryCsv(const std::vector<std::string>& files,
+                          const std::vector<mapping::TrajectoryPose>& trajectory) {
+  std::ostringstream csv;
+  csv << "scan,file,x_m,y_m,z_m,qw,qx,qy,qz\n";
+  csv.precision(9);
+  for (const mapping::TrajectoryPose& p : trajectory) {
+    const Eigen::Vector3d t = p.T_map_base.translation();
+    const Eigen::Quaterniond q(p.T_map_base.rotation());
+    csv << p.scan_index << "," << files[p.scan_index] << "," << t.x() << "," << t.y() << ","
+        << t.z() << "," << q.w() << "," << q.x() << "," << q.y() << "," << q.z() << "\n";
   }
-  std::filesystem::rename(tmp, path);
+  return csv.str();
 }
 
 }  // namespace
@@ -217,17 +214,23 @@ int RunMerge(int argc, char** argv) {
     sp.range_m = p.norm();
     map.points.push_back(sp);
   }
-  if (Result<void> written = sensors::WriteScanPcd(map, out); !written) {
-    throw std::runtime_error(written.error().message);
-  }
+  // The map and its two trajectories are one answer: each file is written whole or not at all,
+  // and when one cannot be written those already written are removed with it.
   const std::string trajectory_path = TrajectoryPath(args, out);
-  WriteTrajectory(trajectory_path, files, builder->trajectory());
   const std::string tum_path = TumPath(trajectory_path);
-  if (Result<void> tum =
-          mapping::WriteTumTrajectory(tum_path, Stamped(builder->trajectory(), stamps_s));
-      !tum) {
-    throw std::runtime_error(tum_path + ": " + tum.error().message);
-  }
+  std::vector<std::string> written;
+  const auto write = [&](const std::string& path, const Result<void>& result) {
+    if (!result) {
+      for (const std::string& w : written) std::remove(w.c_str());
+      throw std::runtime_error(result.error().message);
+    }
+    written.push_back(path);
+  };
+  write(out, sensors::WriteScanPcd(map, out));
+  write(trajectory_path, mapping::WriteFileAtomically(
+                             trajectory_path, TrajectoryCsv(files, builder->trajectory())));
+  write(tum_path,
+        mapping::WriteTumTrajectory(tum_path, Stamped(builder->trajectory(), stamps_s)));
   nlohmann::json summary = {{"map", out},
                             {"map_points", map.points.size()},
                             {"trajectory", trajectory_path},

@@ -15,11 +15,14 @@ Result<void> WriteFileAtomically(const std::string& path, const std::string& byt
     if (!out) {
       return Fail(Error::Code::kInvalidArgument, path + ": cannot write: " + std::strerror(errno));
     }
+    errno = 0;
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    if (!out.flush()) {
-      out.close();
+    out.close();  // closing writes what is buffered, and may be where a full disk shows
+    if (out.fail()) {
+      // What the system said (a full disk, a file size limit), when it said anything.
+      const std::string why = errno != 0 ? std::strerror(errno) : "write failed";
       std::remove(tmp.c_str());  // a full disk leaves no partial file behind
-      return Fail(Error::Code::kFailed, path + ": write failed");
+      return Fail(Error::Code::kFailed, path + ": cannot write: " + why);
     }
   }
   std::error_code ec;

@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 
 #include "pitchlab/mapping/elevation_io.hpp"
@@ -119,14 +121,21 @@ Eigen::Vector2d MapToPixel(const GridGeometry& g, const RgbImage& image, double 
 Result<void> WritePng(const RgbImage& image, const std::string& path) {
   const std::string tmp = path + ".tmp";
   FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) return Fail(Error::Code::kInvalidArgument, path + ": cannot write");
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  if (!f) {
+    return Fail(Error::Code::kInvalidArgument, path + ": cannot write: " + std::strerror(errno));
+  }
+  errno = 0;  // what a failed write below sets names the cause (a full disk)
+  // libpng's own handlers print to stderr; the error comes back to the caller here instead.
+  const auto on_error = [](png_structp p, png_const_charp) { png_longjmp(p, 1); };
+  const auto on_warning = [](png_structp, png_const_charp) {};
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, on_error, on_warning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!png || !info || setjmp(png_jmpbuf(png))) {
     png_destroy_write_struct(&png, &info);
     std::fclose(f);
+    const std::string why = errno != 0 ? std::strerror(errno) : "libpng failed";
     std::remove(tmp.c_str());
-    return Fail(Error::Code::kFailed, path + ": libpng failed");
+    return Fail(Error::Code::kFailed, path + ": cannot write: " + why);
   }
   png_init_io(png, f);
   // Our pictures draw each map cell as a block of pixels, so most rows repeat the one above: the
@@ -149,8 +158,9 @@ Result<void> WritePng(const RgbImage& image, const std::string& path) {
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
   if (std::fclose(f) != 0) {
+    const std::string why = std::strerror(errno);
     std::remove(tmp.c_str());
-    return Fail(Error::Code::kFailed, path + ": write failed");
+    return Fail(Error::Code::kFailed, path + ": cannot write: " + why);
   }
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);

@@ -137,6 +137,20 @@ TEST_F(InterruptCli, AFullDiskDuringARunNamesTheFileAndLeavesNothing) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+TEST_F(InterruptCli, AFullDiskUnderMapSaysWhyAndLeavesNothing) {
+  const fs::path out = dir_ / "map";
+  const fs::path scan = fs::path(PITCHLAB_SOURCE_DIR) / "tests/data/real/3dtk_corridor/scan000.3d";
+  // 16 kB: less than the map's lossless file of 333 x 147 cells.
+  const pid_t pid = Start({"map", scan.string(), "--out", out.string()}, 16 * 1024);
+  const Ended e = Wait(pid);
+  EXPECT_EQ(e.exit_code, 1) << e.err;
+  EXPECT_NE(e.err.find("pitchlab map: error: "), std::string::npos) << e.err;
+  EXPECT_NE(e.err.find(": cannot write: " + std::string(std::strerror(EFBIG))), std::string::npos)
+      << e.err;
+  EXPECT_TRUE(Staging(dir_.path(), ".map").empty());
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST_F(InterruptCli, BenchStopsItsRunsAndLeavesNoStagingFolder) {
   const fs::path bench = dir_ / "bench";
   const pid_t pid = Start({"bench", "--worlds", kYard.string(), "--seeds", "1", "--out",

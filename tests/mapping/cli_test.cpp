@@ -149,6 +149,30 @@ TEST_F(Cli, MergeWritesTheMapAndTheTrajectory) {
   }
 }
 
+// The map and its trajectories are written together or not at all: a trajectory that cannot be
+// written (its folder does not exist) fails the command naming it, and the map written before
+// it is removed.
+TEST_F(Cli, MergeThatCannotWriteItsTrajectoryLeavesNoMapBehind) {
+  std::vector<std::string> args;
+  for (int i = 0; i < 2; ++i) {
+    args.push_back(Write(SimulatedScan("office", -8 + 0.6 * i, 0, 0, 30 + i),
+                         "s" + std::to_string(i) + ".pcd"));
+  }
+  const std::string map = (dir_ / "map.pcd").string();
+  const std::string trajectory = (dir_ / "no_such_folder" / "t.csv").string();
+  args.insert(args.end(), {"--out", map, "--trajectory", trajectory});
+  std::string message = "no error";
+  try {
+    RunCommand(apps::RunMerge, args);
+  } catch (const std::runtime_error& e) {
+    message = e.what();
+  }
+  ::testing::internal::GetCapturedStdout();
+  EXPECT_EQ(message.rfind(trajectory + ": cannot write: ", 0), 0u) << message;
+  EXPECT_FALSE(fs::exists(map));
+  EXPECT_FALSE(fs::exists(dir_ / "map_trajectory.csv"));
+}
+
 // A sequence 3 m along the office's corridor and back, reversing to where it began (no odometry:
 // the scans carry only their truth). With --loop-closure the JSON counts the loops, none wrong,
 // the final pose is no worse than without, and the TUM trajectory has every merged pose.
