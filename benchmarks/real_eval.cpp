@@ -196,6 +196,39 @@ json Run(const Scan& target, const Scan& source, const Grid& grid, bool with_pri
   return out;
 }
 
+// Whether the servo's pitch errors repeat from scan to scan, so that a table taken once could
+// correct them: the lines two scans share (the same recorded pitch, within the line gap that
+// tells lines apart) and how their corrections compare. `table_leaves_deg` is what scan a's
+// corrections, applied to scan b, would leave of b's error (RMS of the difference), against
+// `rms_b_deg` with no correction at all.
+json LinePitchRepeat(const mapping::LinePitch& a, const mapping::LinePitch& b) {
+  const double gap = mapping::LinePitchConfig{}.line_gap_rad;
+  std::vector<std::pair<double, double>> shared;
+  for (const mapping::LineCorrection& ca : a.line_corrections) {
+    for (const mapping::LineCorrection& cb : b.line_corrections) {
+      if (std::abs(ca.pitch_rad - cb.pitch_rad) <= gap) {
+        shared.emplace_back(ca.correction_rad, cb.correction_rad);
+        break;
+      }
+    }
+  }
+  if (shared.size() < 3) return {{"shared_lines", shared.size()}};
+  const double n = static_cast<double>(shared.size());
+  double ma = 0, mb = 0;
+  for (const auto& [x, y] : shared) ma += x / n, mb += y / n;
+  double saa = 0, sbb = 0, sab = 0, a2 = 0, b2 = 0, d2 = 0;
+  for (const auto& [x, y] : shared) {
+    saa += (x - ma) * (x - ma), sbb += (y - mb) * (y - mb), sab += (x - ma) * (y - mb);
+    a2 += x * x, b2 += y * y, d2 += (x - y) * (x - y);
+  }
+  constexpr double kToDeg = 180 / 3.14159265358979323846;
+  return {{"shared_lines", shared.size()},
+          {"correlation", sab / std::sqrt(saa * sbb)},
+          {"rms_a_deg", std::sqrt(a2 / n) * kToDeg},
+          {"rms_b_deg", std::sqrt(b2 / n) * kToDeg},
+          {"table_leaves_deg", std::sqrt(d2 / n) * kToDeg}};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -297,8 +330,15 @@ int main(int argc, char** argv) {
       j["cpu_s"] = s.line_pitch_cpu_s;
       line_pitch.push_back(j);
     }
+    json repeat = json::array();
+    for (std::size_t k = 1; k < scans.size(); ++k) {
+      json r = LinePitchRepeat(scans[k - 1].line_pitch, scans[k].line_pitch);
+      r["scans"] = {scans[k - 1].path, scans[k].path};
+      repeat.push_back(r);
+    }
     json out = {{"folder", dir},
                 {"line_pitch", line_pitch},
+                {"line_pitch_repeat", repeat},
                 {"prior_error", {bound.translation_m, bound.rotation_deg}},
                 {"runs", runs},
                 {"successes", successes},

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "pitchlab/mapping/dem_io.hpp"
+#include "pitchlab/sensors/number_text.hpp"
 
 namespace pitchlab::mapping {
 namespace {
@@ -59,14 +60,14 @@ Result<AsciiGrid> GridFromHeader(const std::map<std::string, Field>& h, const st
     // 1e8 cells a side: beyond any DEM a file of text holds, and the product fits 64 bits.
     if (!(f.value >= 1 && f.value <= 1e8 && f.value == std::floor(f.value)))
       return bad(f.line, std::string("'") + key + "' must be a whole number >= 1, not " +
-                             std::to_string(f.value));
+                             NumberText(f.value));
   }
   g.ncols = static_cast<int>(h.at("ncols").value);
   g.nrows = static_cast<int>(h.at("nrows").value);
   g.cell_size = h.at("cellsize").value;
   if (!(g.cell_size > 0))
     return bad(h.at("cellsize").line,
-               "'cellsize' must be positive, not " + std::to_string(g.cell_size));
+               "'cellsize' must be positive, not " + NumberText(g.cell_size));
   for (const std::string axis : {"x", "y"}) {
     const bool corner = h.count(axis + "llcorner"), centre = h.count(axis + "llcenter");
     if (corner == centre)

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "pitchlab/sensors/number_text.hpp"
+
 namespace pitchlab::mapping {
 
 namespace {
@@ -43,7 +45,7 @@ double ChiSquareQuantile(int dof, double probability) {
   CheckDof(dof);
   if (!(probability > 0 && probability < 1)) {
     throw std::invalid_argument("chi-square quantile: probability = " +
-                                std::to_string(probability) + ": must lie in (0, 1)");
+                                NumberText(probability) + ": must lie in (0, 1)");
   }
   double lo = 0, hi = dof;  // the CDF is increasing: bracket, then bisect
   for (int doublings = 0; ChiSquareCdf(dof, hi) < probability; ++doublings) {
@@ -51,7 +53,7 @@ double ChiSquareQuantile(int dof, double probability) {
     // no probability short of 1 in double precision needs more.
     if (doublings == 8) {
       throw std::invalid_argument("chi-square quantile: probability = " +
-                                  std::to_string(probability) + " is too close to 1");
+                                  NumberText(probability) + " is too close to 1");
     }
     hi *= 2;
   }

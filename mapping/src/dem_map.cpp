@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "pitchlab/mapping/dem_io.hpp"
+#include "pitchlab/sensors/number_text.hpp"
 
 namespace pitchlab::mapping {
 namespace {
@@ -202,7 +203,7 @@ Result<Dem> LoadDem(const std::string& asc_path) {
   // corners within longitude/latitude range is in degrees, whatever the missing .prj would say.
   if (dem.crs.name == "no .prj" && g.cell_size < 0.01 && std::abs(g.xll_corner) <= 360 &&
       std::abs(g.yll_corner) <= 90)
-    return bad("cell size " + std::to_string(g.cell_size) +
+    return bad("cell size " + NumberText(g.cell_size) +
                " looks like degrees, but no .prj "
                "says so: put the grid's .prj beside it (GEOGCS for longitude/latitude)");
   if (dem.crs.kind == Kind::kGeographic &&

@@ -9,6 +9,8 @@
 
 #include "elevation_insert.hpp"
 
+#include "pitchlab/sensors/number_text.hpp"
+
 namespace pitchlab::mapping {
 namespace {
 
@@ -511,9 +513,9 @@ InsertStats InsertScanImpl(const GridGeometry& geometry, std::vector<CellStats>&
 GridGeometry GridGeometry::FromArea(double x_min_m, double y_min_m, double size_x_m,
                                     double size_y_m, double cell_m) {
   if (!(cell_m > 0.0) || !(size_x_m > 0.0) || !(size_y_m > 0.0)) {
-    throw std::invalid_argument("elevation map: cell (" + std::to_string(cell_m) +
-                                " m) and area (" + std::to_string(size_x_m) + " x " +
-                                std::to_string(size_y_m) + " m) must be positive");
+    throw std::invalid_argument("elevation map: cell (" + NumberText(cell_m) +
+                                " m) and area (" + NumberText(size_x_m) + " x " +
+                                NumberText(size_y_m) + " m) must be positive");
   }
   GridGeometry g;
   g.x_min_m = x_min_m;
@@ -585,8 +587,8 @@ Result<std::size_t> ElevationMap::Merge(const ElevationMap& other, MergeCells ce
   const GridGeometry& b = other.geometry_;
   if (std::abs(a.cell_m - b.cell_m) > 1e-9 * a.cell_m) {
     return Fail(Error::Code::kInvalidArgument, "merge: cell sizes differ (" +
-                                                   std::to_string(a.cell_m) + " m vs " +
-                                                   std::to_string(b.cell_m) + " m)");
+                                                   NumberText(a.cell_m) + " m vs " +
+                                                   NumberText(b.cell_m) + " m)");
   }
   const double oi = (b.x_min_m - a.x_min_m) / a.cell_m, oj = (b.y_min_m - a.y_min_m) / a.cell_m;
   if (std::abs(oi - std::round(oi)) > 1e-6 || std::abs(oj - std::round(oj)) > 1e-6) {

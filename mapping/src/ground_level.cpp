@@ -10,9 +10,10 @@
 #include <utility>
 #include <vector>
 
-
 #include "half_normal_quantile.hpp"
 #include "up_plane_fit.hpp"
+
+#include "pitchlab/sensors/number_text.hpp"
 
 namespace pitchlab::mapping {
 namespace {
@@ -164,8 +165,8 @@ Result<GroundLevel> FitGroundLevel(const std::vector<Eigen::Vector3f>& points_m,
   if (candidates.size() < config.min_points) {
     return Fail(Error::Code::kFailed, "ground levelling: " + std::to_string(candidates.size()) +
                                           " cells with points below the sensor within " +
-                                          std::to_string(config.min_radius_m) + ".." +
-                                          std::to_string(config.max_radius_m) +
+                                          NumberText(config.min_radius_m) + ".." +
+                                          NumberText(config.max_radius_m) +
                                           " m of it, too few to find the floor (need " +
                                           std::to_string(config.min_points) + ")");
   }
@@ -173,7 +174,7 @@ Result<GroundLevel> FitGroundLevel(const std::vector<Eigen::Vector3f>& points_m,
   const Hypothesis best = BestHypothesis(candidates, sensor_m, config, rng);
   if (!std::isfinite(best.score_m)) {
     return Fail(Error::Code::kFailed, "ground levelling: no plane within " +
-                                          std::to_string(config.max_tilt_rad * 180 / M_PI) +
+                                          NumberText(config.max_tilt_rad * 180 / M_PI) +
                                           " deg of level lies below the sensor among " +
                                           std::to_string(candidates.size()) + " points");
   }

@@ -10,6 +10,8 @@
 
 #include "up_plane_fit.hpp"
 
+#include "pitchlab/sensors/number_text.hpp"
+
 namespace pitchlab::mapping {
 namespace {
 
@@ -252,13 +254,20 @@ void SetLinesRight(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f
       before += std::pow(first.n.dot(v) - first.d, 2);
       ++n;
     }
+    std::vector<double> elevation;
+    elevation.reserve(line.all.size());
     for (const std::uint32_t k : line.all) {
       const Eigen::Vector3d v = (points_m[k] - sensor_m).cast<double>();
+      elevation.push_back(std::atan2(-v.z(), v.x()));
       points_m[k] = sensor_m + TurnedAboutY(v, line.correction_rad).cast<float>();
     }
+    std::nth_element(elevation.begin(), elevation.begin() + elevation.size() / 2, elevation.end());
+    out.line_corrections.push_back({elevation[elevation.size() / 2], line.correction_rad});
   }
+  std::sort(out.line_corrections.begin(), out.line_corrections.end(),
+            [](const LineCorrection& a, const LineCorrection& b) { return a.pitch_rad < b.pitch_rad; });
   if (out.corrected == 0) {
-    out.note = "no line crossed the floor within " + std::to_string(config.ground.max_radius_m) +
+    out.note = "no line crossed the floor within " + NumberText(config.ground.max_radius_m) +
                " m in " + std::to_string(config.min_line_points) + " points";
     return;
   }

@@ -11,6 +11,8 @@
 #include "se3_perturbation.hpp"
 #include "voxel_hash.hpp"
 
+#include "pitchlab/sensors/number_text.hpp"
+
 namespace pitchlab::mapping {
 namespace {
 
@@ -78,7 +80,7 @@ Result<Matrix6d> EdgeInformation(const RegistrationResult& registration, double 
     return Fail(Error::Code::kInvalidArgument,
                 "edge information: the registration's covariance is not positive definite "
                 "(smallest eigenvalue " +
-                    std::to_string(eigen.eigenvalues()(0)) + "): no ICP result was scored");
+                    NumberText(eigen.eigenvalues()(0)) + "): no ICP result was scored");
   }
   const Matrix6d inverse = eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().asDiagonal() *
                            eigen.eigenvectors().transpose();

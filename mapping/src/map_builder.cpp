@@ -7,6 +7,7 @@
 #include "loop_closer.hpp"
 #include "pitchlab/mapping/parallel_for.hpp"
 #include "pitchlab/mapping/cloud_statistics.hpp"
+#include "pitchlab/sensors/number_text.hpp"
 
 namespace pitchlab::mapping {
 namespace {
@@ -24,7 +25,7 @@ Eigen::Isometry3d Orthonormal(Eigen::Isometry3d T) {
 
 void LoopClosureConfig::Validate() const {
   const auto fail = [](const std::string& field, double value, const std::string& rule) {
-    throw std::invalid_argument("map.loop_closure." + field + " = " + std::to_string(value) + ": " +
+    throw std::invalid_argument("map.loop_closure." + field + " = " + NumberText(value) + ": " +
                                 rule);
   };
   if (!(std::isfinite(candidates.max_distance_m) && candidates.max_distance_m > 0)) {
@@ -48,11 +49,11 @@ void LoopClosureConfig::Validate() const {
 
 void MapConfig::Validate() const {
   if (!(map_voxel_m > 0)) {
-    throw std::invalid_argument("map.map_voxel_m = " + std::to_string(map_voxel_m) +
+    throw std::invalid_argument("map.map_voxel_m = " + NumberText(map_voxel_m) +
                                 ": must be > 0");
   }
   if (!(local_map_radius_m > 0)) {
-    throw std::invalid_argument("map.local_map_radius_m = " + std::to_string(local_map_radius_m) +
+    throw std::invalid_argument("map.local_map_radius_m = " + NumberText(local_map_radius_m) +
                                 ": must be > 0");
   }
   registration.Validate();

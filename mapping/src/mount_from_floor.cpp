@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 
 #include "pitchlab/mapping/point_cloud.hpp"
+#include "pitchlab/sensors/number_text.hpp"
 
 #include "half_normal_quantile.hpp"
 
@@ -141,9 +142,9 @@ Result<MountFromFloor> CalibrateMountFromFloor(const sensors::Scan3D& scan,
   if (!(level->tilt_rad <= config.max_tilt_rad)) {
     return Fail(Error::Code::kFailed,
                 "mount calibration: the floor at the start tilts " +
-                    std::to_string(level->tilt_rad * 180 / M_PI) +
+                    NumberText(level->tilt_rad * 180 / M_PI) +
                     " deg in base_link, more than a mount error (" +
-                    std::to_string(config.max_tilt_rad * 180 / M_PI) + " deg)");
+                    NumberText(config.max_tilt_rad * 180 / M_PI) + " deg)");
   }
   Band band = FloorBand(scan, nominal, laser, *level, config.ground);
   if (band.points.size() < config.ground.min_points) {
@@ -189,9 +190,9 @@ Result<MountFromFloor> CalibrateMountFromFloor(const sensors::Scan3D& scan,
   if (!(s.x.norm() <= config.max_tilt_rad)) {
     return Fail(Error::Code::kFailed,
                 "mount calibration: the floor asks for a mount " +
-                    std::to_string(s.x.norm() * 180 / M_PI) +
+                    NumberText(s.x.norm() * 180 / M_PI) +
                     " deg off, more than a mount error (" +
-                    std::to_string(config.max_tilt_rad * 180 / M_PI) + " deg)");
+                    NumberText(config.max_tilt_rad * 180 / M_PI) + " deg)");
   }
   out.mount = WithCorrection(nominal, s.x);
   out.correction_rpy_rad = s.x;

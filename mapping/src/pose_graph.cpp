@@ -15,6 +15,8 @@
 #include "chi_square.hpp"
 #include "relative_pose_cost.hpp"
 
+#include "pitchlab/sensors/number_text.hpp"
+
 namespace pitchlab::mapping {
 
 namespace {
@@ -68,7 +70,7 @@ Result<Matrix6d> SqrtInformation(const Matrix6d& information, const std::string&
   if (!(eigen.eigenvalues()(0) > 1e-12 * eigen.eigenvalues()(5))) {
     return Fail(Error::Code::kInvalidArgument,
                 what + ": information is not positive definite (smallest eigenvalue " +
-                    std::to_string(eigen.eigenvalues()(0)) +
+                    NumberText(eigen.eigenvalues()(0)) +
                     "): a direction the registration left free; pass the inverse of its "
                     "covariance, which bounds that direction by its guess");
   }
@@ -95,11 +97,11 @@ const char* ToString(EdgeKind kind) {
 void PoseGraphConfig::Validate() const {
   if (!(std::isfinite(loop_kernel_chi2) && loop_kernel_chi2 > 0)) {
     throw std::invalid_argument("pose_graph.loop_kernel_chi2 = " +
-                                std::to_string(loop_kernel_chi2) + ": must be finite and > 0");
+                                NumberText(loop_kernel_chi2) + ": must be finite and > 0");
   }
   if (!(loop_acceptance_probability > 0 && loop_acceptance_probability < 1)) {
     throw std::invalid_argument(
-        "pose_graph.loop_acceptance_probability = " + std::to_string(loop_acceptance_probability) +
+        "pose_graph.loop_acceptance_probability = " + NumberText(loop_acceptance_probability) +
         ": must lie in (0, 1)");
   }
   if (max_iterations < 1) {
@@ -374,9 +376,9 @@ Result<void> CheckQuery(const LoopCandidateQuery& query) {
     return {};
   }
   return Fail(Error::Code::kInvalidArgument,
-              "loop candidates: max_distance_m = " + std::to_string(query.max_distance_m) +
-                  " (finite, > 0), probability = " + std::to_string(query.probability) +
-                  " (in (0, 1)), min_travel_m = " + std::to_string(query.min_travel_m) +
+              "loop candidates: max_distance_m = " + NumberText(query.max_distance_m) +
+                  " (finite, > 0), probability = " + NumberText(query.probability) +
+                  " (in (0, 1)), min_travel_m = " + NumberText(query.min_travel_m) +
                   " (finite, >= 0)");
 }
 

@@ -15,6 +15,8 @@
 #include "seen_space.hpp"
 #include "target_memo.hpp"
 
+#include "pitchlab/sensors/number_text.hpp"
+
 namespace pitchlab::mapping {
 namespace {
 constexpr double kPi = 3.14159265358979323846;
@@ -1079,7 +1081,7 @@ Result<void> CheckEnoughPoints(const Prepared& prep, const RegistrationConfig& c
     if (cloud->size() < kMinPoints) {
       return Fail(Error::Code::kInvalidArgument,
                   std::string(name) + " cloud has " + std::to_string(cloud->size()) +
-                      " points after the " + std::to_string(config.icp_voxel_m) +
+                      " points after the " + NumberText(config.icp_voxel_m) +
                       " m voxel grid; registration needs at least " + std::to_string(kMinPoints));
     }
   }

@@ -5,12 +5,14 @@
 
 #include "voxel_hash.hpp"
 
+#include "pitchlab/sensors/number_text.hpp"
+
 namespace pitchlab::mapping {
 
 ScanVoxelMap::ScanVoxelMap(double voxel_m, bool keep_scans)
     : voxel_m_(voxel_m), keep_scans_(keep_scans) {
   if (!(voxel_m > 0)) {
-    throw std::invalid_argument("scan voxel map: voxel_m = " + std::to_string(voxel_m) +
+    throw std::invalid_argument("scan voxel map: voxel_m = " + NumberText(voxel_m) +
                                 ": must be > 0");
   }
 }

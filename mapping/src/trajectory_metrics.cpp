@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include "pitchlab/mapping/registration.hpp"
+#include "pitchlab/sensors/number_text.hpp"
 
 namespace pitchlab::mapping {
 
@@ -109,7 +110,7 @@ Result<RelativePoseError> RelativePoseErrorPerMetre(const Poses& estimate, const
   if (auto ok = CheckPair(estimate, truth, 2, "RPE"); !ok) return tl::make_unexpected(ok.error());
   if (!(std::isfinite(segment_m) && segment_m > 0)) {
     return Fail(Error::Code::kInvalidArgument,
-                "RPE per metre: segment_m = " + std::to_string(segment_m) + ": must be > 0");
+                "RPE per metre: segment_m = " + NumberText(segment_m) + ": must be > 0");
   }
   std::vector<double> path_m(truth.size(), 0.0);  // true path length from stop 0
   for (std::size_t i = 1; i < truth.size(); ++i) {
@@ -127,8 +128,8 @@ Result<RelativePoseError> RelativePoseErrorPerMetre(const Poses& estimate, const
   }
   if (acc.count == 0) {
     return Fail(Error::Code::kInvalidArgument,
-                "RPE per metre: the true path (" + std::to_string(path_m.back()) +
-                    " m) is shorter than one segment (" + std::to_string(segment_m) + " m)");
+                "RPE per metre: the true path (" + NumberText(path_m.back()) +
+                    " m) is shorter than one segment (" + NumberText(segment_m) + " m)");
   }
   return acc.Relative();
 }

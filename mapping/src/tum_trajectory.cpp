@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "pitchlab/mapping/atomic_file.hpp"
+#include "pitchlab/sensors/number_text.hpp"
 
 namespace pitchlab::mapping {
 
@@ -86,7 +87,7 @@ Result<StampedPose> ParseLine(const std::vector<std::string>& fields, const std:
   Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);  // w, x, y, z
   if (std::abs(q.norm() - 1) > kQuaternionNormTolerance) {
     return Fail(Error::Code::kInvalidArgument,
-                where + ": quaternion norm " + std::to_string(q.norm()) + " is not 1");
+                where + ": quaternion norm " + NumberText(q.norm()) + " is not 1");
   }
   StampedPose p;
   p.stamp_s = v[0];

@@ -14,6 +14,7 @@
 #include "pitchlab/hw/stop_request.hpp"
 #include "pitchlab/mission/run_folder.hpp"
 #include "pitchlab/mission/sim_mission.hpp"
+#include "pitchlab/sensors/number_text.hpp"
 #include "pitchlab/worlds/world_metadata.hpp"
 
 namespace pitchlab::mission {
@@ -260,11 +261,11 @@ HwMissionFrame FrameHwMission(const HwMissionSpec& spec) {
   for (const auto& [name, p] :
        {std::pair{"start", Eigen::Vector2d(spec.start.head<2>())}, std::pair{"goal", f.goal}}) {
     if (p.x() < a.x_min_m || p.x() > a.x_max_m() || p.y() < a.y_min_m || p.y() > a.y_max_m()) {
-      throw std::runtime_error(std::string(name) + " (" + std::to_string(p.x()) + ", " +
-                               std::to_string(p.y()) + ") is off the map: it spans x " +
-                               std::to_string(a.x_min_m) + " .. " + std::to_string(a.x_max_m()) +
-                               ", y " + std::to_string(a.y_min_m) + " .. " +
-                               std::to_string(a.y_max_m()));
+      throw std::runtime_error(std::string(name) + " (" + NumberText(p.x()) + ", " +
+                               NumberText(p.y()) + ") is off the map: it spans x " +
+                               NumberText(a.x_min_m) + " .. " + NumberText(a.x_max_m()) +
+                               ", y " + NumberText(a.y_min_m) + " .. " +
+                               NumberText(a.y_max_m()));
     }
   }
   return f;

@@ -13,6 +13,7 @@
 #include "pitchlab/mapping/point_cloud.hpp"
 #include "pitchlab/mission/elevation_scan.hpp"
 #include "pitchlab/mission/slope_guard.hpp"
+#include "pitchlab/sensors/number_text.hpp"
 
 #include "drive_length.hpp"
 #include "line_gaps.hpp"
@@ -375,7 +376,7 @@ bool Mission::OverBudget() {
     return true;
   }
   if (probes_.now_s() - result_.start_s <= config_.time_budget_s) return false;
-  result_.reason = "time budget of " + std::to_string(config_.time_budget_s) + " s spent";
+  result_.reason = "time budget of " + NumberText(config_.time_budget_s) + " s spent";
   return true;
 }
 
@@ -878,7 +879,7 @@ bool Mission::TurnTo(double yaw_rad) {
       closest_rad = std::abs(error);
       progress_s = probes_.now_s();
     } else if (probes_.now_s() - progress_s > config_.stuck_timeout_s) {
-      result_.reason = "stuck: cannot turn to " + std::to_string(yaw_rad * 180 / kPi) + " deg";
+      result_.reason = "stuck: cannot turn to " + NumberText(yaw_rad * 180 / kPi) + " deg";
       return false;
     }
     const double omega = std::clamp(kTurnGain_per_s * error, -rate, rate);
@@ -905,7 +906,7 @@ bool Mission::RecordSample(const sensors::Odometry& odo) {
   const double tilt = Tilt();
   result_.max_tilt_rad = std::max(result_.max_tilt_rad, tilt);
   if (tilt <= config_.max_tilt_deg * kPi / 180) return true;
-  result_.reason = "tipping over: tilt " + std::to_string(tilt * 180 / kPi) + " deg";
+  result_.reason = "tipping over: tilt " + NumberText(tilt * 180 / kPi) + " deg";
   return false;
 }
 
@@ -971,7 +972,7 @@ bool Mission::Follow(const planning::Path& path, double length_m) {
       progress_yaw = odo.yaw_rad;
       progress_s = probes_.now_s();
     } else if (probes_.now_s() - progress_s > config_.stuck_timeout_s) {
-      result_.reason = "stuck: no progress for " + std::to_string(config_.stuck_timeout_s) + " s";
+      result_.reason = "stuck: no progress for " + NumberText(config_.stuck_timeout_s) + " s";
       return false;
     }
   }

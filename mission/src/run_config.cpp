@@ -8,6 +8,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "pitchlab/sensors/number_text.hpp"
+
 namespace pitchlab::mission {
 namespace {
 
@@ -102,7 +104,7 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
       if (key == "map_size_m") {
         s.map_size_m = kv.second.as<double>();
         if (!(*s.map_size_m >= 2.0 && *s.map_size_m <= 2000.0)) {
-          throw std::invalid_argument("= " + std::to_string(*s.map_size_m) +
+          throw std::invalid_argument("= " + NumberText(*s.map_size_m) +
                                       " is outside 2 .. 2000 m");
         }
       } else if (key == "max_stops") {
@@ -134,7 +136,7 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
     }
   }
   if (!(s.cell_m >= 0.02 && s.cell_m <= 2.0)) {
-    throw std::invalid_argument(source + ": run.cell_m = " + std::to_string(s.cell_m) +
+    throw std::invalid_argument(source + ": run.cell_m = " + NumberText(s.cell_m) +
                                 " is outside 0.02 .. 2 m");
   }
   for (const auto& [name, value] : {std::pair{"odometry_error_m", m.odometry_error_m},
@@ -143,13 +145,13 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
                                     {"odometry_error_deg", m.odometry_error_deg},
                                     {"odometry_error_dps", m.odometry_error_dps}}) {
     if (!(value >= 0 && std::isfinite(value))) {
-      throw std::invalid_argument(source + ": run." + name + " = " + std::to_string(value) +
+      throw std::invalid_argument(source + ": run." + name + " = " + NumberText(value) +
                                   " must be finite and >= 0");
     }
   }
   if (!(m.tilt_tolerance_deg > 0 && m.tilt_tolerance_deg <= 90)) {
     throw std::invalid_argument(source + ": run.tilt_tolerance_deg = " +
-                                std::to_string(m.tilt_tolerance_deg) + " is outside (0, 90] deg");
+                                NumberText(m.tilt_tolerance_deg) + " is outside (0, 90] deg");
   }
   if (m.max_stops < 1 || !(m.drive_per_stop_m > 0) || !(m.goal_tolerance_m > 0) ||
       !(m.time_budget_s > 0) || !(m.control_period_s > 0)) {
@@ -209,12 +211,12 @@ RunSettings ParseRunSettings(const std::string& yaml_text, const std::string& so
                                 "slope_speed_mps > 0");
   }
   if (!(m.map_range_m > 1.0)) {
-    throw std::invalid_argument(source + ": run.map_range_m = " + std::to_string(m.map_range_m) +
+    throw std::invalid_argument(source + ": run.map_range_m = " + NumberText(m.map_range_m) +
                                 " must be > 1 m (the robot needs to see past its own footprint)");
   }
   if (!(s.inclination_radius_m >= 0 && s.inclination_radius_m <= 16 * s.cell_m)) {
     throw std::invalid_argument(
-        source + ": run.inclination_radius_m = " + std::to_string(s.inclination_radius_m) +
+        source + ": run.inclination_radius_m = " + NumberText(s.inclination_radius_m) +
         " is outside 0 .. 16 cells");
   }
   // The region reaches inclination_radius_m from the centre cell's centre to its outer edge.

@@ -20,6 +20,7 @@
 #include "pitchlab/mission/waypoint_route.hpp"
 #include "pitchlab/planning/planner.hpp"
 #include "pitchlab/planning/traversability.hpp"
+#include "pitchlab/sensors/number_text.hpp"
 #include "pitchlab/sensors/stopwatch.hpp"
 #include "pitchlab/sim/sim_rig.hpp"
 
@@ -39,10 +40,10 @@ constexpr std::uint64_t kAttitudeSeedSalt = 0x6174746974756465;  // "attitude": 
 
 void CheckOnMap(const std::string& what, const Eigen::Vector2d& p, const worlds::Bounds2d& b) {
   if (p.x() < b.x_min_m || p.x() > b.x_max_m || p.y() < b.y_min_m || p.y() > b.y_max_m) {
-    throw std::runtime_error(what + " (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) +
-                             ") is off the map: the world spans x " + std::to_string(b.x_min_m) +
-                             " .. " + std::to_string(b.x_max_m) + ", y " +
-                             std::to_string(b.y_min_m) + " .. " + std::to_string(b.y_max_m));
+    throw std::runtime_error(what + " (" + NumberText(p.x()) + ", " + NumberText(p.y()) +
+                             ") is off the map: the world spans x " + NumberText(b.x_min_m) +
+                             " .. " + NumberText(b.x_max_m) + ", y " +
+                             NumberText(b.y_min_m) + " .. " + NumberText(b.y_max_m));
   }
 }
 

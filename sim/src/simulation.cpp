@@ -19,6 +19,8 @@
 #include "robot_layout.hpp"
 #include "simulation_impl.hpp"
 
+#include "pitchlab/sensors/number_text.hpp"
+
 namespace pitchlab::sim {
 namespace {
 
@@ -258,10 +260,10 @@ Simulation::Simulation(const std::string& world_xml, const std::string& base_dir
   const double courant = robot_.pitch_servo.kv_nms_per_rad * timestep_s() / inertia;
   if (courant > 1.5) {
     throw std::runtime_error("world " + source + ": <option timestep=\"" +
-                             std::to_string(timestep_s()) +
+                             NumberText(timestep_s()) +
                              "\"> is too long for robot.pitch_servo.kv = " +
-                             std::to_string(robot_.pitch_servo.kv_nms_per_rad) +
-                             " (kv * timestep / inertia = " + std::to_string(courant) + " > 1.5)");
+                             NumberText(robot_.pitch_servo.kv_nms_per_rad) +
+                             " (kv * timestep / inertia = " + NumberText(courant) + " > 1.5)");
   }
   // MuJoCo's default step, 2 ms, is the world's unless it chose its own; while the laser is
   // locked the robot's own drive step applies (P3Params::locked_timestep_s says why).

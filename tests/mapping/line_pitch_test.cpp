@@ -95,6 +95,36 @@ TEST(LinePitch, LinesOffByAWobbleAndAJumpLieOnOneFloorAgain) {
   EXPECT_GT(r.floor_rms_before_m, 0.01);
 }
 
+// Each corrected line is reported at its recorded pitch with the turn it got: from line to line
+// the turns follow the error the lines were cast with. (Not line by line: a turn common to all
+// lines, and one falling as 1 / distance ahead, are the floor plane's, and are left to it.)
+TEST(LinePitch, ReportsEachLinesRecordedPitchAndTurn) {
+  std::vector<Eigen::Vector3f> scan = NoddingScan(Wobble, 0.003, 1);
+  const LinePitch r = RectifyLinePitch(scan, Eigen::Vector3f::Zero());
+  ASSERT_EQ(r.line_corrections.size(), r.corrected);
+  double off_sq = 0, step_sq = 0;
+  int steps = 0;
+  for (std::size_t k = 0; k < r.line_corrections.size(); ++k) {
+    const LineCorrection& c = r.line_corrections[k];
+    // Recorded every 0.5 deg from 30 deg up: line (pitch + 30 deg) / 0.5 deg, to float rounding.
+    const double line = (c.pitch_rad / kDeg + 30) / 0.5;
+    EXPECT_NEAR(line, std::round(line), 1e-3);
+    if (k == 0) continue;
+    const LineCorrection& b = r.line_corrections[k - 1];
+    const int l = static_cast<int>(std::round(line));
+    ASSERT_GT(c.pitch_rad, b.pitch_rad);  // by pitch
+    if (std::round((b.pitch_rad / kDeg + 30) / 0.5) != l - 1) continue;  // neighbours only
+    // A line cast lower than recorded (a positive error) is turned down by as much.
+    const double error_step = Wobble(l) - Wobble(l - 1);
+    off_sq += std::pow((c.correction_rad - b.correction_rad) - error_step, 2);
+    step_sq += error_step * error_step;
+    ++steps;
+  }
+  ASSERT_GT(steps, 50);
+  EXPECT_GT(std::sqrt(step_sq / steps), 0.4 * kDeg);   // the wobble's steps, and the jump
+  EXPECT_LT(std::sqrt(off_sq / steps), 0.05 * kDeg);  // followed to a tenth of that
+}
+
 TEST(LinePitch, LinesAtTheirRecordedPitchStayWhereTheyAre) {
   const std::vector<Eigen::Vector3f> truth = NoddingScan([](int) { return 0.0; }, 0.003, 2);
   std::vector<Eigen::Vector3f> scan = truth;

@@ -89,6 +89,9 @@ TEST(GroundLevel, TooFewPointsNearTheSensorIsAnErrorNamingTheCount) {
   const Result<GroundLevel> level = FitGroundLevel(few, Eigen::Vector3f::Zero());
   ASSERT_FALSE(level.has_value());
   EXPECT_NE(level.error().message.find("3 cells"), std::string::npos) << level.error().message;
+  // The band as people write it (NumberText), not as "0.500000..4.000000 m".
+  EXPECT_NE(level.error().message.find("within 0.5..4 m of it"), std::string::npos)
+      << level.error().message;
 }
 
 // The levelled scan in a map around the sensor, the band and the underside rule as given.

@@ -45,6 +45,14 @@ struct LinePitchConfig {
   GroundLevelConfig ground;
 };
 
+/// One line turned onto the floor: the pitch it was recorded at (its points' median elevation
+/// below the pitch axis, down positive) and the turn applied (positive: the line lay lower than
+/// recorded) [rad].
+struct LineCorrection {
+  double pitch_rad = 0;
+  double correction_rad = 0;
+};
+
 /// What RectifyLinePitch found and did.
 struct LinePitch {
   bool nodding = false;          ///< the points fell into lines of one elevation each
@@ -55,6 +63,9 @@ struct LinePitch {
   double floor_rms_before_m = 0;  ///< the floor points' RMS distance from the floor plane [m]
   double floor_rms_after_m = 0;   ///< the same after the correction [m]
   std::string note;               ///< why nothing was corrected, when nothing was
+  /// Each corrected line, by recorded pitch: the servo's error profile as the floor measured it
+  /// (whether it repeats from scan to scan says whether a table could correct it; real_eval).
+  std::vector<LineCorrection> line_corrections;
 };
 
 /// Sets each line of a nodding scan right by the floor it crossed. `points_m` are in the scan's

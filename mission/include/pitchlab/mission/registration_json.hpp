@@ -2,6 +2,8 @@
 // How a registration's stage timings appear in the JSON the apps write (register --json, each
 // run stop's registration.json), in one place so the two read alike.
 
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 
 #include "pitchlab/mapping/line_pitch.hpp"
@@ -49,6 +51,13 @@ inline nlohmann::json LinePitchJson(const mapping::LinePitch& r) {
                       {"floor_rms_before_m", r.floor_rms_before_m},
                       {"floor_rms_after_m", r.floor_rms_after_m}};
   if (!r.note.empty()) j["note"] = r.note;
+  // Each corrected line's recorded pitch and turn, to the 0.001 deg: the servo's error profile.
+  nlohmann::json lines = nlohmann::json::array();
+  const auto deg = [&](double rad) { return std::round(rad * kToDeg * 1000) / 1000; };
+  for (const mapping::LineCorrection& c : r.line_corrections) {
+    lines.push_back({deg(c.pitch_rad), deg(c.correction_rad)});
+  }
+  j["pitch_and_correction_deg"] = lines;
   return j;
 }
 

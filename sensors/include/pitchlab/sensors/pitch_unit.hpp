@@ -17,8 +17,9 @@ struct PitchUnitConfig {
   // period line_pitch_error_period_deg plus steps that change every period (a gear's tooth, a
   // coupling's play), each half the variance, RMS line_pitch_error_deg. The real 3DTK rig's
   // lines are off their floor by 0.9 / 1.0 deg RMS (two scans), a wobble of ~8 lines (4.2 deg at
-  // its 0.52 deg lines) with jumps of 2-3 deg between neighbouring lines, at the same pitches in
-  // both scans (mapping/README.md, "Line pitch"); steps of RMS 0.9 deg / sqrt(2) give jumps of
+  // its 0.52 deg lines) with jumps of 2-3 deg between neighbouring lines, at about the same
+  // pitches in both scans (mapping/README.md, "Line pitch"; line for line the two correlate only
+  // 0.6: the real jumps move by a few degrees from scan to scan, these do not); steps of RMS 0.9 deg / sqrt(2) give jumps of
   // RMS 0.9 deg, 2.7 deg at 3 sigma. 0 (the default) is a unit that reports its true pitch, as
   // every simulated figure so far assumed.
   double line_pitch_error_deg = 0.0;         ///< RMS of the reported pitch's error [deg]
