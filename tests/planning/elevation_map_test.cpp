@@ -1,17 +1,12 @@
 // Elevation map (Eq. 2, 3, inclination) on hand-built clouds with known answers.
 
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <mujoco/mujoco.h>
 #include <GeographicLib/LocalCartesian.hpp>
 #include <GeographicLib/TransverseMercator.hpp>
 #include <cerrno>
 #include <cmath>
-#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -24,6 +19,7 @@
 #include "pitchlab/mapping/elevation_map.hpp"
 #include "pitchlab/mapping/elevation_truth.hpp"
 #include "pitchlab/sensors/ray_caster.hpp"
+#include "file_size_limit.hpp"
 #include "scoped_temp_dir.hpp"
 
 namespace pitchlab::mapping {
@@ -572,8 +568,8 @@ TEST(ElevationMapIo, PngShowsUnknownAndDropsDistinctly) {
   EXPECT_EQ(std::string(sig + 1, 3), "PNG");
 }
 
-// A full disk, as a file-size limit makes it portably (in a child: the limit and the ignored
-// SIGXFSZ stay there): each writer says why, names the file and leaves nothing behind.
+// A full disk, as a file-size limit makes it (file_size_limit.hpp): each writer says why, names
+// the file and leaves nothing behind.
 TEST(ElevationMapIo, AFullDiskIsAnErrorWithItsReasonAndLeavesNothing) {
   const ScopedTempDir dir("elev_full");
   RgbImage img;
@@ -582,25 +578,17 @@ TEST(ElevationMapIo, AFullDiskIsAnErrorWithItsReasonAndLeavesNothing) {
   std::mt19937 rng(1);  // noise: deflate cannot shrink it under the limit
   for (std::uint8_t& b : img.rgb) b = static_cast<std::uint8_t>(rng());
   const std::string png = (dir / "m.png").string(), bytes = (dir / "m.bin").string();
-  const pid_t pid = ::fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    std::signal(SIGXFSZ, SIG_IGN);  // the write then fails with EFBIG instead of killing us
-    const rlimit limit{16 * 1024, 16 * 1024};
-    ::setrlimit(RLIMIT_FSIZE, &limit);
+  const int failed = test_support::InChildWithFileSizeLimit(16 * 1024, [&] {
     const auto says = [](const Result<void>& r, const std::string& path) {
       return !r && r.error().message == path + ": cannot write: " + std::strerror(EFBIG);
     };
     const bool png_ok = says(WritePng(img, png), png);
     const bool bytes_ok = says(WriteFileAtomically(bytes, std::string(64 * 1024, 'x')), bytes);
-    ::_exit((png_ok ? 0 : 1) | (bytes_ok ? 0 : 2));
-  }
-  int status = 0;
-  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status) & 1, 0) << "WritePng: no error '<path>: cannot write: File too large'";
-  EXPECT_EQ(WEXITSTATUS(status) & 2, 0)
-      << "WriteFileAtomically: no error '<path>: cannot write: File too large'";
+    return (png_ok ? 0 : 1) | (bytes_ok ? 0 : 2);
+  });
+  ASSERT_GE(failed, 0) << "the child did not exit";
+  EXPECT_EQ(failed & 1, 0) << "WritePng: no error '<path>: cannot write: File too large'";
+  EXPECT_EQ(failed & 2, 0) << "WriteFileAtomically: no error '<path>: cannot write: File too large'";
   EXPECT_TRUE(std::filesystem::is_empty(dir.path())) << "a partial or temporary file was left";
 }
 

@@ -1,11 +1,6 @@
 // Bad PCD input and a full disk: each case is an error naming the file, never a crash, a
 // 20-second allocation, or a file left behind (issue 18).
 
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -17,6 +12,7 @@
 
 #include "pitchlab/sensors/cloud_file.hpp"
 #include "pitchlab/sensors/scan_pcd.hpp"
+#include "file_size_limit.hpp"
 #include "scoped_temp_dir.hpp"
 
 namespace pitchlab::sensors {
@@ -170,22 +166,14 @@ TEST_F(PcdRobustness, AFullDiskIsAnErrorWithItsReasonAndLeavesNothing) {
   Scan3D scan;
   scan.points.resize(20000);  // 560 kB of records
   const fs::path file = dir_ / "scan.pcd";
-  const pid_t pid = ::fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    std::signal(SIGXFSZ, SIG_IGN);  // the write then fails with EFBIG instead of killing us
-    const rlimit limit{64 * 1024, 64 * 1024};
-    ::setrlimit(RLIMIT_FSIZE, &limit);
+  const int names_it = test_support::InChildWithFileSizeLimit(64 * 1024, [&] {
     const Result<void> written = WriteScanPcd(scan, file.string());
-    const bool names_it = !written && written.error().message.find(file.string()) !=
-                                          std::string::npos &&
-                          written.error().message.find(std::strerror(EFBIG)) != std::string::npos;
-    ::_exit(names_it ? 0 : 1);
-  }
-  int status = 0;
-  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 0) << "no error naming the path and 'File too large'";
+    return !written && written.error().message.find(file.string()) != std::string::npos &&
+                   written.error().message.find(std::strerror(EFBIG)) != std::string::npos
+               ? 0
+               : 1;
+  });
+  EXPECT_EQ(names_it, 0) << "no error naming the path and 'File too large'";
   EXPECT_TRUE(fs::is_empty(dir_.path())) << "a partial or temporary file was left behind";
 }
 
