@@ -79,6 +79,10 @@ CliArgs PlanArgs() {
       "  MAP.asc    a DEM, ESRI ASCII grid, with its MAP.prj when georeferenced (longitude/\n"
       "             latitude, UTM or another Transverse Mercator; none: local metres); a\n"
       "             georeferenced grid is resampled onto square metres at its centre\n"
+      "  MAP.tif    a DEM as a GeoTIFF (also .tiff, SRTM .hgt, .img, .vrt: any raster\n"
+      "             GDAL reads), one band of heights in metres or feet, north-up square\n"
+      "             cells, georeferenced by the coordinate system it carries as an .asc is\n"
+      "             by its .prj\n"
       "  MAP.yaml   a ROS map_server occupancy grid (PGM image; trinary, scale or raw):\n"
       "             occupied cells are obstacles, grey levels costs, unknown cells unknown\n"
       "--start and --goal are in the map's own coordinates: the map frame of a .plem, the\n"
@@ -90,7 +94,7 @@ CliArgs PlanArgs() {
       "robot's inclination), not as a step, and a warning says what the map cannot show.\n"
       "\n" +
           PlannerDefaults());
-  args.Positionals("MAP", "map file: .plem, .asc or .yaml (see above)", 1, 1)
+  args.Positionals("MAP", "map file: .plem, .asc, .tif (or another raster) or .yaml (see above)", 1, 1)
       .Option("start", "x,y", "start in the map's own coordinates (see above)")
       .Option("goal", "x,y", "goal in the map's own coordinates")
       .Option("robot", "p3at|p3dx",

@@ -40,10 +40,19 @@ PlanInput FromElevationMap(const mapping::ElevationMap& map, const planning::Pla
   return in;
 }
 
+// The raster formats a DEM commonly comes in, read through GDAL: GeoTIFF (SRTM, Copernicus,
+// USGS 3DEP, most national DEMs), SRTM's raw .hgt, ERDAS .img, GDAL's own .vrt.
+bool IsRasterDem(const std::string& ext) {
+  return ext == ".tif" || ext == ".tiff" || ext == ".hgt" || ext == ".img" || ext == ".vrt";
+}
+
 PlanInput FromDem(const std::string& path, const planning::PlannerConfig& c) {
   auto dem = std::make_shared<mapping::Dem>(OrThrow(mapping::LoadDem(path)));
   PlanInput in = FromElevationMap(dem->map, c);
-  in.about = {{"kind", "DEM (ESRI ASCII grid)"},       {"crs", dem->crs.name},
+  const bool esri = std::filesystem::path(path).extension() == ".asc" ||
+                    std::filesystem::path(path).extension() == ".ASC";
+  in.about = {{"kind", esri ? "DEM (ESRI ASCII grid)" : "DEM (raster, read by GDAL)"},
+              {"crs", dem->crs.name},
               {"coordinates", CrsKind(dem->crs.kind)}, {"file_cell", dem->grid.cell_size},
               {"nodata_cells", dem->nodata_cells},     {"resampled", dem->resampled}};
   if (dem->resampled) {
@@ -77,14 +86,15 @@ PlanInput LoadPlanInput(const std::string& path, const planning::PlannerConfig& 
   if (ext == ".plem") {
     in = FromElevationMap(OrThrow(mapping::LoadElevationMap(path)), config);
     in.about = {{"kind", "pitchlab elevation map"}, {"map_frame", "the map's own [m]"}};
-  } else if (ext == ".asc") {
+  } else if (ext == ".asc" || IsRasterDem(ext)) {
     in = FromDem(path, config);
   } else if (ext == ".yaml" || ext == ".yml") {
     in = FromOccupancyGrid(path, config);
   } else {
     throw CliError("MAP '" + path +
-                   "' must be a .plem (pitchlab map), an .asc (ESRI ASCII "
-                   "grid, with its .prj) or a .yaml (map_server occupancy grid)");
+                   "' must be a .plem (pitchlab map), an .asc (ESRI ASCII grid, with its .prj), "
+                   "a raster DEM (.tif, .tiff, .hgt, .img, .vrt) or a .yaml (map_server "
+                   "occupancy grid)");
   }
   in.about["file"] = path;
   in.about["cell_m"] = in.grid.geometry.cell_m;

@@ -1,5 +1,6 @@
-// A DEM (ESRI ASCII grid + .prj) as an ElevationMap (dem_io.hpp): placed exactly when its frame
-// is local metres, else resampled onto a local east-north-up grid at its centre.
+// A DEM (ESRI ASCII grid + .prj, or a raster GDAL reads) as an ElevationMap (dem_io.hpp): placed
+// exactly when its frame is local metres, else resampled onto a local east-north-up grid at its
+// centre.
 
 #include <GeographicLib/LocalCartesian.hpp>
 #include <GeographicLib/TransverseMercator.hpp>
@@ -14,6 +15,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "gdal_raster_reader.hpp"
 #include "pitchlab/mapping/dem_io.hpp"
 #include "pitchlab/sensors/number_text.hpp"
 
@@ -185,27 +187,60 @@ Result<DemCrs> ReadCrs(const std::string& asc_path) {
   return ParsePrj(text.str(), prj);
 }
 
+bool IsEsriAsciiGrid(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".asc";
+}
+
+// The grid and its coordinate system: an ESRI grid by our own reader and its `.prj`, any other
+// raster through GDAL with the coordinate system it carries.
+Result<Dem> ReadGridAndCrs(const std::string& path) {
+  Dem dem;
+  if (IsEsriAsciiGrid(path)) {
+    Result<AsciiGrid> grid = ReadAsciiGrid(path);
+    if (!grid) return tl::make_unexpected(grid.error());
+    Result<DemCrs> crs = ReadCrs(path);
+    if (!crs) return tl::make_unexpected(crs.error());
+    dem.grid = std::move(*grid);
+    dem.crs = *crs;
+    return dem;
+  }
+  Result<internal::RasterDem> raster = internal::ReadGdalRaster(path);
+  if (!raster) return tl::make_unexpected(raster.error());
+  dem.grid = std::move(raster->grid);
+  if (raster->esri_wkt.empty()) {
+    dem.crs.name = "no coordinate system";
+  } else {
+    Result<DemCrs> crs = ParsePrj(raster->esri_wkt, path);
+    if (!crs) return tl::make_unexpected(crs.error());
+    dem.crs = *crs;
+  }
+  return dem;
+}
+
 }  // namespace
 
-Result<Dem> LoadDem(const std::string& asc_path) {
-  Dem dem;
-  Result<AsciiGrid> grid = ReadAsciiGrid(asc_path);
-  if (!grid) return tl::make_unexpected(grid.error());
-  Result<DemCrs> crs = ReadCrs(asc_path);
-  if (!crs) return tl::make_unexpected(crs.error());
-  dem.grid = std::move(*grid);
-  dem.crs = *crs;
+Result<Dem> LoadDem(const std::string& path) {
+  Result<Dem> read = ReadGridAndCrs(path);
+  if (!read) return read;
+  Dem dem = std::move(*read);
   const AsciiGrid& g = dem.grid;
   const auto bad = [&](const std::string& why) {
-    return Fail(Error::Code::kInvalidArgument, asc_path + ": " + why);
+    return Fail(Error::Code::kInvalidArgument, path + ": " + why);
   };
   // A hundredth of a unit is a 1 cm cell in metres, 1.1 km in degrees: a grid that fine with
   // corners within longitude/latitude range is in degrees, whatever the missing .prj would say.
-  if (dem.crs.name == "no .prj" && g.cell_size < 0.01 && std::abs(g.xll_corner) <= 360 &&
-      std::abs(g.yll_corner) <= 90)
-    return bad("cell size " + NumberText(g.cell_size) +
-               " looks like degrees, but no .prj "
-               "says so: put the grid's .prj beside it (GEOGCS for longitude/latitude)");
+  const bool no_crs = dem.crs.name == "no .prj" || dem.crs.name == "no coordinate system";
+  if (no_crs && g.cell_size < 0.01 && std::abs(g.xll_corner) <= 360 &&
+      std::abs(g.yll_corner) <= 90) {
+    return bad("cell size " + NumberText(g.cell_size) + " looks like degrees, but " +
+               (dem.crs.name == "no .prj"
+                    ? "no .prj says so: put the grid's .prj beside it (GEOGCS for "
+                      "longitude/latitude)"
+                    : "the file gives no coordinate system: set one (`gdal_edit.py -a_srs "
+                      "EPSG:4326` for longitude/latitude)"));
+  }
   if (dem.crs.kind == Kind::kGeographic &&
       !(std::abs(g.yll_corner) <= 90 && std::abs(g.yll_corner + g.nrows * g.cell_size) <= 90 &&
         std::abs(g.xll_corner) <= 360 && std::abs(g.xll_corner + g.ncols * g.cell_size) <= 360))

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <string>
 
+#include <gdal.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -56,6 +57,50 @@ TEST(UserMapsCli, PlansOnARealGeographicDemAndWritesWgs84GeoJson) {
     EXPECT_GE(c[2].get<double>(), 1690 - 1e-3);
     EXPECT_LE(c[2].get<double>(), 1807 + 1e-3);
   }
+}
+
+// The same DEM as a GeoTIFF (GDAL's copy of the .asc and its .prj): the same plan, in the same
+// longitude/latitude, the input said to be a raster GDAL read.
+TEST(UserMapsCli, PlansOnAGeoTiffAsOnTheSameGridAsAsc) {
+  const ScopedTempDir dir("user_maps");
+  GDALAllRegister();
+  GDALDatasetH in = GDALOpen((kDemDir + "west_bijou_escarpment_snippet.asc").c_str(), GA_ReadOnly);
+  ASSERT_NE(in, nullptr);
+  const std::string tif = (dir / "bijou.tif").string();
+  GDALDatasetH copy =
+      GDALCreateCopy(GDALGetDriverByName("GTiff"), tif.c_str(), in, FALSE, nullptr, nullptr, nullptr);
+  ASSERT_NE(copy, nullptr);
+  GDALClose(copy);
+  GDALClose(in);
+  const std::string points = " --start -104.3380,39.5110 --goal -104.3180,39.5110 --json --out ";
+  const CliResult from_tif =
+      cli_test::RunPitchlab("plan " + tif + points + (dir / "t").string(), dir.path());
+  const CliResult from_asc = cli_test::RunPitchlab(
+      "plan " + kDemDir + "west_bijou_escarpment_snippet.asc" + points + (dir / "a").string(),
+      dir.path());
+  ASSERT_EQ(from_tif.exit_code, 0) << from_tif.err;
+  ASSERT_EQ(from_asc.exit_code, 0) << from_asc.err;
+  const nlohmann::json t = nlohmann::json::parse(from_tif.out);
+  const nlohmann::json a = nlohmann::json::parse(from_asc.out);
+  EXPECT_EQ(t["input"]["kind"], "DEM (raster, read by GDAL)");
+  EXPECT_EQ(t["input"]["coordinates"], "longitude/latitude [deg]");
+  EXPECT_TRUE(t["found"].get<bool>());
+  EXPECT_NEAR(t["length_m"].get<double>(), a["length_m"].get<double>(), 1e-6);
+  EXPECT_EQ(Slurp(dir / "t" / "path.csv"), Slurp(dir / "a" / "path.csv"));
+}
+
+// A file that is no raster, under a raster's name: exit 1 naming it, no output folder.
+TEST(UserMapsCli, ATifThatIsNoRasterIsRefusedNamingIt) {
+  const ScopedTempDir dir("user_maps");
+  std::ofstream(dir / "notes.tif") << "not a raster\n";
+  const CliResult r = cli_test::RunPitchlab("plan " + (dir / "notes.tif").string() +
+                                                " --start 0,0 --goal 1,1 --out " + (dir / "p").string(),
+                                            dir.path());
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find((dir / "notes.tif").string() + ": cannot be read as a raster"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir / "p"));
 }
 
 TEST(UserMapsCli, PlansOnADemWithoutPrjInItsOwnMetres) {
@@ -117,7 +162,8 @@ TEST(UserMapsCli, BadUserMapsAreRefusedNamingFileAndLineWithNothingWritten) {
   std::ofstream(dir / "bad.asc") << "ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n"
                                     "1 2\n3 oops\n";
   std::ofstream(dir / "bad.yaml") << "image: m.pgm\nresolution: 0.1\nresolution: 0.2\n";
-  std::ofstream(dir / "map.tif") << "II*";
+  std::ofstream(dir / "map.tif") << "II*";  // a TIFF's byte order and nothing after it
+  std::ofstream(dir / "map.png") << "\x89PNG";
   const struct {
     std::string map, message;
     int exit_code;
@@ -125,7 +171,9 @@ TEST(UserMapsCli, BadUserMapsAreRefusedNamingFileAndLineWithNothingWritten) {
       {(dir / "bad.asc").string(), (dir / "bad.asc").string() + ":7: 'oops' is not a finite", 1},
       {(dir / "bad.yaml").string(), (dir / "bad.yaml").string() + ":3: 'resolution' is given twice",
        1},
-      {(dir / "map.tif").string(), "must be a .plem", 2},
+      {(dir / "map.tif").string(),
+       (dir / "map.tif").string() + ": cannot be read as a raster: Cannot read TIFF header", 1},
+      {(dir / "map.png").string(), "must be a .plem", 2},
   };
   for (const auto& c : cases) {
     const CliResult r = cli_test::RunPitchlab(

@@ -1,6 +1,7 @@
 #pragma once
-// Users' terrain: a digital elevation model (DEM) as an ESRI ASCII grid with its `.prj`, read
-// into an ElevationMap the planner takes like one built from scans.
+// Users' terrain: a digital elevation model (DEM), an ESRI ASCII grid with its `.prj` or a raster
+// GDAL reads (a GeoTIFF, with the coordinate system it carries), read into an ElevationMap the
+// planner takes like one built from scans.
 //
 // Frames. A grid without a `.prj`, or whose `.prj` is a LOCAL_CS, is metres in a local frame: the
 // map frame is the file's own x, y, every cell read exactly as written. A georeferenced grid
@@ -84,10 +85,15 @@ struct Dem {
   Eigen::Vector2d MapToFile(const Eigen::Vector2d& map_m) const;
 };
 
-/// Reads `asc_path` and the `.prj` beside it (same stem), if any, into a Dem (see the top of this
-/// file for frames). Fails (kInvalidArgument) as ReadAsciiGrid and ParsePrj, on a grid without
-/// a `.prj` whose cell size looks like degrees (below 0.01 with corners within lon/lat range),
-/// on a grid with no valid cell, or one too large for a map (more than 2^31 cells).
-[[nodiscard]] Result<Dem> LoadDem(const std::string& asc_path);
+/// Reads a DEM into a Dem (see the top of this file for frames): an `.asc` with the `.prj` beside
+/// it (same stem), if any; any other file as a raster through GDAL (GeoTIFF, SRTM .hgt, .img,
+/// .vrt, ...: band 1 of a single-band, north-up raster of square cells, heights in metres or
+/// feet), with the coordinate system it carries (none: local metres). Fails (kInvalidArgument;
+/// kNotFound for a file that cannot be opened) as ReadAsciiGrid and ParsePrj, on a raster GDAL
+/// cannot read or pitchlab cannot take (several bands, no geotransform, rotated or non-square
+/// cells, another height unit), on a grid without a coordinate system whose cell size looks like
+/// degrees (below 0.01 with corners within lon/lat range), on a grid with no valid cell, or one
+/// too large for a map (more than 2^31 cells).
+[[nodiscard]] Result<Dem> LoadDem(const std::string& path);
 
 }  // namespace pitchlab::mapping
