@@ -64,7 +64,7 @@ Result<AsciiGrid> GridFromHeader(const std::map<std::string, Field>& h, const st
   }
   g.ncols = static_cast<int>(h.at("ncols").value);
   g.nrows = static_cast<int>(h.at("nrows").value);
-  g.cell_size = h.at("cellsize").value;
+  g.cell_size = g.cell_size_y = h.at("cellsize").value;
   if (!(g.cell_size > 0))
     return bad(h.at("cellsize").line,
                "'cellsize' must be positive, not " + NumberText(g.cell_size));

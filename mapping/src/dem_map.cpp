@@ -76,7 +76,7 @@ class FileProjection {
 // Bilinear height at file coordinates (x, y): NaN outside the grid or next to a NODATA cell.
 double SampleBilinear(const AsciiGrid& g, double x, double y) {
   const double col = (x - g.xll_corner) / g.cell_size - 0.5;
-  const double row_south = (y - g.yll_corner) / g.cell_size - 0.5;  // 0 at the southern centres
+  const double row_south = (y - g.yll_corner) / g.cell_size_y - 0.5;  // 0 at the southern centres
   if (!(col >= -0.5 && col <= g.ncols - 0.5 && row_south >= -0.5 && row_south <= g.nrows - 0.5))
     return std::nan("");
   // Between the outer edge and the first centre the edge cell's value holds (clamped).
@@ -128,7 +128,7 @@ ElevationMap PlaceExactly(const AsciiGrid& g, const std::optional<GeodeticOrigin
 ElevationMap Resample(const AsciiGrid& g, const DemCrs& crs, double mean_height_m) {
   const FileProjection projection(crs);
   const double xc = g.xll_corner + 0.5 * g.ncols * g.cell_size;
-  const double yc = g.yll_corner + 0.5 * g.nrows * g.cell_size;
+  const double yc = g.yll_corner + 0.5 * g.nrows * g.cell_size_y;
   GeodeticOrigin origin;
   projection.ToGeodetic(xc, yc, &origin.latitude_deg, &origin.longitude_deg);
   origin.height_m = mean_height_m;
@@ -140,12 +140,12 @@ ElevationMap Resample(const AsciiGrid& g, const DemCrs& crs, double mean_height_
     return Eigen::Vector2d(e, n);
   };
   // Cell: the finer of the grid's two spacings at its centre, so no detail is lost either way.
-  const double h = 0.5 * g.cell_size;
-  const double cell_m = std::min((to_enu(xc + h, yc) - to_enu(xc - h, yc)).norm(),
-                                 (to_enu(xc, yc + h) - to_enu(xc, yc - h)).norm());
+  const double hx = 0.5 * g.cell_size, hy = 0.5 * g.cell_size_y;
+  const double cell_m = std::min((to_enu(xc + hx, yc) - to_enu(xc - hx, yc)).norm(),
+                                 (to_enu(xc, yc + hy) - to_enu(xc, yc - hy)).norm());
   // Extent: the grid's outline, 64 points an edge (a geographic grid's parallels curve in ENU).
   Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
-  const double w = g.ncols * g.cell_size, t = g.nrows * g.cell_size;
+  const double w = g.ncols * g.cell_size, t = g.nrows * g.cell_size_y;
   for (int k = 0; k <= 64; ++k) {
     const double f = k / 64.0;
     for (const Eigen::Vector2d& p : {to_enu(g.xll_corner + f * w, g.yll_corner),
@@ -242,7 +242,7 @@ Result<Dem> LoadDem(const std::string& path) {
                       "EPSG:4326` for longitude/latitude)"));
   }
   if (dem.crs.kind == Kind::kGeographic &&
-      !(std::abs(g.yll_corner) <= 90 && std::abs(g.yll_corner + g.nrows * g.cell_size) <= 90 &&
+      !(std::abs(g.yll_corner) <= 90 && std::abs(g.yll_corner + g.nrows * g.cell_size_y) <= 90 &&
         std::abs(g.xll_corner) <= 360 && std::abs(g.xll_corner + g.ncols * g.cell_size) <= 360))
     return bad(
         "its .prj says longitude/latitude, but the grid reaches beyond +-90 deg latitude "
@@ -251,6 +251,13 @@ Result<Dem> LoadDem(const std::string& path) {
   dem.nodata_cells = g.values.size() - valid;
   if (valid == 0) return bad("every cell is NODATA");
   try {
+    const bool square = std::abs(g.cell_size - g.cell_size_y) <= 1e-6 * g.cell_size;
+    if (!square && (dem.crs.kind == Kind::kLocal || IsLocalTransverseMercator(dem.crs))) {
+      // Placed cell for cell, a grid takes the map's square cells; a georeferenced one is
+      // resampled onto them, whatever its own.
+      return bad("its cells are " + NumberText(g.cell_size) + " by " + NumberText(g.cell_size_y) +
+                 " in a local frame: pitchlab places such a grid cell for cell on square cells");
+    }
     if (dem.crs.kind == Kind::kLocal) {
       dem.map = PlaceExactly(g, std::nullopt);
     } else if (IsLocalTransverseMercator(dem.crs)) {

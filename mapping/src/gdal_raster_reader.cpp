@@ -158,11 +158,8 @@ Result<RasterDem> ReadGdalRaster(const std::string& path) {
   }
   if (gt[2] != 0.0 || gt[4] != 0.0) return bad("its grid is rotated; pitchlab reads north-up grids");
   const double dx = gt[1], dy = std::abs(gt[5]);
-  // Square to a millionth: the cell size a file states in decimal degrees is rounded there.
-  if (!(dx > 0) || !(dy > 0) || std::abs(dx - dy) > 1e-6 * dx) {
-    return bad("its cells are " + NumberText(dx) + " by " + NumberText(dy) +
-               ": pitchlab reads square cells (`gdalwarp -tr " + NumberText(std::min(dx, dy)) +
-               " " + NumberText(std::min(dx, dy)) + " IN OUT` makes them)");
+  if (!(dx > 0) || !(dy > 0)) {
+    return bad("its cells are " + NumberText(dx) + " by " + NumberText(gt[5]) + ": not a grid");
   }
   const int nx = GDALGetRasterXSize(d), ny = GDALGetRasterYSize(d);
   Result<std::vector<double>> heights =
@@ -174,6 +171,8 @@ Result<RasterDem> ReadGdalRaster(const std::string& path) {
   g.ncols = nx;
   g.nrows = ny;
   g.cell_size = dx;
+  // Square to a millionth is square: a cell size in decimal degrees is rounded there.
+  g.cell_size_y = std::abs(dx - dy) <= 1e-6 * dx ? dx : dy;
   g.xll_corner = gt[0];
   g.yll_corner = gt[5] < 0 ? gt[3] + ny * gt[5] : gt[3];
   g.values = std::move(*heights);

@@ -11,8 +11,8 @@
 
 namespace pitchlab::mapping::internal {
 
-/// A raster DEM as read: the grid (rows north to south, square cells, heights in metres, NaN
-/// where there is no value) and its coordinate system.
+/// A raster DEM as read: the grid (rows north to south, heights in metres, NaN where there is no
+/// value) and its coordinate system.
 struct RasterDem {
   AsciiGrid grid;
   /// The raster's coordinate system as ESRI WKT1 (what a `.prj` holds); empty when it has none.
@@ -22,9 +22,8 @@ struct RasterDem {
 
 /// Reads band 1 of a single-band raster. Fails (kInvalidArgument; kNotFound when GDAL cannot open
 /// it) naming `path` and what is wrong: not a raster GDAL reads, more than one band (an image, not
-/// heights), no geotransform (nothing places the cells), a rotated or non-square grid (pitchlab
-/// reads north-up square cells: `gdalwarp -tr` makes them), heights in a unit other than metres
-/// or feet.
+/// heights), no geotransform (nothing places the cells), a rotated grid (pitchlab reads north-up
+/// grids), heights in a unit other than metres or feet.
 [[nodiscard]] Result<RasterDem> ReadGdalRaster(const std::string& path);
 
 }  // namespace pitchlab::mapping::internal

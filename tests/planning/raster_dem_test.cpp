@@ -199,6 +199,46 @@ TEST(RasterDem, FeetNoDataAndSouthUpRastersAreReadAsTheyMean) {
   ExpectSameMap(*feet, *south);
 }
 
+// Cells 1.5" by 1" (Copernicus' DEM beyond 50 deg latitude), heights linear in longitude and
+// latitude: bilinear sampling gives them back exactly wherever a map cell's centre falls, on
+// square map cells of the finer spacing (1" of latitude, 30.9 m).
+TEST(RasterDem, AGeographicRasterOfOblongCellsIsResampledExactlyForAPlane) {
+  const ScopedTempDir dir("raster_dem");
+  const double lon0 = 10.0, lat0 = 51.01, dlon = 1.5 / 3600, dlat = 1.0 / 3600;
+  const int nx = 30, ny = 40;
+  const auto plane = [&](double lon, double lat) {
+    return 300 + 2000 * (lon - lon0) - 5000 * (lat - lat0);
+  };
+  const double gt[6] = {lon0, dlon, 0, lat0, 0, -dlat};
+  WriteGeoTiff(dir / "oblong.tif", nx, ny, 1, gt,
+               [&](int col, int row) {
+                 return plane(lon0 + (col + 0.5) * dlon, lat0 - (row + 0.5) * dlat);
+               },
+               Wgs84Wkt().c_str());
+  const Result<Dem> dem = LoadDem((dir / "oblong.tif").string());
+  ASSERT_TRUE(dem) << dem.error().message;
+  EXPECT_DOUBLE_EQ(dem->grid.cell_size, dlon);
+  EXPECT_DOUBLE_EQ(dem->grid.cell_size_y, dlat);
+  // 1" of latitude is 30.9 m; 1.5" of longitude at 51 deg is 29.2 m: the finer wins.
+  EXPECT_NEAR(dem->map.geometry().cell_m, 1.5 * 30.92 * std::cos(51.0 * M_PI / 180), 0.2);
+  const double z0 = dem->map.geodetic_origin()->height_m;
+  const GridGeometry& g = dem->map.geometry();
+  int checked = 0;
+  for (int j = 0; j < g.size_y; ++j)
+    for (int i = 0; i < g.size_x; ++i) {
+      if (!dem->map.at(CellIndex{i, j}).known()) continue;
+      const Eigen::Vector2d f = dem->MapToFile(g.CenterOf({i, j}));
+      // Inside the rectangle of the file's cell centres, where nothing is clamped.
+      if (f.x() < lon0 + dlon / 2 || f.x() > lon0 + (nx - 0.5) * dlon ||
+          f.y() > lat0 - dlat / 2 || f.y() < lat0 - (ny - 0.5) * dlat)
+        continue;
+      // float32 heights in the file: 1e-4 m near 300 m.
+      EXPECT_NEAR(dem->map.at(CellIndex{i, j}).mean_z + z0, plane(f.x(), f.y()), 1e-3);
+      ++checked;
+    }
+  EXPECT_GT(checked, 800);  // of ~ (29 x 1.5 / 0.95) x 39 map cells inside
+}
+
 TEST(RasterDem, RastersPitchlabCannotTakeAreRefusedSayingWhy) {
   const ScopedTempDir dir("raster_dem");
   const auto flat = [](int, int) { return 10.0; };
@@ -218,7 +258,7 @@ TEST(RasterDem, RastersPitchlabCannotTakeAreRefusedSayingWhy) {
   refused(dir / "rotated.tif", "rotated");
   const double oblong[6] = {0, 1, 0, 0, 0, -2};
   WriteGeoTiff(dir / "oblong.tif", 4, 4, 1, oblong, flat);
-  refused(dir / "oblong.tif", "its cells are 1 by 2: pitchlab reads square cells");
+  refused(dir / "oblong.tif", "its cells are 1 by 2 in a local frame");
   WriteGeoTiff(dir / "furlong.tif", 4, 4, 1, gt, flat, nullptr, "furlong");
   refused(dir / "furlong.tif", "heights in 'furlong', not metres or feet");
   const double degrees[6] = {-104.3, 0.0003, 0, 39.5, 0, -0.0003};

@@ -27,13 +27,16 @@
 
 namespace pitchlab::mapping {
 
-/// An ESRI ASCII grid as stored: rows north to south, x, y and cell in the file's units.
+/// A DEM grid as stored: rows north to south, x, y and cells in the file's units.
 struct AsciiGrid {
   int ncols = 0;                       ///< cells west to east [1]
   int nrows = 0;                       ///< cells north to south [1]
   double xll_corner = 0;               ///< western edge [file units]
   double yll_corner = 0;               ///< southern edge [file units]
-  double cell_size = 0;                ///< [file units]
+  double cell_size = 0;                ///< west to east [file units]
+  /// South to north [file units]: an ESRI grid's cells are square (cell_size); a raster's may not
+  /// be (Copernicus' 1 arc-second DEM beyond 50 deg latitude: 1.5" by 1").
+  double cell_size_y = 0;
   std::optional<double> nodata_value;  ///< as the header gives it
   std::vector<double> values;          ///< row-major, row 0 northernmost; NODATA -> NaN
 
