@@ -53,8 +53,11 @@ PlanInput FromDem(const std::string& path, const planning::PlannerConfig& c) {
                     std::filesystem::path(path).extension() == ".ASC";
   in.about = {{"kind", esri ? "DEM (ESRI ASCII grid)" : "DEM (raster, read by GDAL)"},
               {"crs", dem->crs.name},
-              {"coordinates", CrsKind(dem->crs.kind)}, {"file_cell", dem->grid.cell_size}, {"file_cell_y", dem->grid.cell_size_y},
-              {"nodata_cells", dem->nodata_cells},     {"resampled", dem->resampled}};
+              {"coordinates", CrsKind(dem->crs.kind)},
+              {"file_cell", dem->grid.cell_size},
+              {"file_cell_y", dem->grid.cell_size_y},
+              {"nodata_cells", dem->nodata_cells},
+              {"resampled", dem->resampled}};
   if (dem->resampled) {
     in.about["map_frame"] =
         "east-north-up metres at the grid's centre (the geodetic origin), "

@@ -71,14 +71,17 @@ Result<std::string> EsriWkt(GDALDatasetH ds, const std::string& path) {
   OGRSpatialReferenceH srs = GDALGetSpatialRef(ds);
   if (srs == nullptr) return std::string();
   // Clone: morphing for ESRI must not change the dataset's own.
-  std::unique_ptr<void, void (*)(OGRSpatialReferenceH)> copy(OSRClone(srs), OSRDestroySpatialReference);
+  std::unique_ptr<void, void (*)(OGRSpatialReferenceH)> copy(OSRClone(srs),
+                                                             OSRDestroySpatialReference);
   char* wkt = nullptr;
   const char* const options[] = {"FORMAT=WKT1_ESRI", nullptr};
-  if (OSRExportToWktEx(static_cast<OGRSpatialReferenceH>(copy.get()), &wkt, options) != OGRERR_NONE ||
+  if (OSRExportToWktEx(static_cast<OGRSpatialReferenceH>(copy.get()), &wkt, options) !=
+          OGRERR_NONE ||
       wkt == nullptr) {
     CPLFree(wkt);
-    return Fail(Error::Code::kInvalidArgument,
-                path + ": its coordinate system has no ESRI WKT form" + QuietGdalErrors::Last(path));
+    return Fail(
+        Error::Code::kInvalidArgument,
+        path + ": its coordinate system has no ESRI WKT form" + QuietGdalErrors::Last(path));
   }
   std::string text(wkt);
   CPLFree(wkt);
@@ -137,8 +140,9 @@ Result<RasterDem> ReadGdalRaster(const std::string& path) {
   } else {  // GDAL would only say that no driver recognised it
     return Fail(Error::Code::kNotFound, path + ": cannot be read: " + std::strerror(errno));
   }
-  const Dataset ds(GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR,
-                              nullptr, nullptr, nullptr));
+  const Dataset ds(GDALOpenEx(path.c_str(),
+                              GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR, nullptr,
+                              nullptr, nullptr));
   if (!ds) {
     return Fail(Error::Code::kNotFound,
                 path + ": cannot be read as a raster" + QuietGdalErrors::Last(path));
@@ -153,17 +157,18 @@ Result<RasterDem> ReadGdalRaster(const std::string& path) {
   }
   double gt[6] = {0, 1, 0, 0, 0, 1};
   if (GDALGetGeoTransform(d, gt) != CE_None) {
-    return bad("has no geotransform: nothing gives its cells' size and place "
-               "(a GeoTIFF, or an ESRI grid with its .prj, does)");
+    return bad(
+        "has no geotransform: nothing gives its cells' size and place "
+        "(a GeoTIFF, or an ESRI grid with its .prj, does)");
   }
-  if (gt[2] != 0.0 || gt[4] != 0.0) return bad("its grid is rotated; pitchlab reads north-up grids");
+  if (gt[2] != 0.0 || gt[4] != 0.0)
+    return bad("its grid is rotated; pitchlab reads north-up grids");
   const double dx = gt[1], dy = std::abs(gt[5]);
   if (!(dx > 0) || !(dy > 0)) {
     return bad("its cells are " + NumberText(dx) + " by " + NumberText(gt[5]) + ": not a grid");
   }
   const int nx = GDALGetRasterXSize(d), ny = GDALGetRasterYSize(d);
-  Result<std::vector<double>> heights =
-      Heights(GDALGetRasterBand(d, 1), nx, ny, gt[5] > 0, path);
+  Result<std::vector<double>> heights = Heights(GDALGetRasterBand(d, 1), nx, ny, gt[5] > 0, path);
   if (!heights) return tl::make_unexpected(heights.error());
   Result<std::string> wkt = EsriWkt(d, path);
   if (!wkt) return tl::make_unexpected(wkt.error());

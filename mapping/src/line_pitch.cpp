@@ -264,8 +264,9 @@ void SetLinesRight(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f
     std::nth_element(elevation.begin(), elevation.begin() + elevation.size() / 2, elevation.end());
     out.line_corrections.push_back({elevation[elevation.size() / 2], line.correction_rad});
   }
-  std::sort(out.line_corrections.begin(), out.line_corrections.end(),
-            [](const LineCorrection& a, const LineCorrection& b) { return a.pitch_rad < b.pitch_rad; });
+  std::sort(
+      out.line_corrections.begin(), out.line_corrections.end(),
+      [](const LineCorrection& a, const LineCorrection& b) { return a.pitch_rad < b.pitch_rad; });
   if (out.corrected == 0) {
     out.note = "no line crossed the floor within " + NumberText(config.ground.max_radius_m) +
                " m in " + std::to_string(config.min_line_points) + " points";

@@ -67,8 +67,8 @@ TEST(UserMapsCli, PlansOnAGeoTiffAsOnTheSameGridAsAsc) {
   GDALDatasetH in = GDALOpen((kDemDir + "west_bijou_escarpment_snippet.asc").c_str(), GA_ReadOnly);
   ASSERT_NE(in, nullptr);
   const std::string tif = (dir / "bijou.tif").string();
-  GDALDatasetH copy =
-      GDALCreateCopy(GDALGetDriverByName("GTiff"), tif.c_str(), in, FALSE, nullptr, nullptr, nullptr);
+  GDALDatasetH copy = GDALCreateCopy(GDALGetDriverByName("GTiff"), tif.c_str(), in, FALSE,
+                                     nullptr, nullptr, nullptr);
   ASSERT_NE(copy, nullptr);
   GDALClose(copy);
   GDALClose(in);
@@ -93,9 +93,10 @@ TEST(UserMapsCli, PlansOnAGeoTiffAsOnTheSameGridAsAsc) {
 TEST(UserMapsCli, ATifThatIsNoRasterIsRefusedNamingIt) {
   const ScopedTempDir dir("user_maps");
   std::ofstream(dir / "notes.tif") << "not a raster\n";
-  const CliResult r = cli_test::RunPitchlab("plan " + (dir / "notes.tif").string() +
-                                                " --start 0,0 --goal 1,1 --out " + (dir / "p").string(),
-                                            dir.path());
+  const CliResult r = cli_test::RunPitchlab(
+      "plan " + (dir / "notes.tif").string() + " --start 0,0 --goal 1,1 --out " +
+          (dir / "p").string(),
+      dir.path());
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find((dir / "notes.tif").string() + ": cannot be read as a raster"),
             std::string::npos)

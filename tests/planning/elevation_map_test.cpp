@@ -588,7 +588,8 @@ TEST(ElevationMapIo, AFullDiskIsAnErrorWithItsReasonAndLeavesNothing) {
   });
   ASSERT_GE(failed, 0) << "the child did not exit";
   EXPECT_EQ(failed & 1, 0) << "WritePng: no error '<path>: cannot write: File too large'";
-  EXPECT_EQ(failed & 2, 0) << "WriteFileAtomically: no error '<path>: cannot write: File too large'";
+  EXPECT_EQ(failed & 2, 0)
+      << "WriteFileAtomically: no error '<path>: cannot write: File too large'";
   EXPECT_TRUE(std::filesystem::is_empty(dir.path())) << "a partial or temporary file was left";
 }
 

@@ -45,8 +45,9 @@ void CopyAsGeoTiff(const std::string& source, const fs::path& out) {
 // A new float32 GeoTIFF of `bands` bands, `nx` x `ny`, every band filled by `height(col, row)`
 // (row 0 first in the file); geotransform and unit as given (no geotransform when `gt` is null).
 void WriteGeoTiff(const fs::path& out, int nx, int ny, int bands, const double* gt,
-                  const std::function<double(int, int)>& height, const char* epsg_wkt_from = nullptr,
-                  const char* unit = nullptr, std::optional<double> nodata = std::nullopt) {
+                  const std::function<double(int, int)>& height,
+                  const char* epsg_wkt_from = nullptr, const char* unit = nullptr,
+                  std::optional<double> nodata = std::nullopt) {
   GDALAllRegister();
   GDALDatasetH d = GDALCreate(GDALGetDriverByName("GTiff"), out.string().c_str(), nx, ny, bands,
                               GDT_Float32, nullptr);
@@ -59,7 +60,8 @@ void WriteGeoTiff(const fs::path& out, int nx, int ny, int bands, const double* 
   if (epsg_wkt_from) GDALSetProjection(d, epsg_wkt_from);
   std::vector<float> values(static_cast<std::size_t>(nx) * ny);
   for (int row = 0; row < ny; ++row)
-    for (int col = 0; col < nx; ++col) values[row * nx + col] = static_cast<float>(height(col, row));
+    for (int col = 0; col < nx; ++col)
+      values[row * nx + col] = static_cast<float>(height(col, row));
   for (int b = 1; b <= bands; ++b) {
     GDALRasterBandH band = GDALGetRasterBand(d, b);
     if (unit) GDALSetRasterUnitType(band, unit);
@@ -92,7 +94,8 @@ void ExpectSameMap(const Dem& a, const Dem& b) {
   EXPECT_DOUBLE_EQ(ga.y_min_m, gb.y_min_m);
   ASSERT_EQ(a.map.geodetic_origin().has_value(), b.map.geodetic_origin().has_value());
   if (a.map.geodetic_origin()) {
-    EXPECT_NEAR(a.map.geodetic_origin()->latitude_deg, b.map.geodetic_origin()->latitude_deg, 1e-12);
+    EXPECT_NEAR(a.map.geodetic_origin()->latitude_deg, b.map.geodetic_origin()->latitude_deg,
+                1e-12);
     EXPECT_NEAR(a.map.geodetic_origin()->longitude_deg, b.map.geodetic_origin()->longitude_deg,
                 1e-12);
     EXPECT_NEAR(a.map.geodetic_origin()->height_m, b.map.geodetic_origin()->height_m, 1e-3);
@@ -192,8 +195,9 @@ TEST(RasterDem, FeetNoDataAndSouthUpRastersAreReadAsTheyMean) {
   EXPECT_FALSE(feet->map.at(CellIndex{2, 2}).known());  // file row 1, col 2: no data
 
   const double south_up[6] = {1000, 2, 0, 1992, 0, 2};  // row 0 is the southernmost
-  WriteGeoTiff(dir / "south.tif", 5, 4, 1, south_up, [&](int col, int row) { return h(col, 3 - row); },
-               nullptr, "ft", -9999.0);
+  WriteGeoTiff(
+      dir / "south.tif", 5, 4, 1, south_up, [&](int col, int row) { return h(col, 3 - row); },
+      nullptr, "ft", -9999.0);
   const Result<Dem> south = LoadDem((dir / "south.tif").string());
   ASSERT_TRUE(south) << south.error().message;
   ExpectSameMap(*feet, *south);
@@ -210,11 +214,10 @@ TEST(RasterDem, AGeographicRasterOfOblongCellsIsResampledExactlyForAPlane) {
     return 300 + 2000 * (lon - lon0) - 5000 * (lat - lat0);
   };
   const double gt[6] = {lon0, dlon, 0, lat0, 0, -dlat};
-  WriteGeoTiff(dir / "oblong.tif", nx, ny, 1, gt,
-               [&](int col, int row) {
-                 return plane(lon0 + (col + 0.5) * dlon, lat0 - (row + 0.5) * dlat);
-               },
-               Wgs84Wkt().c_str());
+  WriteGeoTiff(
+      dir / "oblong.tif", nx, ny, 1, gt,
+      [&](int col, int row) { return plane(lon0 + (col + 0.5) * dlon, lat0 - (row + 0.5) * dlat); },
+      Wgs84Wkt().c_str());
   const Result<Dem> dem = LoadDem((dir / "oblong.tif").string());
   ASSERT_TRUE(dem) << dem.error().message;
   EXPECT_DOUBLE_EQ(dem->grid.cell_size, dlon);
@@ -229,8 +232,8 @@ TEST(RasterDem, AGeographicRasterOfOblongCellsIsResampledExactlyForAPlane) {
       if (!dem->map.at(CellIndex{i, j}).known()) continue;
       const Eigen::Vector2d f = dem->MapToFile(g.CenterOf({i, j}));
       // Inside the rectangle of the file's cell centres, where nothing is clamped.
-      if (f.x() < lon0 + dlon / 2 || f.x() > lon0 + (nx - 0.5) * dlon ||
-          f.y() > lat0 - dlat / 2 || f.y() < lat0 - (ny - 0.5) * dlat)
+      if (f.x() < lon0 + dlon / 2 || f.x() > lon0 + (nx - 0.5) * dlon || f.y() > lat0 - dlat / 2 ||
+          f.y() < lat0 - (ny - 0.5) * dlat)
         continue;
       // float32 heights in the file: 1e-4 m near 300 m.
       EXPECT_NEAR(dem->map.at(CellIndex{i, j}).mean_z + z0, plane(f.x(), f.y()), 1e-3);
