@@ -9,7 +9,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libboost-graph-dev
   libcli11-dev  # the pitchlab command's option parsing (apps/cli_args.cpp)
   libceres-dev  # the pose graph (mapping/src/pose_graph.cpp)
-  libgdal-dev  # raster DEMs: GeoTIFF and the rest (mapping/src/gdal_raster_reader.cpp)
+  libgdal-dev  # raster DEMs, GeoTIFF and the rest: headers, and the library dlopen loads
   libjs-three chromium  # the report's 3D view; its headless-browser test
   slurmctld slurmd slurm-client munge  # scripts/test-slurm.sh
   clang libclang-rt-dev valgrind  # the hw libFuzzer targets in CTest; scripts/sanitize.sh

@@ -4,6 +4,8 @@
 
 #include <cpl_conv.h>
 #include <cpl_error.h>
+#include <cpl_vsi.h>
+#include <dlfcn.h>
 #include <gdal.h>
 #include <ogr_srs_api.h>
 
@@ -14,8 +16,8 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
-#include <mutex>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "pitchlab/sensors/number_text.hpp"
@@ -23,20 +25,99 @@
 namespace pitchlab::mapping::internal {
 namespace {
 
+// GDAL's C API, loaded the first time a raster is read. Linked, libgdal and the ~100 libraries
+// it needs load with every pitchlab process (measured: `pitchlab --help` 0.12 -> 0.23 s, 47 ->
+// 146 shared libraries; each run of a sweep is a process), while few processes read a raster.
+// The headers give the types; the library is the one the build found (PITCHLAB_GDAL_SONAME).
+struct GdalApi {
+  decltype(&::GDALAllRegister) AllRegister = nullptr;
+  decltype(&::GDALOpenEx) OpenEx = nullptr;
+  decltype(&::GDALClose) Close = nullptr;
+  decltype(&::GDALGetDatasetDriver) GetDatasetDriver = nullptr;
+  decltype(&::GDALGetDriverShortName) GetDriverShortName = nullptr;
+  decltype(&::GDALGetRasterCount) GetRasterCount = nullptr;
+  decltype(&::GDALGetGeoTransform) GetGeoTransform = nullptr;
+  decltype(&::GDALGetRasterXSize) GetRasterXSize = nullptr;
+  decltype(&::GDALGetRasterYSize) GetRasterYSize = nullptr;
+  decltype(&::GDALGetRasterBand) GetRasterBand = nullptr;
+  decltype(&::GDALRasterIO) RasterIO = nullptr;
+  decltype(&::GDALGetRasterNoDataValue) GetRasterNoDataValue = nullptr;
+  decltype(&::GDALGetRasterScale) GetRasterScale = nullptr;
+  decltype(&::GDALGetRasterOffset) GetRasterOffset = nullptr;
+  decltype(&::GDALGetRasterUnitType) GetRasterUnitType = nullptr;
+  decltype(&::GDALGetSpatialRef) GetSpatialRef = nullptr;
+  decltype(&::OSRClone) SrsClone = nullptr;
+  decltype(&::OSRDestroySpatialReference) SrsDestroy = nullptr;
+  decltype(&::OSRExportToWktEx) SrsExportToWktEx = nullptr;
+  decltype(&::VSIFree) Free = nullptr;
+  decltype(&::CPLPushErrorHandler) PushErrorHandler = nullptr;
+  decltype(&::CPLPopErrorHandler) PopErrorHandler = nullptr;
+  decltype(&::CPLQuietErrorHandler) QuietErrorHandler = nullptr;
+  decltype(&::CPLErrorReset) ErrorReset = nullptr;
+  decltype(&::CPLGetLastErrorMsg) GetLastErrorMsg = nullptr;
+  std::string missing;  ///< why GDAL could not be loaded; empty when it was
+};
+
+GdalApi LoadGdal() {
+  GdalApi api;
+  void* lib = ::dlopen(PITCHLAB_GDAL_SONAME, RTLD_NOW | RTLD_LOCAL);  // kept for the process
+  if (lib == nullptr) {
+    api.missing = std::string("GDAL is not installed (") + ::dlerror() + ")";
+    return api;
+  }
+  const auto bind = [&](auto& f, const char* name) {
+    f = reinterpret_cast<std::remove_reference_t<decltype(f)>>(::dlsym(lib, name));
+    if (f == nullptr && api.missing.empty()) api.missing = std::string("GDAL has no ") + name;
+  };
+  bind(api.AllRegister, "GDALAllRegister");
+  bind(api.OpenEx, "GDALOpenEx");
+  bind(api.Close, "GDALClose");
+  bind(api.GetDatasetDriver, "GDALGetDatasetDriver");
+  bind(api.GetDriverShortName, "GDALGetDriverShortName");
+  bind(api.GetRasterCount, "GDALGetRasterCount");
+  bind(api.GetGeoTransform, "GDALGetGeoTransform");
+  bind(api.GetRasterXSize, "GDALGetRasterXSize");
+  bind(api.GetRasterYSize, "GDALGetRasterYSize");
+  bind(api.GetRasterBand, "GDALGetRasterBand");
+  bind(api.RasterIO, "GDALRasterIO");
+  bind(api.GetRasterNoDataValue, "GDALGetRasterNoDataValue");
+  bind(api.GetRasterScale, "GDALGetRasterScale");
+  bind(api.GetRasterOffset, "GDALGetRasterOffset");
+  bind(api.GetRasterUnitType, "GDALGetRasterUnitType");
+  bind(api.GetSpatialRef, "GDALGetSpatialRef");
+  bind(api.SrsClone, "OSRClone");
+  bind(api.SrsDestroy, "OSRDestroySpatialReference");
+  bind(api.SrsExportToWktEx, "OSRExportToWktEx");
+  bind(api.Free, "VSIFree");
+  bind(api.PushErrorHandler, "CPLPushErrorHandler");
+  bind(api.PopErrorHandler, "CPLPopErrorHandler");
+  bind(api.QuietErrorHandler, "CPLQuietErrorHandler");
+  bind(api.ErrorReset, "CPLErrorReset");
+  bind(api.GetLastErrorMsg, "CPLGetLastErrorMsg");
+  if (api.missing.empty()) api.AllRegister();
+  return api;
+}
+
+// Loaded and its drivers registered once, on first use.
+const GdalApi& Gdal() {
+  static const GdalApi api = LoadGdal();
+  return api;
+}
+
 // GDAL reports errors to a handler that prints them by default; here they are kept quiet for the
 // scope and the last one becomes part of our own message.
 class QuietGdalErrors {
  public:
   QuietGdalErrors() {
-    CPLPushErrorHandler(CPLQuietErrorHandler);
-    CPLErrorReset();
+    Gdal().PushErrorHandler(Gdal().QuietErrorHandler);
+    Gdal().ErrorReset();
   }
-  ~QuietGdalErrors() { CPLPopErrorHandler(); }
+  ~QuietGdalErrors() { Gdal().PopErrorHandler(); }
   QuietGdalErrors(const QuietGdalErrors&) = delete;
   QuietGdalErrors& operator=(const QuietGdalErrors&) = delete;
   // GDAL's last message, from ": ", without the file's name (ours leads the message already).
   static std::string Last(const std::string& path) {
-    const char* m = CPLGetLastErrorMsg();
+    const char* m = Gdal().GetLastErrorMsg();
     std::string text = m ? m : "";
     for (const std::string& prefix : {path + ": ", path + ":"}) {
       while (text.rfind(prefix, 0) == 0) text.erase(0, prefix.size());
@@ -46,7 +127,7 @@ class QuietGdalErrors {
 };
 
 struct DatasetCloser {
-  void operator()(void* d) const { GDALClose(static_cast<GDALDatasetH>(d)); }
+  void operator()(void* d) const { Gdal().Close(static_cast<GDALDatasetH>(d)); }
 };
 using Dataset = std::unique_ptr<void, DatasetCloser>;
 
@@ -68,23 +149,23 @@ double MetresPerHeightUnit(const std::string& unit) {
 
 // The dataset's coordinate system as ESRI WKT1, empty when it has none.
 Result<std::string> EsriWkt(GDALDatasetH ds, const std::string& path) {
-  OGRSpatialReferenceH srs = GDALGetSpatialRef(ds);
+  OGRSpatialReferenceH srs = Gdal().GetSpatialRef(ds);
   if (srs == nullptr) return std::string();
   // Clone: morphing for ESRI must not change the dataset's own.
-  std::unique_ptr<void, void (*)(OGRSpatialReferenceH)> copy(OSRClone(srs),
-                                                             OSRDestroySpatialReference);
+  const auto destroy = [](void* srs) { Gdal().SrsDestroy(static_cast<OGRSpatialReferenceH>(srs)); };
+  const std::unique_ptr<void, decltype(destroy)> copy(Gdal().SrsClone(srs), destroy);
   char* wkt = nullptr;
   const char* const options[] = {"FORMAT=WKT1_ESRI", nullptr};
-  if (OSRExportToWktEx(static_cast<OGRSpatialReferenceH>(copy.get()), &wkt, options) !=
+  if (Gdal().SrsExportToWktEx(static_cast<OGRSpatialReferenceH>(copy.get()), &wkt, options) !=
           OGRERR_NONE ||
       wkt == nullptr) {
-    CPLFree(wkt);
+    Gdal().Free(wkt);
     return Fail(
         Error::Code::kInvalidArgument,
         path + ": its coordinate system has no ESRI WKT form" + QuietGdalErrors::Last(path));
   }
   std::string text(wkt);
-  CPLFree(wkt);
+  Gdal().Free(wkt);
   return text;
 }
 
@@ -93,17 +174,18 @@ Result<std::string> EsriWkt(GDALDatasetH ds, const std::string& path) {
 Result<std::vector<double>> Heights(GDALRasterBandH band, int nx, int ny, bool south_up,
                                     const std::string& path) {
   std::vector<double> v(static_cast<std::size_t>(nx) * ny);
-  if (GDALRasterIO(band, GF_Read, 0, 0, nx, ny, v.data(), nx, ny, GDT_Float64, 0, 0) != CE_None) {
+  if (Gdal().RasterIO(band, GF_Read, 0, 0, nx, ny, v.data(), nx, ny, GDT_Float64, 0, 0) !=
+      CE_None) {
     return Fail(Error::Code::kInvalidArgument,
                 path + ": its heights cannot be read" + QuietGdalErrors::Last(path));
   }
   int has_nodata = 0, has_scale = 0, has_offset = 0;
-  const double nodata = GDALGetRasterNoDataValue(band, &has_nodata);
-  double scale = GDALGetRasterScale(band, &has_scale);
-  double offset = GDALGetRasterOffset(band, &has_offset);
+  const double nodata = Gdal().GetRasterNoDataValue(band, &has_nodata);
+  double scale = Gdal().GetRasterScale(band, &has_scale);
+  double offset = Gdal().GetRasterOffset(band, &has_offset);
   if (!has_scale) scale = 1.0;
   if (!has_offset) offset = 0.0;
-  const std::string unit = GDALGetRasterUnitType(band);
+  const std::string unit = Gdal().GetRasterUnitType(band);
   const double metres = MetresPerHeightUnit(unit);
   if (metres == 0.0) {
     return Fail(Error::Code::kInvalidArgument,
@@ -129,8 +211,9 @@ Result<std::vector<double>> Heights(GDALRasterBandH band, int nx, int ny, bool s
 }  // namespace
 
 Result<RasterDem> ReadGdalRaster(const std::string& path) {
-  static std::once_flag registered;
-  std::call_once(registered, [] { GDALAllRegister(); });
+  if (!Gdal().missing.empty()) {
+    return Fail(Error::Code::kFailed, path + ": cannot read a raster DEM: " + Gdal().missing);
+  }
   const QuietGdalErrors quiet;
   const auto bad = [&](const std::string& why) {
     return Fail(Error::Code::kInvalidArgument, path + ": " + why);
@@ -140,23 +223,23 @@ Result<RasterDem> ReadGdalRaster(const std::string& path) {
   } else {  // GDAL would only say that no driver recognised it
     return Fail(Error::Code::kNotFound, path + ": cannot be read: " + std::strerror(errno));
   }
-  const Dataset ds(GDALOpenEx(path.c_str(),
-                              GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR, nullptr,
-                              nullptr, nullptr));
+  const Dataset ds(Gdal().OpenEx(path.c_str(),
+                                 GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR, nullptr,
+                                 nullptr, nullptr));
   if (!ds) {
     return Fail(Error::Code::kNotFound,
                 path + ": cannot be read as a raster" + QuietGdalErrors::Last(path));
   }
   const GDALDatasetH d = static_cast<GDALDatasetH>(ds.get());
   RasterDem out;
-  out.driver = GDALGetDriverShortName(GDALGetDatasetDriver(d));
-  const int bands = GDALGetRasterCount(d);
+  out.driver = Gdal().GetDriverShortName(Gdal().GetDatasetDriver(d));
+  const int bands = Gdal().GetRasterCount(d);
   if (bands != 1) {
     return bad("holds " + std::to_string(bands) +
                " bands: a DEM holds one, the heights (is it an image?)");
   }
   double gt[6] = {0, 1, 0, 0, 0, 1};
-  if (GDALGetGeoTransform(d, gt) != CE_None) {
+  if (Gdal().GetGeoTransform(d, gt) != CE_None) {
     return bad(
         "has no geotransform: nothing gives its cells' size and place "
         "(a GeoTIFF, or an ESRI grid with its .prj, does)");
@@ -167,8 +250,9 @@ Result<RasterDem> ReadGdalRaster(const std::string& path) {
   if (!(dx > 0) || !(dy > 0)) {
     return bad("its cells are " + NumberText(dx) + " by " + NumberText(gt[5]) + ": not a grid");
   }
-  const int nx = GDALGetRasterXSize(d), ny = GDALGetRasterYSize(d);
-  Result<std::vector<double>> heights = Heights(GDALGetRasterBand(d, 1), nx, ny, gt[5] > 0, path);
+  const int nx = Gdal().GetRasterXSize(d), ny = Gdal().GetRasterYSize(d);
+  Result<std::vector<double>> heights =
+      Heights(Gdal().GetRasterBand(d, 1), nx, ny, gt[5] > 0, path);
   if (!heights) return tl::make_unexpected(heights.error());
   Result<std::string> wkt = EsriWkt(d, path);
   if (!wkt) return tl::make_unexpected(wkt.error());
