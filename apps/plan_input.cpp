@@ -46,11 +46,10 @@ bool IsRasterDem(const std::string& ext) {
   return ext == ".tif" || ext == ".tiff" || ext == ".hgt" || ext == ".img" || ext == ".vrt";
 }
 
-PlanInput FromDem(const std::string& path, const planning::PlannerConfig& c) {
+// `esri`: an .asc read by our own reader, else a raster read by GDAL (LoadDem decides alike).
+PlanInput FromDem(const std::string& path, bool esri, const planning::PlannerConfig& c) {
   auto dem = std::make_shared<mapping::Dem>(OrThrow(mapping::LoadDem(path)));
   PlanInput in = FromElevationMap(dem->map, c);
-  const bool esri = std::filesystem::path(path).extension() == ".asc" ||
-                    std::filesystem::path(path).extension() == ".ASC";
   in.about = {{"kind", esri ? "DEM (ESRI ASCII grid)" : "DEM (raster, read by GDAL)"},
               {"crs", dem->crs.name},
               {"coordinates", CrsKind(dem->crs.kind)},
@@ -90,7 +89,7 @@ PlanInput LoadPlanInput(const std::string& path, const planning::PlannerConfig& 
     in = FromElevationMap(OrThrow(mapping::LoadElevationMap(path)), config);
     in.about = {{"kind", "pitchlab elevation map"}, {"map_frame", "the map's own [m]"}};
   } else if (ext == ".asc" || IsRasterDem(ext)) {
-    in = FromDem(path, config);
+    in = FromDem(path, ext == ".asc", config);
   } else if (ext == ".yaml" || ext == ".yml") {
     in = FromOccupancyGrid(path, config);
   } else {
