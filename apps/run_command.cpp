@@ -136,6 +136,10 @@ int RunRun(int argc, char** argv) {
                run.result.success ? "success" : "FAILED", run.result.reason.c_str(),
                run.result.stops.size(), run.result.end_s - run.result.start_s,
                run.context.wall_time_s, (run.folder / "report.html").string().c_str());
+  // The truth's verdict beside the mission's: the robot cannot know it drove too near a hazard.
+  for (const std::string& finding : run.safety) {
+    std::fprintf(stderr, "run: unsafe: %s\n", finding.c_str());
+  }
   return run.result.success ? 0 : 1;
 }
 

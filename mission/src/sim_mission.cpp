@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "background_jobs.hpp"
+#include "report_summary.hpp"
 #include "run_pictures.hpp"
 #include "truth_cache.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
@@ -372,6 +373,7 @@ SimMissionOutcome RunSimMission(const SimMissionSpec& spec, const std::filesyste
   WriteSummary(folder, run.context, run.result, run.score, final_map);
   folder.Commit();
   run.metrics = RunMetrics(run.context, run.result, run.score);
+  run.safety = ReadOutcome(run.metrics).safety;
   run.folder = folder.final_path();
   return run;
 }

@@ -139,6 +139,10 @@ TEST_F(RunCli, AMissionAroundABlockReachesTheGoalAndWritesEveryOutput) {
   EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
   EXPECT_EQ(html.find("<script src"), std::string::npos);  // every script inline: works offline
   EXPECT_NE(html.find("<div id=outcome class=\"outcome "), std::string::npos);
+  // The console's last word agrees with the report's verdict: "unsafe" lines exactly when the
+  // report says the run was (this run kept off every hazard).
+  EXPECT_NE(html.find("<div id=outcome class=\"outcome ok\""), std::string::npos);
+  EXPECT_EQ(r.err.find("unsafe"), std::string::npos) << r.err;
 }
 
 struct BadRun {

@@ -72,6 +72,9 @@ struct SimMissionOutcome {
   RunContext context;            ///< as written into metrics.json and config.yaml
   nlohmann::json metrics;        ///< metrics.json's content
   std::filesystem::path folder;  ///< the run folder, committed
+  /// report.html's safety findings, one sentence each (the true trajectory over true hazard or
+  /// forbidden cells): empty when the run was safe. A mission can reach its goal unsafely.
+  std::vector<std::string> safety;
 };
 
 /// Runs `spec` and writes the run folder `out` (run_outputs.hpp), committed only at the end: a
