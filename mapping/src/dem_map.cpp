@@ -173,58 +173,56 @@ ElevationMap Resample(const AsciiGrid& g, const DemCrs& crs, double mean_height_
   return map;
 }
 
-// The `.prj` beside the grid, or a local frame without one.
-Result<DemCrs> ReadCrs(const std::string& asc_path) {
-  const std::string prj = std::filesystem::path(asc_path).replace_extension(".prj").string();
-  std::ifstream in(prj);
-  if (!in) {
-    DemCrs local;
-    local.name = "no .prj";
-    return local;
-  }
-  std::stringstream text;
-  text << in.rdbuf();
-  return ParsePrj(text.str(), prj);
-}
-
 bool IsEsriAsciiGrid(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return ext == ".asc";
 }
 
-// The grid and its coordinate system: an ESRI grid by our own reader and its `.prj`, any other
-// raster through GDAL with the coordinate system it carries.
-Result<Dem> ReadGridAndCrs(const std::string& path) {
-  Dem dem;
+}  // namespace
+
+// The grid and its coordinate system text: an ESRI grid by our own reader and its `.prj`, any
+// other raster through GDAL with the coordinate system it carries.
+Result<DemGrid> ReadDemGrid(const std::string& path) {
+  DemGrid dem;
   if (IsEsriAsciiGrid(path)) {
     Result<AsciiGrid> grid = ReadAsciiGrid(path);
     if (!grid) return tl::make_unexpected(grid.error());
-    Result<DemCrs> crs = ReadCrs(path);
-    if (!crs) return tl::make_unexpected(crs.error());
     dem.grid = std::move(*grid);
-    dem.crs = *crs;
+    dem.esri_ascii = true;
+    dem.wkt_source = std::filesystem::path(path).replace_extension(".prj").string();
+    if (std::ifstream in(dem.wkt_source); in) {
+      std::stringstream text;
+      text << in.rdbuf();
+      dem.wkt = text.str();
+    }
     return dem;
   }
   Result<internal::RasterDem> raster = internal::ReadGdalRaster(path);
   if (!raster) return tl::make_unexpected(raster.error());
   dem.grid = std::move(raster->grid);
-  if (raster->esri_wkt.empty()) {
-    dem.crs.name = "no coordinate system";
-  } else {
-    Result<DemCrs> crs = ParsePrj(raster->esri_wkt, path);
-    if (!crs) return tl::make_unexpected(crs.error());
-    dem.crs = *crs;
-  }
+  dem.wkt = std::move(raster->esri_wkt);
+  dem.wkt_source = path;
   return dem;
 }
 
-}  // namespace
+Result<DemCrs> CrsOf(const DemGrid& dem) {
+  if (dem.wkt.empty()) {
+    DemCrs local;
+    local.name = dem.esri_ascii ? "no .prj" : "no coordinate system";
+    return local;
+  }
+  return ParsePrj(dem.wkt, dem.wkt_source);
+}
 
 Result<Dem> LoadDem(const std::string& path) {
-  Result<Dem> read = ReadGridAndCrs(path);
-  if (!read) return read;
-  Dem dem = std::move(*read);
+  Result<DemGrid> read = ReadDemGrid(path);
+  if (!read) return tl::make_unexpected(read.error());
+  Result<DemCrs> crs = CrsOf(*read);
+  if (!crs) return tl::make_unexpected(crs.error());
+  Dem dem;
+  dem.grid = std::move(read->grid);
+  dem.crs = *crs;
   const AsciiGrid& g = dem.grid;
   const auto bad = [&](const std::string& why) {
     return Fail(Error::Code::kInvalidArgument, path + ": " + why);

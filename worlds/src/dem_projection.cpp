@@ -180,7 +180,7 @@ ProjectedDem ProjectDem(const EsriGrid& dem, const DemPlacement& placement, doub
       double x_file = 0.0, y_file = 0.0;
       frame.to_file(grid.x0_m + ix * cell_m, grid.y0_m + iy * cell_m, x_file, y_file);
       const double col = (x_file - dem.xll_corner) / dem.cell_size - 0.5;
-      const double row = dem.nrows - 0.5 - (y_file - dem.yll_corner) / dem.cell_size;
+      const double row = dem.nrows - 0.5 - (y_file - dem.yll_corner) / dem.cell_size_y;
       grid.At(ix, iy) = SampleBicubic(dem, rect, row, col) - origin_height_m;
     }
   }

@@ -44,7 +44,9 @@ std::string Describe(const DemPlacement& placement) {
 }  // namespace
 
 DemWorld BuildDemWorld(const DemWorldConfig& config) {
-  const EsriGrid dem = LoadEsriGrid(config.dem_path);
+  EsriGrid read;  // a DEM of a few hundred MB is not copied
+  if (!config.grid) read = LoadEsriGrid(config.dem_path);
+  const EsriGrid& dem = config.grid ? *config.grid : read;
   const DemPlacement placement = ChoosePlacement(config, dem);
   ProjectedDem projected = [&] {
     try {

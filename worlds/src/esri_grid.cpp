@@ -81,6 +81,7 @@ EsriGrid MakeGrid(const Header& header, const std::string& source) {
     Fail(source, header.fields.at("cellsize").second,
          "header field 'cellsize' must be positive, got " + std::to_string(grid.cell_size));
   }
+  grid.cell_size_y = grid.cell_size;
   grid.xll_corner = RequireCorner(header, "x", grid.cell_size, source);
   grid.yll_corner = RequireCorner(header, "y", grid.cell_size, source);
   if (header.Has("nodata_value")) grid.nodata_value = header.Get("nodata_value");

@@ -6,7 +6,9 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
+#include "dem_input.hpp"
 #include "pitchlab/worlds/dem_world.hpp"
 #include "pitchlab/worlds/terrain_generator.hpp"
 
@@ -19,10 +21,13 @@ commands:
       procedural outdoor terrain -> DIR/terrain.xml + DIR/terrain_hfield.bin
   gully --dem FILE.asc --out DIR [--relief-seed N] [--cell M]
       the West Bijou gully (3 m DEM, UTM 13N) -> DIR/gully.xml + DIR/gully_hfield.bin
-  dem --in FILE.asc --out DIR/NAME.xml [--utm-zone 13N | --geographic | --local]
+  dem --in FILE --out DIR/NAME.xml [--utm-zone 13N | --geographic | --local]
       [--cell M] [--relief-seed N]
-      any ESRI ASCII grid -> NAME.xml + NAME_hfield.bin; lon/lat is detected from a .prj with
-      GEOGCS, otherwise give the coordinates; the geodetic origin is the valid data's centre
+      a DEM -> NAME.xml + NAME_hfield.bin: an ESRI ASCII grid (.asc, with its .prj) or a raster
+      GDAL reads (GeoTIFF .tif, SRTM .hgt, .img, .vrt: band 1, heights in metres or feet).
+      Placed from the file's coordinate system (longitude/latitude, UTM, local metres) unless
+      one of the three options says how to read x, y; without one, local metres. The geodetic
+      origin is the valid data's centre (UTM and lon/lat taken on WGS84)
 
 options:
   --cell M   output vertex spacing [m] (terrain 0.1, gully 0.15, dem 0.2)
@@ -123,6 +128,8 @@ int Run(int argc, char** argv) {
                        "--relief-seed"});
     DemWorldConfig config;
     config.dem_path = Require(flags, "--in");
+    const bool placement_given =
+        flags.count("--utm-zone") + flags.count("--geographic") + flags.count("--local") > 0;
     config.cell_m = NumberFlag(flags, "--cell", config.cell_m);
     if (flags.count("--relief-seed")) config.relief_seed = SeedFlag(flags, "--relief-seed", 0);
     if (flags.count("--utm-zone") + flags.count("--geographic") + flags.count("--local") > 1) {
@@ -131,10 +138,15 @@ int Run(int argc, char** argv) {
     if (flags.count("--utm-zone")) config.placement = ParseUtmZone(flags.at("--utm-zone"));
     if (flags.count("--geographic")) config.placement = DemPlacement{DemCoordinates::kGeographic};
     if (flags.count("--local")) config.placement = DemPlacement{DemCoordinates::kLocal};
+    // Checked before the DEM is read: a large GeoTIFF takes a while.
     const std::string out = Require(flags, "--out");
     if (std::filesystem::path(out).extension() != ".xml") {
       throw std::invalid_argument("--out must name an .xml file, got '" + out + "'");
     }
+    pitchlab::worldgen::DemInput input =
+        pitchlab::worldgen::ReadDemInput(config.dem_path, placement_given);
+    if (!placement_given) config.placement = input.placement;
+    config.grid = std::move(input.grid);
     GenerateDemWorld(config, out);
     std::cout << out << "\n";
   } else {

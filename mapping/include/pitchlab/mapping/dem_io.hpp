@@ -74,6 +74,27 @@ struct DemCrs {
 /// how to reproject.
 [[nodiscard]] Result<DemCrs> ParsePrj(const std::string& wkt, const std::string& source);
 
+/// A DEM file as stored, before it is placed: its grid and the coordinate system text that came
+/// with it (what LoadDem reads, for users who place the grid themselves, such as a simulated
+/// world built from it).
+struct DemGrid {
+  AsciiGrid grid;
+  /// ESRI WKT1 (what a `.prj` holds): the `.prj` beside an `.asc`, or a raster's own coordinate
+  /// system; empty when there is none.
+  std::string wkt;
+  std::string wkt_source;  ///< the `.prj`'s path or the raster's: where `wkt` came from
+  bool esri_ascii = false;  ///< an `.asc` (its coordinate system is a `.prj`), not a GDAL raster
+};
+
+/// Reads a DEM's grid and coordinate system text as LoadDem does (an `.asc` and the `.prj` beside
+/// it; any other file through GDAL), without parsing the text or placing the grid. Fails as
+/// ReadAsciiGrid and on a raster GDAL cannot read or pitchlab cannot take (see LoadDem).
+[[nodiscard]] Result<DemGrid> ReadDemGrid(const std::string& path);
+
+/// The coordinate system of `dem`: ParsePrj of its text; without one kLocal, named "no .prj" for
+/// an `.asc` and "no coordinate system" for a raster. Fails as ParsePrj.
+[[nodiscard]] Result<DemCrs> CrsOf(const DemGrid& dem);
+
 /// A DEM read as an elevation map (one point per cell at the cell's centre and height).
 struct Dem {
   ElevationMap map;              ///< geodetic origin set when the grid is georeferenced

@@ -9,9 +9,12 @@
 
 namespace pitchlab::worlds {
 
-/// A heightfield world built from a user's DEM (ESRI ASCII grid).
+/// A heightfield world built from a user's DEM (ESRI ASCII grid, or a grid read by the caller).
 struct DemWorldConfig {
-  std::filesystem::path dem_path;            ///< the .asc file
+  std::filesystem::path dem_path;            ///< the .asc file; with `grid`, only its name
+  /// The DEM already read (a GeoTIFF, through mapping's ReadDemGrid in pitchlab_worldgen);
+  /// absent: dem_path is read as an ESRI ASCII grid.
+  std::optional<EsriGrid> grid;
   std::optional<DemPlacement> placement;     ///< absent: lon/lat if a .prj says GEOGCS, else local
   double cell_m = 0.2;                       ///< output vertex spacing [m]
   std::optional<std::uint64_t> relief_seed;  ///< add seeded rocks and cracks when given

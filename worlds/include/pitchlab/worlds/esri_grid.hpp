@@ -9,14 +9,18 @@
 
 namespace pitchlab::worlds {
 
-/// An ESRI ASCII grid as stored: cell values, rows north to south, in the file's own units
-/// (metres for projected or local grids, degrees for geographic ones).
+/// A DEM grid as stored (an ESRI ASCII grid, or a raster read elsewhere into the same form): cell
+/// values, rows north to south, in the file's own units (metres for projected or local grids,
+/// degrees for geographic ones).
 struct EsriGrid {
   int ncols = 0;                       ///< cells west to east
   int nrows = 0;                       ///< cells north to south
   double xll_corner = 0.0;             ///< western edge of the grid [file units]
   double yll_corner = 0.0;             ///< southern edge of the grid [file units]
-  double cell_size = 0.0;              ///< [file units]
+  double cell_size = 0.0;              ///< west to east [file units]
+  /// South to north [file units]: an ESRI grid's cells are square (cell_size); a GeoTIFF's may
+  /// not be (Copernicus' 1 arc-second DEM beyond 50 deg latitude: 1.5" by 1").
+  double cell_size_y = 0.0;
   std::optional<double> nodata_value;  ///< as written in the header, if any
   std::vector<double> values;          ///< row-major, row 0 northernmost; NODATA -> NaN
 
@@ -25,7 +29,7 @@ struct EsriGrid {
   /// x of the centre of column `col` [file units].
   double ColumnX(double col) const { return xll_corner + (col + 0.5) * cell_size; }
   /// y of the centre of row `row` (row 0 northernmost) [file units].
-  double RowY(double row) const { return yll_corner + (nrows - row - 0.5) * cell_size; }
+  double RowY(double row) const { return yll_corner + (nrows - row - 0.5) * cell_size_y; }
 };
 
 /// Parses an ESRI ASCII grid: header keys in any order and case (ncols, nrows, xllcorner or
