@@ -5,9 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include <cpl_conv.h>
 #include <gdal.h>
-#include <ogr_srs_api.h>
 
 #include <algorithm>
 #include <cmath>
@@ -18,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "gdal_peer.hpp"
 #include "gdal_raster_reader.hpp"
 #include "pitchlab/mapping/dem_io.hpp"
 #include "scoped_temp_dir.hpp"
@@ -26,21 +25,11 @@ namespace pitchlab::mapping {
 namespace {
 
 namespace fs = std::filesystem;
+using test_support::CopyAsGeoTiff;
+using test_support::EpsgWkt;
 using test_support::ScopedTempDir;
 
 const std::string kDemDir = std::string(PITCHLAB_TEST_DATA_DIR) + "/dem/";
-
-// A GeoTIFF copy of `source` (any raster GDAL reads, here our .asc with its .prj) at `out`.
-void CopyAsGeoTiff(const std::string& source, const fs::path& out) {
-  GDALAllRegister();
-  GDALDatasetH in = GDALOpen(source.c_str(), GA_ReadOnly);
-  ASSERT_NE(in, nullptr) << source;
-  GDALDatasetH copy = GDALCreateCopy(GDALGetDriverByName("GTiff"), out.string().c_str(), in, FALSE,
-                                     nullptr, nullptr, nullptr);
-  ASSERT_NE(copy, nullptr);
-  GDALClose(copy);
-  GDALClose(in);
-}
 
 // A new float32 GeoTIFF of `bands` bands, `nx` x `ny`, every band filled by `height(col, row)`
 // (row 0 first in the file); geotransform and unit as given (no geotransform when `gt` is null).
@@ -70,18 +59,6 @@ void WriteGeoTiff(const fs::path& out, int nx, int ny, int bands, const double* 
               CE_None);
   }
   GDALClose(d);
-}
-
-// The WKT of EPSG:4326 (longitude, latitude; GDAL's axis order for GeoTIFF keys).
-std::string Wgs84Wkt() {
-  OGRSpatialReferenceH srs = OSRNewSpatialReference(nullptr);
-  EXPECT_EQ(OSRImportFromEPSG(srs, 4326), OGRERR_NONE);
-  char* wkt = nullptr;
-  OSRExportToWkt(srs, &wkt);
-  std::string text(wkt);
-  CPLFree(wkt);
-  OSRDestroySpatialReference(srs);
-  return text;
 }
 
 void ExpectSameMap(const Dem& a, const Dem& b) {
@@ -217,7 +194,7 @@ TEST(RasterDem, AGeographicRasterOfOblongCellsIsResampledExactlyForAPlane) {
   WriteGeoTiff(
       dir / "oblong.tif", nx, ny, 1, gt,
       [&](int col, int row) { return plane(lon0 + (col + 0.5) * dlon, lat0 - (row + 0.5) * dlat); },
-      Wgs84Wkt().c_str());
+      EpsgWkt(4326).c_str());
   const Result<Dem> dem = LoadDem((dir / "oblong.tif").string());
   ASSERT_TRUE(dem) << dem.error().message;
   EXPECT_DOUBLE_EQ(dem->grid.cell_size, dlon);
@@ -271,7 +248,7 @@ TEST(RasterDem, RastersPitchlabCannotTakeAreRefusedSayingWhy) {
   refused(dir / "text.tif", "cannot be read as a raster");
   refused(dir / "missing.tif", "cannot be read: No such file or directory");
   // And one it can: the same 0.0003 deg cells with EPSG:4326 set.
-  WriteGeoTiff(dir / "wgs84.tif", 4, 4, 1, degrees, flat, Wgs84Wkt().c_str());
+  WriteGeoTiff(dir / "wgs84.tif", 4, 4, 1, degrees, flat, EpsgWkt(4326).c_str());
   const Result<Dem> wgs84 = LoadDem((dir / "wgs84.tif").string());
   ASSERT_TRUE(wgs84) << wgs84.error().message;
   EXPECT_EQ(wgs84->crs.kind, DemCrs::Kind::kGeographic);

@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "gdal_peer.hpp"
 #include "pitchlab/worlds/world_metadata.hpp"
 #include "test_support.hpp"
 
@@ -23,6 +24,7 @@ namespace pitchlab::worlds {
 namespace {
 
 namespace fs = std::filesystem;
+using ::test_support::CopyAsGeoTiff;
 
 const fs::path kDemDir = fs::path(PITCHLAB_TEST_DATA_DIR) / "dem";
 
@@ -38,32 +40,6 @@ Outcome Worldgen(const std::string& args, const fs::path& scratch) {
       std::string(PITCHLAB_WORLDGEN_EXE) + " " + args + " > /dev/null 2> " + err.string();
   const int status = std::system(command.c_str());
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, test::ReadBytes(err)};
-}
-
-// The WKT of an EPSG code, as GDAL writes it into a GeoTIFF's keys.
-std::string EpsgWkt(int code) {
-  OGRSpatialReferenceH srs = OSRNewSpatialReference(nullptr);
-  EXPECT_EQ(OSRImportFromEPSG(srs, code), OGRERR_NONE) << code;
-  char* wkt = nullptr;
-  OSRExportToWkt(srs, &wkt);
-  std::string text(wkt);
-  CPLFree(wkt);
-  OSRDestroySpatialReference(srs);
-  return text;
-}
-
-// A GeoTIFF copy of `source` (our .asc, with its .prj if any); its coordinate system replaced by
-// EPSG `epsg` unless 0.
-void CopyAsGeoTiff(const fs::path& source, const fs::path& out, int epsg = 0) {
-  GDALAllRegister();
-  GDALDatasetH in = GDALOpen(source.string().c_str(), GA_ReadOnly);
-  ASSERT_NE(in, nullptr) << source;
-  GDALDatasetH copy = GDALCreateCopy(GDALGetDriverByName("GTiff"), out.string().c_str(), in, FALSE,
-                                     nullptr, nullptr, nullptr);
-  ASSERT_NE(copy, nullptr);
-  if (epsg != 0) ASSERT_EQ(GDALSetProjection(copy, EpsgWkt(epsg).c_str()), CE_None);
-  GDALClose(copy);
-  GDALClose(in);
 }
 
 // Two worlds are one: the same placement on the Earth and bounds, and the same ground under a
