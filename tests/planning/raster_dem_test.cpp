@@ -25,8 +25,8 @@ namespace pitchlab::mapping {
 namespace {
 
 namespace fs = std::filesystem;
-using test_support::CopyAsGeoTiff;
-using test_support::EpsgWkt;
+using ::test_support::CopyAsGeoTiff;
+using ::test_support::EpsgWkt;
 using test_support::ScopedTempDir;
 
 const std::string kDemDir = std::string(PITCHLAB_TEST_DATA_DIR) + "/dem/";
