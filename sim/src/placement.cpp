@@ -1,5 +1,6 @@
 // Simulation::PlaceRobot: find the ground under the footprint, check it is free, drop and settle.
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -9,8 +10,6 @@
 
 namespace pitchlab::sim {
 namespace {
-
-constexpr double kNoHit = -1.0;
 
 std::string Xy(double x, double y) {
   std::ostringstream os;
@@ -33,28 +32,66 @@ std::vector<Eigen::Vector2d> FootprintSamples(const P3Params& p, double x, doubl
   return out;
 }
 
+// The top of heightfield geom `g` at world (x, y) [m], on the triangles MuJoCo collides with
+// (vertex (r, c) at (c dx - sx, r dy - sy, data[r ncol + c] sz), cell (r, c) split along
+// (r, c)-(r+1, c+1)); -inf off the field. Not mj_rayHfield alone: MuJoCo 2.2.2's lets a
+// vertical ray that runs exactly along a grid line fall through the surface onto the base's top
+// (measured: of the vertical rays through the vertices and edge midpoints of a DEM world at
+// 0.3 m, 38 k of 4.2 M; none of a million at random positions), and a start at round
+// coordinates puts the footprint's samples on grid lines: "a step of 24 m" under a flat
+// footprint. A field tilted off world z (never written by pitchlab) is left to mj_rayHfield.
+double HfieldTop(const mjModel* m, const mjData* d, int g, const Eigen::Vector2d& xy,
+                 const mjtNum pnt[3], const mjtNum down[3]) {
+  const double dist = mj_rayHfield(m, d, g, pnt, down);
+  const double ray_top = dist >= 0 ? pnt[2] - dist : -std::numeric_limits<double>::infinity();
+  const mjtNum* R = d->geom_xmat + 9 * g;  // row-major: world = R local + pos
+  if (R[8] < 1.0 - 1e-9) return ray_top;
+  const mjtNum* pos = d->geom_xpos + 3 * g;
+  const double wx = xy.x() - pos[0], wy = xy.y() - pos[1];
+  const double lx = R[0] * wx + R[3] * wy, ly = R[1] * wx + R[4] * wy;  // R^T (p - pos)
+  const int h = m->geom_dataid[g];
+  const int nrow = m->hfield_nrow[h], ncol = m->hfield_ncol[h];
+  const mjtNum* size = m->hfield_size + 4 * h;
+  const float* data = m->hfield_data + m->hfield_adr[h];
+  const double col = (lx + size[0]) * (ncol - 1) / (2.0 * size[0]);
+  const double row = (ly + size[1]) * (nrow - 1) / (2.0 * size[1]);
+  if (!(col >= 0 && col <= ncol - 1 && row >= 0 && row <= nrow - 1)) return ray_top;
+  const int c = std::min(static_cast<int>(col), ncol - 2),
+            r = std::min(static_cast<int>(row), nrow - 2);
+  const double fx = col - c, fy = row - r;
+  const auto z = [&](int rr, int cc) { return static_cast<double>(data[rr * ncol + cc]); };
+  const double top =
+      fx >= fy ? z(r, c) + fx * (z(r, c + 1) - z(r, c)) + fy * (z(r + 1, c + 1) - z(r, c + 1))
+               : z(r, c) + fy * (z(r + 1, c) - z(r, c)) + fx * (z(r + 1, c + 1) - z(r + 1, c));
+  const double surface = pos[2] + top * size[2];
+  // Where MuJoCo's ray found the surface (the two agree to 1e-13 m there, measured at 10^6 random
+  // points of terrain, gully and a DEM world), its hit is kept to the bit: a start's height a
+  // few 1e-14 m off sends the whole run elsewhere (the default run: 21 stops instead of 19).
+  constexpr double kSameSurface_m = 1e-6;
+  return std::abs(ray_top - surface) <= kSameSurface_m ? ray_top : surface;
+}
+
 // Highest terrain (plane / heightfield) surface under (x, y) [m], or NaN. `from_z` is above all.
 double TerrainHeight(const mjModel* m, const mjData* d, const Eigen::Vector2d& xy, double from_z,
                      bool any_terrain, const mjtByte* groups) {
   const mjtNum pnt[3] = {xy.x(), xy.y(), from_z};
   const mjtNum down[3] = {0, 0, -1};
-  double best = std::numeric_limits<double>::infinity();
+  double top = -std::numeric_limits<double>::infinity();
   if (!any_terrain) {  // worlds without planes or heightfields: the first static surface is ground
     int geom = -1;
     const double dist = mj_ray(m, d, pnt, down, groups, 1, -1, &geom);
     return dist >= 0 ? from_z - dist : std::nan("");
   }
   for (int g = 0; g < m->ngeom; ++g) {
-    double dist = kNoHit;
     if (m->geom_type[g] == mjGEOM_PLANE) {
-      dist = mju_rayGeom(d->geom_xpos + 3 * g, d->geom_xmat + 9 * g, m->geom_size + 3 * g, pnt,
-                         down, mjGEOM_PLANE);
+      const double dist = mju_rayGeom(d->geom_xpos + 3 * g, d->geom_xmat + 9 * g,
+                                      m->geom_size + 3 * g, pnt, down, mjGEOM_PLANE);
+      if (dist >= 0) top = std::max(top, from_z - dist);
     } else if (m->geom_type[g] == mjGEOM_HFIELD) {
-      dist = mj_rayHfield(m, d, g, pnt, down);
+      top = std::max(top, HfieldTop(m, d, g, xy, pnt, down));
     }
-    if (dist >= 0 && dist < best) best = dist;
   }
-  return std::isfinite(best) ? from_z - best : std::nan("");
+  return std::isfinite(top) ? top : std::nan("");
 }
 
 // In a world without terrain geoms the first static surface from above is taken as ground. It is

@@ -1,4 +1,5 @@
-# Run as: cmake -DBUILD_DIR=... -DEXAMPLE_DIR=... -DWORK_DIR=... -DBUILD_TREE_WORLDS=... -P this
+# Run as: cmake -DBUILD_DIR=... -DEXAMPLE_DIR=... -DWORK_DIR=... -DBUILD_TREE_WORLDS=...
+#   -DDEM_FILE=... (an .asc with its .prj) -P this
 #   [-DTREE_CXX_FLAGS=... -DTREE_EXE_LINKER_FLAGS=...: the flags the installed tree was built with]
 cmake_minimum_required(VERSION 3.22)
 
@@ -21,7 +22,7 @@ set(prefix "${WORK_DIR}/prefix")
 run("cmake --install" ${CMAKE_COMMAND} --install "${BUILD_DIR}" --prefix "${prefix}")
 
 # What the package promises, and nothing of the build tree in it.
-foreach(file bin/pitchlab include/pitchlab/mission/sim_mission.hpp
+foreach(file bin/pitchlab bin/pitchlab_worldgen include/pitchlab/mission/sim_mission.hpp
         include/pitchlab/sensors/scan3d.hpp share/pitchlab/worlds/office.xml
         share/pitchlab/worlds/terrain_hfield.bin lib/cmake/pitchlab/pitchlabConfig.cmake)
   expect("EXISTS;${prefix}/${file}" "the install has no ${file}")
@@ -46,6 +47,15 @@ set(ENV{PITCHLAB_WORLDS_DIR} "")
 run("installed pitchlab worlds" "${prefix}/bin/pitchlab" worlds --json)
 string(FIND "${last_output}" "${prefix}/share/pitchlab/worlds" at)
 expect("NOT;at;EQUAL;-1" "installed `pitchlab worlds` does not read ${prefix}/share/pitchlab/worlds:\n${last_output}")
+
+# The installed world maker makes a world of a user's DEM, and the installed program runs on it.
+set(dem_world "${WORK_DIR}/my_worlds/escarpment.xml")
+run("installed pitchlab_worldgen dem" "${prefix}/bin/pitchlab_worldgen" dem --in "${DEM_FILE}"
+    --cell 2 --out "${dem_world}")
+expect("EXISTS;${WORK_DIR}/my_worlds/escarpment_hfield.bin" "pitchlab_worldgen wrote no height field")
+run("installed pitchlab scan of the DEM world" "${prefix}/bin/pitchlab" scan --world "${dem_world}"
+    --out "${WORK_DIR}/my_worlds/scan.pcd")
+expect("EXISTS;${WORK_DIR}/my_worlds/scan.pcd" "pitchlab scan wrote no scan of the DEM world")
 
 # A user's project: configure and build examples/ against the prefix only. It is built with the
 # flags the installed libraries were built with, as a user of such a package must: the libraries

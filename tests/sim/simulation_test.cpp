@@ -359,6 +359,62 @@ int CountFiles(const std::string& dir) {
   return n;
 }
 
+// MuJoCo 2.2.2's mj_rayHfield lets some vertical rays that run exactly along a grid line fall
+// through the surface onto the top of the field's base (here 1375 of the 159 k vertices of a
+// smooth 401 x 401 field); placement once took such a ray for the ground and refused a start at
+// round coordinates, "a step of 24 m" under a flat footprint. It reads the field's triangles
+// instead: a start with its footprint's centre on each such vertex is placed on the surface.
+TEST(Simulation, PlacementOnAHeightfieldGridVertexFindsTheSurface) {
+  const ScopedTempDir dir("grid_vertex");
+  constexpr std::int32_t kN = 401;
+  {
+    std::ofstream out(dir / "waves.bin", std::ios::binary);
+    out.write(reinterpret_cast<const char*>(&kN), sizeof kN);
+    out.write(reinterpret_cast<const char*>(&kN), sizeof kN);
+    for (int row = 0; row < kN; ++row) {
+      for (int col = 0; col < kN; ++col) {  // gentle: at most 9 deg
+        const float h =
+            static_cast<float>(0.5 + 0.25 * std::sin(0.031 * col) * std::cos(0.027 * row));
+        out.write(reinterpret_cast<const char*>(&h), sizeof h);
+      }
+    }
+  }
+  const std::filesystem::path world = dir / "waves.xml";
+  std::ofstream(world) << R"(<mujoco>
+    <asset><hfield name="waves" file="waves.bin" size="20 20 1 1"/></asset>
+    <worldbody><geom name="ground" type="hfield" hfield="waves" pos="0 0 -1"/></worldbody>
+  </mujoco>)";
+  // The vertices where MuJoCo's own vertical ray misses the surface, and the surface there.
+  char error[1000] = "";
+  std::unique_ptr<mjModel, void (*)(mjModel*)> m(
+      mj_loadXML(world.string().c_str(), nullptr, error, sizeof error), mj_deleteModel);
+  ASSERT_TRUE(m) << error;
+  std::unique_ptr<mjData, void (*)(mjData*)> d(mj_makeData(m.get()), mj_deleteData);
+  mj_forward(m.get(), d.get());
+  struct Vertex {
+    double x, y, surface_z;
+  };
+  std::vector<Vertex> fallen;
+  for (int row = 40; row < kN - 40 && fallen.size() < 6; row += 1) {
+    for (int col = 40; col < kN - 40 && fallen.size() < 6; col += 7) {
+      const double x = -20.0 + 40.0 * col / (kN - 1), y = -20.0 + 40.0 * row / (kN - 1);
+      const double surface = -1.0 + m->hfield_data[row * kN + col];  // size z 1, normalised
+      const mjtNum from[3] = {x, y, 10.0}, down[3] = {0, 0, -1};
+      const double hit_z = 10.0 - mj_rayHfield(m.get(), d.get(), 0, from, down);
+      if (hit_z < surface - 0.01) fallen.push_back({x, y, surface});
+    }
+  }
+  ASSERT_FALSE(fallen.empty()) << "this field no longer shows MuJoCo's fall-through";
+  Simulation sim(world.string(), Robot(P3Model::kP3AT));
+  const double footprint_x = sim.params().footprint_x_m;
+  for (const Vertex& v : fallen) {
+    const Result<Eigen::Isometry3d> pose = sim.PlaceRobot(v.x - footprint_x, v.y, 0.0);
+    ASSERT_TRUE(pose) << v.x << ", " << v.y << ": " << pose.error().message;
+    // base_link (on the ground, REP-105) on the surface, not on the base's top a metre below.
+    EXPECT_NEAR(pose->translation().z(), v.surface_z, 0.02) << v.x << ", " << v.y;
+  }
+}
+
 TEST(Simulation, HeightfieldFileResolvesAgainstTheWorldFolderWhichStaysUntouched) {
   const ScopedTempDir dir("world_dir");
   const std::string world_dir = dir.path().string();
