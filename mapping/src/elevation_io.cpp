@@ -15,8 +15,15 @@
 namespace pitchlab::mapping {
 namespace {
 
-constexpr char kMagic[8] = {'P', 'L', 'E', 'L', 'E', 'V', '0', '1'};
+constexpr char kMagic[8] = {'P', 'L', 'E', 'L', 'E', 'V', '0', '2'};
+constexpr char kMagicDense[8] = {'P', 'L', 'E', 'L', 'E', 'V', '0', '1'};  // read, no longer written
 static_assert(sizeof(CellStats) == 52, "the .plem record layout is 13 packed 4-byte fields");
+
+// A cell nothing reached: no point, no ray (CellStats' defaults, byte for byte: 13 packed fields).
+bool Unseen(const CellStats& c) {
+  static const CellStats kUnseen{};
+  return std::memcmp(&c, &kUnseen, sizeof(CellStats)) == 0;
+}
 
 std::uint64_t Fnv1a(std::string_view bytes) {
   std::uint64_t h = 1469598103934665603ull;
@@ -74,8 +81,20 @@ Result<void> SaveElevationMap(const ElevationMap& map, const std::string& path) 
   Put(out, geo.longitude_deg);
   Put(out, geo.height_m);
   Put(out, static_cast<std::uint32_t>(sizeof(CellStats)));
-  out.append(reinterpret_cast<const char*>(map.cells().data()),
-             map.cells().size() * sizeof(CellStats));
+  // Runs of unseen cells, then of seen ones with their records. A run's map covers its world and
+  // is mostly unseen (the default terrain run: 81 % of 410 k cells, in 1953 runs): its file was
+  // 21 MB of mostly default records, a 350 m DEM world's 655 MB.
+  const std::vector<CellStats>& cells = map.cells();
+  for (std::size_t k = 0; k < cells.size();) {
+    std::size_t seen = k;
+    while (seen < cells.size() && Unseen(cells[seen])) ++seen;
+    std::size_t end = seen;
+    while (end < cells.size() && !Unseen(cells[end])) ++end;
+    Put(out, static_cast<std::uint32_t>(seen - k));  // a grid holds at most 2^31 cells
+    Put(out, static_cast<std::uint32_t>(end - seen));
+    out.append(reinterpret_cast<const char*>(cells.data() + seen), (end - seen) * sizeof(CellStats));
+    k = end;
+  }
   Put(out, Fnv1a(out));
   return WriteFileAtomically(path, out);
 }
@@ -139,8 +158,11 @@ Result<ElevationMap> LoadElevationMap(const std::string& path) {
   const auto bad = [&](const std::string& why) {
     return Fail(Error::Code::kInvalidArgument, path + ": not a pitchlab elevation map: " + why);
   };
-  if (bytes.size() < sizeof(kMagic) + 8 || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0)
-    return bad("bad magic (expected PLELEV01)");
+  const bool dense = bytes.size() >= sizeof(kMagic) + 8 &&
+                     std::memcmp(bytes.data(), kMagicDense, sizeof(kMagicDense)) == 0;
+  if (bytes.size() < sizeof(kMagic) + 8 ||
+      (!dense && std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0))
+    return bad("bad magic (expected PLELEV02, or PLELEV01 of earlier versions)");
   std::uint64_t stored_hash = 0;
   std::memcpy(&stored_hash, bytes.data() + bytes.size() - 8, 8);
   if (Fnv1a(std::string_view(bytes).substr(0, bytes.size() - 8)) != stored_hash)
@@ -160,10 +182,30 @@ Result<ElevationMap> LoadElevationMap(const std::string& path) {
   if (sx <= 0 || sy <= 0 || !(g.cell_m > 0)) return bad("empty grid");
   g.size_x = sx;
   g.size_y = sy;
-  const std::size_t cells_bytes = g.cell_count() * sizeof(CellStats);
-  if (pos + cells_bytes + 8 != bytes.size()) return bad("size does not match the grid");
+  const std::size_t end = bytes.size() - 8;  // the hash
   std::vector<CellStats> cells(g.cell_count());
-  std::memcpy(cells.data(), bytes.data() + pos, cells_bytes);
+  if (dense) {  // every record in order
+    const std::size_t cells_bytes = g.cell_count() * sizeof(CellStats);
+    if (pos + cells_bytes != end) return bad("size does not match the grid");
+    std::memcpy(cells.data(), bytes.data() + pos, cells_bytes);
+  } else {
+    for (std::size_t k = 0; k < cells.size();) {
+      std::uint32_t unseen = 0, seen = 0;
+      if (pos + 8 > end || !Get(bytes, pos, &unseen) || !Get(bytes, pos, &seen))
+        return bad("cell runs end before cell " + std::to_string(k) + " of " +
+                   std::to_string(cells.size()));
+      if (unseen + std::uint64_t{seen} == 0 || k + unseen + std::uint64_t{seen} > cells.size())
+        return bad("a run of " + std::to_string(unseen) + " + " + std::to_string(seen) +
+                   " cells at cell " + std::to_string(k) + " does not fit the grid of " +
+                   std::to_string(cells.size()));
+      k += unseen;  // left at CellStats' defaults
+      if (pos + std::uint64_t{seen} * sizeof(CellStats) > end) return bad("truncated cell records");
+      std::memcpy(cells.data() + k, bytes.data() + pos, seen * sizeof(CellStats));
+      pos += seen * sizeof(CellStats);
+      k += seen;
+    }
+    if (pos != end) return bad("size does not match the grid");
+  }
   // The hash proves the bytes are as written, not that a writer wrote numbers: a crafted or
   // foreign file with an infinite cell or a NaN height would plan "paths" of NaN coordinates.
   if (const std::string why = InvalidValues(g, has_geo ? &geo : nullptr, cells); !why.empty())

@@ -511,6 +511,79 @@ TEST(ElevationMapIo, SaveLoadIsLosslessAndInsertionContinues) {
   EXPECT_FALSE(LoadElevationMap((dir / "missing.plem").string()));
 }
 
+// The .plem file format's FNV-1a 64 hash (elevation_io.hpp), for files written by hand here.
+std::uint64_t Fnv1a(const std::string& bytes) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : bytes) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+// A map that saw a corner patch, a patch in the middle (with the cells its rays crossed) and the
+// last cell: the file holds the header, 8 bytes per run of unseen or seen cells, the seen cells'
+// records and the hash, nothing for the cells nothing reached, and loads cell for cell as saved.
+// The dense files of earlier versions (PLELEV01: every record) load as the same map; runs that
+// do not fit the grid are refused.
+TEST(ElevationMapIo, StoresOnlyTheSeenCellsAndReadsEarlierDenseFiles) {
+  const ScopedTempDir dir("elev_io");
+  const GridGeometry g = GridGeometry::FromArea(0, 0, 20, 15, 0.1);  // 200 x 150 cells
+  ElevationMap map(g, GeodeticOrigin{46.77, 23.59, 360});
+  auto corner = Lattice(0, 0.5, 0, 0.3, 0.03, [](double x, double) { return 0.1 * x; });
+  (void)map.InsertPoints(corner.data(), corner.size());
+  auto middle = Lattice(9, 11, 7, 8, 0.03, [](double, double y) { return 0.05 * y; });
+  (void)map.InsertScan(middle.data(), middle.size(), Eigen::Vector3f(6, 7.5, 0.6f));
+  const Eigen::Vector3f last(19.97f, 14.97f, 0.2f);
+  (void)map.InsertPoints(&last, 1);
+  // A pair (unseen, seen) per run of seen cells, one more for unseen cells at the end.
+  std::size_t seen = 0, pairs = 0, ray_only = 0;
+  bool was_seen = false;
+  for (const CellStats& c : map.cells()) {
+    const bool s = c.count > 0 || std::isfinite(c.clearance_z);
+    seen += s;
+    ray_only += c.count == 0 && std::isfinite(c.clearance_z);
+    pairs += s && !was_seen;
+    was_seen = s;
+  }
+  pairs += !was_seen;
+  ASSERT_TRUE(was_seen) << "the last cell is seen";
+  ASSERT_GT(ray_only, 0u) << "the middle patch's rays crossed no cell before it";
+  ASSERT_LT(seen, g.cell_count() / 20);
+  const std::string path = (dir / "sparse.plem").string();
+  ASSERT_TRUE(SaveElevationMap(map, path));
+  EXPECT_EQ(std::filesystem::file_size(path), 72 + 8 * pairs + 52 * seen + 8);
+  const auto loaded = LoadElevationMap(path);
+  ASSERT_TRUE(loaded) << loaded.error().message;
+  ASSERT_EQ(loaded->cells().size(), map.cells().size());
+  EXPECT_EQ(std::memcmp(loaded->cells().data(), map.cells().data(),
+                        map.cells().size() * sizeof(CellStats)),
+            0);
+
+  std::ifstream in(path, std::ios::binary);
+  const std::string sparse((std::istreambuf_iterator<char>(in)), {});
+  std::string dense = "PLELEV01" + sparse.substr(8, 64);  // the same header
+  dense.append(reinterpret_cast<const char*>(map.cells().data()),
+               map.cells().size() * sizeof(CellStats));
+  const std::uint64_t dense_hash = Fnv1a(dense);
+  dense.append(reinterpret_cast<const char*>(&dense_hash), 8);
+  std::ofstream(dir / "dense.plem", std::ios::binary) << dense;
+  const auto old = LoadElevationMap((dir / "dense.plem").string());
+  ASSERT_TRUE(old) << old.error().message;
+  EXPECT_EQ(std::memcmp(old->cells().data(), map.cells().data(),
+                        map.cells().size() * sizeof(CellStats)),
+            0);
+  EXPECT_TRUE(old->geometry().SameAs(g));
+
+  std::string overrun = sparse.substr(0, sparse.size() - 8);
+  const std::uint32_t too_many = static_cast<std::uint32_t>(g.cell_count());  // + the seen ones
+  std::memcpy(overrun.data() + 72, &too_many, 4);
+  const std::uint64_t overrun_hash = Fnv1a(overrun);
+  overrun.append(reinterpret_cast<const char*>(&overrun_hash), 8);
+  std::ofstream(dir / "overrun.plem", std::ios::binary) << overrun;
+  const auto refused = LoadElevationMap((dir / "overrun.plem").string());
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("does not fit the grid of 30000"), std::string::npos)
+      << refused.error().message;
+}
+
 TEST(ElevationMapIo, EsriGridHasHeaderRowsNorthFirstAndPrj) {
   const ScopedTempDir dir("elev_asc");
   ElevationMap map(GridGeometry::FromArea(10, 20, 0.3, 0.2, 0.1));
