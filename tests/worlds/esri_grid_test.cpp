@@ -1,4 +1,6 @@
 // The ESRI ASCII loader on real DEMs and on broken files, and DEM placement on the Earth.
+#include <sys/wait.h>
+
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -253,21 +255,35 @@ TEST(DemWorld, TooFineACellForABigDemSaysWhichCellWorks) {
   }
 }
 
-TEST(Worldgen, CommandLineGivesHelpAndNonZeroExitOnBadInput) {
+// Exit codes as pitchlab's: 0 done, 2 a mistake on the command line (with a pointer to --help),
+// 1 a problem with what it names (a missing DEM); nothing written either way.
+TEST(Worldgen, CommandLineGivesHelpAndExitsTwoOnMistakesOneOnBadInput) {
   const std::string exe = PITCHLAB_WORLDGEN_EXE;
   const test::ScopedTempDir dir("cli");
-  EXPECT_EQ(std::system((exe + " --help > /dev/null").c_str()), 0);
-  EXPECT_NE(std::system((exe + " moon 2> /dev/null").c_str()), 0);
-  EXPECT_NE(std::system((exe + " dem --in /nonexistent.asc --out " + (dir / "x.xml").string() +
-                         " 2> /dev/null")
-                            .c_str()),
-            0);
-  const auto out = dir.path() / "esc.xml";
-  const std::string cmd = exe + " dem --in " +
-                          (kDemDir / "west_bijou_escarpment_snippet.asc").string() +
-                          " --cell 20 --relief-seed 5 --out " + out.string() + " > /dev/null";
-  EXPECT_EQ(std::system(cmd.c_str()), 0);
-  EXPECT_TRUE(test::LoadModel(out));
+  const auto exit_code = [&](const std::string& args) {
+    const int status = std::system((exe + " " + args + " > /dev/null 2>&1").c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  EXPECT_EQ(exit_code("--help"), 0);
+  EXPECT_EQ(exit_code("dem --help"), 0);
+  EXPECT_EQ(exit_code(""), 2);
+  EXPECT_EQ(exit_code("moon"), 2);
+  const std::string dem = (kDemDir / "west_bijou_escarpment_snippet.asc").string();
+  const std::string out = (dir.path() / "x.xml").string();
+  for (const std::string& mistake :
+       {"dem --in " + dem + " --cell abc --out " + out, "dem --in " + dem,
+        "dem --in " + dem + " --out " + (dir.path() / "x.txt").string(),
+        "dem --in " + dem + " --bogus 1 --out " + out,
+        "dem --in " + dem + " --utm-zone 61Q --out " + out,
+        "dem --in " + dem + " --local --geographic --out " + out, "terrain --seed -1 --out " + out,
+        "dem --in " + dem + " --out"}) {
+    EXPECT_EQ(exit_code(mistake), 2) << mistake;
+  }
+  EXPECT_EQ(exit_code("dem --in /nonexistent.asc --out " + out), 1);
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
+  const auto esc = dir.path() / "esc.xml";
+  EXPECT_EQ(exit_code("dem --in " + dem + " --cell 20 --relief-seed 5 --out " + esc.string()), 0);
+  EXPECT_TRUE(test::LoadModel(esc));
 }
 
 }  // namespace

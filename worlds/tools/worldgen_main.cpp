@@ -34,19 +34,24 @@ options:
   --help     this text
 )";
 
+// A mistake on the command line (exit 2), not in what it names (exit 1).
+struct UsageError : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
+};
+
 // "--key value" pairs and "--flag" switches after the command.
 std::map<std::string, std::string> ParseFlags(int argc, char** argv) {
   std::map<std::string, std::string> flags;
   for (int i = 2; i < argc; ++i) {
     const std::string key = argv[i];
-    if (key.rfind("--", 0) != 0) throw std::invalid_argument("unexpected argument '" + key + "'");
+    if (key.rfind("--", 0) != 0) throw UsageError("unexpected argument '" + key + "'");
     const bool is_switch = key == "--geographic" || key == "--local" || key == "--help";
     if (is_switch) {
       flags[key] = "";
     } else if (i + 1 < argc) {
       flags[key] = argv[++i];
     } else {
-      throw std::invalid_argument("option " + key + " needs a value");
+      throw UsageError("option " + key + " needs a value");
     }
   }
   return flags;
@@ -54,7 +59,7 @@ std::map<std::string, std::string> ParseFlags(int argc, char** argv) {
 
 std::string Require(const std::map<std::string, std::string>& flags, const std::string& key) {
   const auto it = flags.find(key);
-  if (it == flags.end()) throw std::invalid_argument("missing required option " + key);
+  if (it == flags.end()) throw UsageError("missing required option " + key);
   return it->second;
 }
 
@@ -70,7 +75,7 @@ double NumberFlag(const std::map<std::string, std::string>& flags, const std::st
     used = 0;
   }
   if (used != it->second.size() || !(value > 0.0)) {
-    throw std::invalid_argument("option " + key + ": expected a positive number, got '" +
+    throw UsageError("option " + key + ": expected a positive number, got '" +
                                 it->second + "'");
   }
   return value;
@@ -82,7 +87,7 @@ std::uint64_t SeedFlag(const std::map<std::string, std::string>& flags, const st
   if (it == flags.end()) return fallback;
   const std::string& text = it->second;
   if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos) {
-    throw std::invalid_argument("option " + key + ": expected a non-negative integer, got '" +
+    throw UsageError("option " + key + ": expected a non-negative integer, got '" +
                                 text + "'");
   }
   return std::stoull(text);
@@ -93,7 +98,7 @@ void CheckKnown(const std::map<std::string, std::string>& flags,
   for (const auto& [key, value] : flags) {
     bool found = false;
     for (const char* k : known) found = found || key == k;
-    if (!found) throw std::invalid_argument("unknown option " + key);
+    if (!found) throw UsageError("unknown option " + key);
   }
 }
 
@@ -133,15 +138,21 @@ int Run(int argc, char** argv) {
     config.cell_m = NumberFlag(flags, "--cell", config.cell_m);
     if (flags.count("--relief-seed")) config.relief_seed = SeedFlag(flags, "--relief-seed", 0);
     if (flags.count("--utm-zone") + flags.count("--geographic") + flags.count("--local") > 1) {
-      throw std::invalid_argument("give at most one of --utm-zone, --geographic, --local");
+      throw UsageError("give at most one of --utm-zone, --geographic, --local");
     }
-    if (flags.count("--utm-zone")) config.placement = ParseUtmZone(flags.at("--utm-zone"));
+    if (flags.count("--utm-zone")) {
+      try {
+        config.placement = ParseUtmZone(flags.at("--utm-zone"));
+      } catch (const std::invalid_argument& e) {
+        throw UsageError(e.what());
+      }
+    }
     if (flags.count("--geographic")) config.placement = DemPlacement{DemCoordinates::kGeographic};
     if (flags.count("--local")) config.placement = DemPlacement{DemCoordinates::kLocal};
     // Checked before the DEM is read: a large GeoTIFF takes a while.
     const std::string out = Require(flags, "--out");
     if (std::filesystem::path(out).extension() != ".xml") {
-      throw std::invalid_argument("--out must name an .xml file, got '" + out + "'");
+      throw UsageError("--out must name an .xml file, got '" + out + "'");
     }
     pitchlab::worldgen::DemInput input =
         pitchlab::worldgen::ReadDemInput(config.dem_path, placement_given);
@@ -150,7 +161,7 @@ int Run(int argc, char** argv) {
     GenerateDemWorld(config, out);
     std::cout << out << "\n";
   } else {
-    throw std::invalid_argument("unknown command '" + command + "' (see --help)");
+    throw UsageError("unknown command '" + command + "'");
   }
   return 0;
 }
@@ -160,6 +171,9 @@ int Run(int argc, char** argv) {
 int main(int argc, char** argv) {
   try {
     return Run(argc, argv);
+  } catch (const UsageError& e) {
+    std::cerr << "pitchlab_worldgen: " << e.what() << " (see pitchlab_worldgen --help)\n";
+    return 2;
   } catch (const std::exception& e) {
     std::cerr << "pitchlab_worldgen: " << e.what() << "\n";
     return 1;
