@@ -155,6 +155,44 @@ TEST(EsriGrid, CorruptFilesRaiseErrorsNamingTheFileLineAndProblem) {
             std::string::npos);
 }
 
+// A 10 x 8 grid of 2 m x 1 m cells, its west edge at x = 100, south edge at y = 200, each cell's
+// value 100 * row + col: the crop keeps exactly the cells whose centres lie in the area, edges
+// included, with their values and corner; an area that holds fewer than 2 x 2 centres is refused
+// naming the grid's extent.
+TEST(EsriGrid, CropKeepsTheCellsWhoseCentresLieInTheArea) {
+  EsriGrid grid;
+  grid.ncols = 10;
+  grid.nrows = 8;
+  grid.xll_corner = 100;
+  grid.yll_corner = 200;
+  grid.cell_size = 2;
+  grid.cell_size_y = 1;
+  for (int row = 0; row < 8; ++row)
+    for (int col = 0; col < 10; ++col) grid.values.push_back(100.0 * row + col);
+  // Column centres 101, 103, ..., 119; row centres 207.5 (row 0) down to 200.5 (row 7).
+  const EsriGrid crop = CropToArea(grid, GridArea{103, 202.5, 109.5, 205});
+  EXPECT_EQ(crop.ncols, 4);  // centres 103 (on the edge), 105, 107, 109
+  EXPECT_EQ(crop.nrows, 3);  // centres 204.5, 203.5, 202.5 (on the edge): rows 3, 4, 5
+  EXPECT_DOUBLE_EQ(crop.xll_corner, 102);
+  EXPECT_DOUBLE_EQ(crop.yll_corner, 202);
+  EXPECT_DOUBLE_EQ(crop.cell_size_y, 1);
+  ASSERT_EQ(crop.values.size(), 12u);
+  EXPECT_EQ(crop.At(0, 0), 301);
+  EXPECT_EQ(crop.At(2, 3), 504);
+  EXPECT_DOUBLE_EQ(crop.ColumnX(0), 103);
+  EXPECT_DOUBLE_EQ(crop.RowY(2), 202.5);
+  // Reaching past the grid keeps what is there.
+  EXPECT_EQ(CropToArea(grid, GridArea{0, 0, 1000, 1000}).values, grid.values);
+  try {
+    CropToArea(grid, GridArea{104, 201, 105.5, 209});  // one column centre (105)
+    FAIL() << "a one-column area was cropped";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("the grid spans x 101 .. 119, y 200.5 .. 207.5"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(EsriGrid, MissingAndBadFilesOnDiskNameThePath) {
   const test::ScopedTempDir dir("esri_bad");
   const auto bad = dir.path() / "bad.asc";

@@ -177,6 +177,55 @@ TEST(WorldgenDem, OblongCellsKeepTheirSpacing) {
   }
 }
 
+// --area builds the part of a DEM in the rectangle: heights rising 0.1 per metre east and 0.2
+// per metre north over 200 x 150 m of 5 m cells; the part between x 50 .. 100 and y 20 .. 60 is
+// a world 50 x 40 m (between its outer cell centres, less the bounds' 1 m margin) whose origin
+// lies at the part's centre, at its height there. Mistakes in the option exit 2; an area beside
+// the DEM exits 1 naming the DEM's extent.
+TEST(WorldgenDem, AnAreaBuildsThatPartOfTheDem) {
+  const test::ScopedTempDir dir("worldgen_dem");
+  std::string text = "ncols 40\nnrows 30\nxllcorner 0\nyllcorner 0\ncellsize 5\n";
+  for (int row = 0; row < 30; ++row) {
+    for (int col = 0; col < 40; ++col) {
+      const double x = 5 * col + 2.5, y = 5 * (29 - row) + 2.5;
+      text += std::to_string(0.1 * x + 0.2 * y) + " ";
+    }
+    text += "\n";
+  }
+  test::WriteText(dir / "plane.asc", text);
+  const fs::path out = dir / "part.xml";
+  const Outcome built = Worldgen("dem --in " + (dir / "plane.asc").string() +
+                                     " --local --area 50,20,100,60 --cell 1 --out " + out.string(),
+                                 dir.path());
+  ASSERT_EQ(built.exit_code, 0) << built.err;
+  const test::ModelPtr m = test::LoadModel(out);
+  ASSERT_TRUE(m);
+  const WorldMetadata w = ReadWorldMetadata(m.get());
+  // Centres 52.5 .. 97.5 and 22.5 .. 57.5: 45 x 35 m, less 1 m each side.
+  EXPECT_NEAR(w.bounds.x_max_m - w.bounds.x_min_m, 43.0, 1.0);
+  EXPECT_NEAR(w.bounds.y_max_m - w.bounds.y_min_m, 33.0, 1.0);
+  const std::string xml = test::ReadBytes(out);
+  const std::size_t at = xml.find("origin height ");
+  ASSERT_NE(at, std::string::npos) << xml.substr(0, 300);
+  // The part's centre (75, 40): 0.1 * 75 + 0.2 * 40.
+  EXPECT_NEAR(std::stod(xml.substr(at + 14)), 15.5, 0.01);
+
+  for (const char* bad : {"50,20,100", "50,20,40,60", "a,b,c,d", "50,20,100,60,1"}) {
+    const Outcome mistake = Worldgen("dem --in " + (dir / "plane.asc").string() +
+                                         " --local --area " + bad + " --out " + out.string(),
+                                     dir.path());
+    EXPECT_EQ(mistake.exit_code, 2) << bad << ": " << mistake.err;
+  }
+  const fs::path beside = dir / "beside.xml";
+  const Outcome outside = Worldgen("dem --in " + (dir / "plane.asc").string() +
+                                       " --local --area 500,500,600,600 --out " + beside.string(),
+                                   dir.path());
+  EXPECT_EQ(outside.exit_code, 1);
+  EXPECT_NE(outside.err.find("the grid spans x 2.5 .. 197.5, y 2.5 .. 147.5"), std::string::npos)
+      << outside.err;
+  EXPECT_FALSE(fs::exists(beside));
+}
+
 // Coordinate systems a world cannot be placed in are refused naming the file and the way out,
 // and leave no world; with --local the same file builds (x, y read as metres). Not a raster at
 // all: refused naming it.

@@ -46,7 +46,14 @@ std::string Describe(const DemPlacement& placement) {
 DemWorld BuildDemWorld(const DemWorldConfig& config) {
   EsriGrid read;  // a DEM of a few hundred MB is not copied
   if (!config.grid) read = LoadEsriGrid(config.dem_path);
-  const EsriGrid& dem = config.grid ? *config.grid : read;
+  if (config.area) {
+    try {
+      read = CropToArea(config.grid ? *config.grid : read, *config.area);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(config.dem_path.string() + ": " + e.what());
+    }
+  }
+  const EsriGrid& dem = config.grid && !config.area ? *config.grid : read;
   const DemPlacement placement = ChoosePlacement(config, dem);
   ProjectedDem projected = [&] {
     try {

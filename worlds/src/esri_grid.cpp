@@ -144,6 +144,44 @@ EsriGrid ParseEsriGrid(std::istream& in, const std::string& source) {
   return grid;
 }
 
+EsriGrid CropToArea(const EsriGrid& grid, const GridArea& area) {
+  // Columns and rows whose centres lie within the area (row 0 northernmost), inclusive: a centre
+  // on the area's edge (a round longitude on a 3" grid) counts. A millionth of a cell: headers
+  // round the cell size (SRTM's 1/1200 deg as 0.000833333333), 60 cells on 2.4e-8 cells off.
+  constexpr double kOnEdge = 1e-6;  // [cell]
+  const auto first = [](double index) { return static_cast<int>(std::ceil(index - kOnEdge)); };
+  const auto last = [](double index) { return static_cast<int>(std::floor(index + kOnEdge)); };
+  const double top = grid.yll_corner + grid.nrows * grid.cell_size_y;
+  const int col0 = std::max(0, first((area.x_min - grid.xll_corner) / grid.cell_size - 0.5));
+  const int col1 =
+      std::min(grid.ncols - 1, last((area.x_max - grid.xll_corner) / grid.cell_size - 0.5));
+  const int row0 = std::max(0, first((top - area.y_max) / grid.cell_size_y - 0.5));
+  const int row1 = std::min(grid.nrows - 1, last((top - area.y_min) / grid.cell_size_y - 0.5));
+  if (!(area.x_min < area.x_max && area.y_min < area.y_max) || col1 - col0 < 1 || row1 - row0 < 1) {
+    std::ostringstream os;
+    os.precision(10);
+    os << "the area x " << area.x_min << " .. " << area.x_max << ", y " << area.y_min << " .. "
+       << area.y_max << " holds fewer than 2 x 2 of the grid's cell centres (the grid spans x "
+       << grid.ColumnX(0) << " .. " << grid.ColumnX(grid.ncols - 1) << ", y "
+       << grid.RowY(grid.nrows - 1) << " .. " << grid.RowY(0) << " between cell centres)";
+    throw std::invalid_argument(os.str());
+  }
+  EsriGrid crop;  // not a copy of the grid: a DEM tile's values run to a few hundred MB
+  crop.ncols = col1 - col0 + 1;
+  crop.nrows = row1 - row0 + 1;
+  crop.xll_corner = grid.xll_corner + col0 * grid.cell_size;
+  crop.yll_corner = grid.yll_corner + (grid.nrows - 1 - row1) * grid.cell_size_y;
+  crop.cell_size = grid.cell_size;
+  crop.cell_size_y = grid.cell_size_y;
+  crop.nodata_value = grid.nodata_value;
+  crop.values.reserve(static_cast<std::size_t>(crop.ncols) * crop.nrows);
+  for (int row = row0; row <= row1; ++row) {
+    const auto first = grid.values.begin() + static_cast<std::ptrdiff_t>(row) * grid.ncols;
+    crop.values.insert(crop.values.end(), first + col0, first + col1 + 1);
+  }
+  return crop;
+}
+
 EsriGrid LoadEsriGrid(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path.string() + ": cannot open ESRI ASCII grid");

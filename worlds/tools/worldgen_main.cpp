@@ -1,5 +1,6 @@
 // pitchlab_worldgen: writes the procedural worlds (and worlds from users' DEMs). A thin shell over
 // the worlds library: parse flags, call one generator, report errors once with a non-zero exit.
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <iostream>
@@ -22,12 +23,14 @@ commands:
   gully --dem FILE.asc --out DIR [--relief-seed N] [--cell M]
       the West Bijou gully (3 m DEM, UTM 13N) -> DIR/gully.xml + DIR/gully_hfield.bin
   dem --in FILE --out DIR/NAME.xml [--utm-zone 13N | --geographic | --local]
-      [--cell M] [--relief-seed N]
+      [--area XMIN,YMIN,XMAX,YMAX] [--cell M] [--relief-seed N]
       a DEM -> NAME.xml + NAME_hfield.bin: an ESRI ASCII grid (.asc, with its .prj) or a raster
       GDAL reads (GeoTIFF .tif, SRTM .hgt, .img, .vrt: band 1, heights in metres or feet).
       Placed from the file's coordinate system (longitude/latitude, UTM, local metres) unless
       one of the three options says how to read x, y; without one, local metres. The geodetic
-      origin is the valid data's centre (UTM and lon/lat taken on WGS84)
+      origin is the valid data's centre (UTM and lon/lat taken on WGS84). --area builds the
+      part whose cell centres lie in the rectangle, in the DEM's own coordinates (easting,
+      northing or x, y in metres; longitude, latitude in degrees): a DEM tile is kilometres wide
 
 options:
   --cell M   output vertex spacing [m] (terrain 0.1, gully 0.15, dem 0.2)
@@ -75,8 +78,7 @@ double NumberFlag(const std::map<std::string, std::string>& flags, const std::st
     used = 0;
   }
   if (used != it->second.size() || !(value > 0.0)) {
-    throw UsageError("option " + key + ": expected a positive number, got '" +
-                                it->second + "'");
+    throw UsageError("option " + key + ": expected a positive number, got '" + it->second + "'");
   }
   return value;
 }
@@ -87,10 +89,31 @@ std::uint64_t SeedFlag(const std::map<std::string, std::string>& flags, const st
   if (it == flags.end()) return fallback;
   const std::string& text = it->second;
   if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos) {
-    throw UsageError("option " + key + ": expected a non-negative integer, got '" +
-                                text + "'");
+    throw UsageError("option " + key + ": expected a non-negative integer, got '" + text + "'");
   }
   return std::stoull(text);
+}
+
+// "--area XMIN,YMIN,XMAX,YMAX": four numbers, each minimum below its maximum.
+pitchlab::worlds::GridArea AreaFlag(const std::string& text) {
+  double v[4] = {};
+  std::size_t at = 0;
+  for (int k = 0; k < 4; ++k) {
+    const std::size_t end = k < 3 ? text.find(',', at) : text.size();
+    const std::string part = end == std::string::npos ? "" : text.substr(at, end - at);
+    char* stop = nullptr;
+    v[k] = std::strtod(part.c_str(), &stop);
+    if (part.empty() || *stop != '\0' || !std::isfinite(v[k])) {
+      throw UsageError("option --area: expected XMIN,YMIN,XMAX,YMAX (four numbers), got '" + text +
+                       "'");
+    }
+    at = end + 1;
+  }
+  if (!(v[0] < v[2] && v[1] < v[3])) {
+    throw UsageError("option --area: XMIN,YMIN,XMAX,YMAX needs XMIN < XMAX and YMIN < YMAX, got '" +
+                     text + "'");
+  }
+  return {v[0], v[1], v[2], v[3]};
 }
 
 void CheckKnown(const std::map<std::string, std::string>& flags,
@@ -130,13 +153,14 @@ int Run(int argc, char** argv) {
     std::cout << GenerateGullyWorld(config, Require(flags, "--out")).string() << "\n";
   } else if (command == "dem") {
     CheckKnown(flags, {"--in", "--out", "--utm-zone", "--geographic", "--local", "--cell",
-                       "--relief-seed"});
+                       "--relief-seed", "--area"});
     DemWorldConfig config;
     config.dem_path = Require(flags, "--in");
     const bool placement_given =
         flags.count("--utm-zone") + flags.count("--geographic") + flags.count("--local") > 0;
     config.cell_m = NumberFlag(flags, "--cell", config.cell_m);
     if (flags.count("--relief-seed")) config.relief_seed = SeedFlag(flags, "--relief-seed", 0);
+    if (flags.count("--area")) config.area = AreaFlag(flags.at("--area"));
     if (flags.count("--utm-zone") + flags.count("--geographic") + flags.count("--local") > 1) {
       throw UsageError("give at most one of --utm-zone, --geographic, --local");
     }
@@ -158,7 +182,14 @@ int Run(int argc, char** argv) {
         pitchlab::worldgen::ReadDemInput(config.dem_path, placement_given);
     if (!placement_given) config.placement = input.placement;
     config.grid = std::move(input.grid);
-    GenerateDemWorld(config, out);
+    try {
+      GenerateDemWorld(config, out);
+    } catch (const std::invalid_argument& e) {
+      // A DEM tile is kilometres wide: too many vertices at the cell asked for.
+      const std::string what = e.what();
+      if (config.area || what.find("needs a cell of at least") == std::string::npos) throw;
+      throw std::invalid_argument(what + " (or build a part of it: --area)");
+    }
     std::cout << out << "\n";
   } else {
     throw UsageError("unknown command '" + command + "'");

@@ -15,6 +15,9 @@ struct DemWorldConfig {
   /// The DEM already read (a GeoTIFF, through mapping's ReadDemGrid in pitchlab_worldgen);
   /// absent: dem_path is read as an ESRI ASCII grid.
   std::optional<EsriGrid> grid;
+  /// The part of the DEM the world is built of, in the DEM's own coordinates (CropToArea);
+  /// absent: all of it.
+  std::optional<GridArea> area;
   std::optional<DemPlacement> placement;     ///< absent: lon/lat if a .prj says GEOGCS, else local
   double cell_m = 0.2;                       ///< output vertex spacing [m]
   std::optional<std::uint64_t> relief_seed;  ///< add seeded rocks and cracks when given

@@ -32,6 +32,16 @@ struct EsriGrid {
   double RowY(double row) const { return yll_corner + (nrows - row - 0.5) * cell_size_y; }
 };
 
+/// A rectangle in a grid's own coordinates (metres, or longitude and latitude in degrees).
+struct GridArea {
+  double x_min = 0.0, y_min = 0.0, x_max = 0.0, y_max = 0.0;  ///< [file units]
+};
+
+/// The cells of `grid` whose centres lie in `area` (a DEM tile is kilometres wide, a robot's
+/// world a few hundred metres). Throws std::invalid_argument naming the grid's extent when
+/// fewer than 2 x 2 cells do.
+EsriGrid CropToArea(const EsriGrid& grid, const GridArea& area);
+
 /// Parses an ESRI ASCII grid: header keys in any order and case (ncols, nrows, xllcorner or
 /// xllcenter, yllcorner or yllcenter, cellsize, optional NODATA_value), then nrows * ncols numbers.
 /// Throws std::runtime_error naming `source_name`, the line and the problem (missing or duplicate
