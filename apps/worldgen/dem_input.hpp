@@ -2,7 +2,7 @@
 // pitchlab_worldgen's DEM input: any DEM pitchlab reads (an ESRI grid with its .prj, a GeoTIFF or
 // another raster GDAL reads), as the worlds library's grid and the placement its coordinate
 // system gives. It reads through mapping's DEM reader, which `pitchlab plan` uses: a world and a
-// plan built from one file read it alike. A tool may use every module; the worlds library may not.
+// plan built from one file read it alike. An app may use every module; the worlds library may not.
 
 #include <filesystem>
 #include <optional>

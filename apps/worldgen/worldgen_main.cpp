@@ -1,5 +1,6 @@
 // pitchlab_worldgen: writes the procedural worlds (and worlds from users' DEMs). A thin shell over
-// the worlds library: parse flags, call one generator, report errors once with a non-zero exit.
+// the worlds library (and mapping's DEM reader): parse flags, call one generator, report errors
+// once: exit 2 for a mistake on the command line, 1 for one in what it names.
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
