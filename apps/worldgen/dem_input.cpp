@@ -61,7 +61,9 @@ DemInput ReadDemInput(const std::filesystem::path& path, bool placement_given) {
   DemInput input;
   if (!placement_given) {
     Result<mapping::DemCrs> crs = mapping::CrsOf(*read);
-    if (!crs) throw std::invalid_argument(crs.error().message + " (or give --utm-zone, --geographic or --local)");
+    if (!crs)
+      throw std::invalid_argument(crs.error().message +
+                                  " (or give --utm-zone, --geographic or --local)");
     input.placement = PlacementOf(*crs, path);
   }
   mapping::AsciiGrid& g = read->grid;

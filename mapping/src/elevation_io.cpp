@@ -16,7 +16,8 @@ namespace pitchlab::mapping {
 namespace {
 
 constexpr char kMagic[8] = {'P', 'L', 'E', 'L', 'E', 'V', '0', '2'};
-constexpr char kMagicDense[8] = {'P', 'L', 'E', 'L', 'E', 'V', '0', '1'};  // read, no longer written
+// Every record in order, no runs: read, no longer written.
+constexpr char kMagicDense[8] = {'P', 'L', 'E', 'L', 'E', 'V', '0', '1'};
 static_assert(sizeof(CellStats) == 52, "the .plem record layout is 13 packed 4-byte fields");
 
 // A cell nothing reached: no point, no ray (CellStats' defaults, byte for byte: 13 packed fields).
@@ -92,7 +93,8 @@ Result<void> SaveElevationMap(const ElevationMap& map, const std::string& path) 
     while (end < cells.size() && !Unseen(cells[end])) ++end;
     Put(out, static_cast<std::uint32_t>(seen - k));  // a grid holds at most 2^31 cells
     Put(out, static_cast<std::uint32_t>(end - seen));
-    out.append(reinterpret_cast<const char*>(cells.data() + seen), (end - seen) * sizeof(CellStats));
+    out.append(reinterpret_cast<const char*>(cells.data() + seen),
+               (end - seen) * sizeof(CellStats));
     k = end;
   }
   Put(out, Fnv1a(out));
