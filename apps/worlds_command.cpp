@@ -20,7 +20,9 @@ int RunWorlds(int argc, char** argv) {
   CliArgs args("worlds",
                "Lists the built-in worlds: description, placement bounds, the default run's\n"
                "start and goal (what `run` and `bench` use without --start / --goal) and\n"
-               "geodetic origin. Any MJCF file is a world too (--world path/to/scene.xml).");
+               "geodetic origin. Any MJCF file is a world too (--world path/to/scene.xml), and\n"
+               "pitchlab_worldgen (beside this program) makes one of a DEM: `pitchlab_worldgen\n"
+               "dem --in DEM.tif --area XMIN,YMIN,XMAX,YMAX --out my/site.xml` (see its --help).");
   args.Flag("json", "print the list as JSON on stdout");
   if (!args.Parse(argc, argv)) return 0;
   nlohmann::json list = nlohmann::json::array();
@@ -77,6 +79,7 @@ int RunWorlds(int argc, char** argv) {
                 start.c_str(), goal.c_str(), w["description"].get<std::string>().c_str());
   }
   std::printf("\nworld files in %s\n", WorldsDir().string().c_str());
+  std::printf("a world of your own DEM (GeoTIFF, ESRI grid): pitchlab_worldgen dem --help\n");
   return 0;
 }
 
