@@ -1,15 +1,19 @@
 #include "pitchlab/mapping/elevation_io.hpp"
 
+#include <unistd.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <new>
 #include <sstream>
 #include <string_view>
 
 #include "pitchlab/mapping/atomic_file.hpp"
+#include "pitchlab/sensors/number_text.hpp"
 #include "pitchlab/sensors/scan3d.hpp"
 
 namespace pitchlab::mapping {
@@ -185,7 +189,25 @@ Result<ElevationMap> LoadElevationMap(const std::string& path) {
   g.size_x = sx;
   g.size_y = sy;
   const std::size_t end = bytes.size() - 8;  // the hash
-  std::vector<CellStats> cells(g.cell_count());
+  // Runs describe a grid in a few bytes, so its size is checked before it is allocated: a 100-byte
+  // file with a valid hash asked for 17 GB (a mutated header, corrupt_map_test.cpp). At most what
+  // GridGeometry makes (2^31 cells) and what this machine's memory holds.
+  const double grid_bytes = static_cast<double>(g.cell_count()) * sizeof(CellStats);
+  const double memory_bytes = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) *
+                              static_cast<double>(::sysconf(_SC_PAGE_SIZE));
+  if (g.cell_count() > 2147483647u || grid_bytes > memory_bytes) {
+    return bad("a grid of " + std::to_string(sx) + " x " + std::to_string(sy) + " cells (" +
+               NumberText(grid_bytes / 1e9) + " GB) is more than a map holds or this machine's " +
+               NumberText(memory_bytes / 1e9) + " GB of memory");
+  }
+  std::vector<CellStats> cells;
+  try {
+    cells.resize(g.cell_count());
+  } catch (const std::bad_alloc&) {
+    return Fail(Error::Code::kFailed, path + ": not enough memory for its grid of " +
+                                          std::to_string(sx) + " x " + std::to_string(sy) +
+                                          " cells (" + NumberText(grid_bytes / 1e9) + " GB)");
+  }
   if (dense) {  // every record in order
     const std::size_t cells_bytes = g.cell_count() * sizeof(CellStats);
     if (pos + cells_bytes != end) return bad("size does not match the grid");

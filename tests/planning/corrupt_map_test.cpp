@@ -2,9 +2,12 @@
 // numbers are not a map's is refused on load, and no path file ever holds a non-finite number.
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
+#include <random>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -78,6 +81,72 @@ TEST_F(CorruptMap, AFolderATruncatedAndAnEmptyFileAreRefusedByName) {
   const auto empty = mapping::LoadElevationMap((dir_ / "empty.plem").string());
   ASSERT_FALSE(empty);
   EXPECT_NE(empty.error().message.find("bad magic"), std::string::npos) << empty.error().message;
+}
+
+// The .plem's runs of unseen cells (PLELEV02) are lengths read from the file: mangled ones must
+// never send the reader past the grid or the file, even when the hash was written anew for them
+// (a crafted file). 3000 mutations of a sparse map (1-4 bytes changed in its cell runs, or the
+// file cut or lengthened), each with its hash recomputed: every one loads as a whole map or is
+// refused as "not a pitchlab elevation map", never a crash (the sanitizer build checks the reads).
+// A header whose grid no memory holds is refused before anything is allocated: mutated anywhere,
+// the first such run of this test asked for 17 GB and died of std::bad_alloc.
+TEST_F(CorruptMap, MangledCellRunsWithAValidHashAreRefusedNotFollowed) {
+  const GridGeometry g = GridGeometry::FromArea(0, 0, 3.0, 2.0, 0.1);  // 30 x 20 cells
+  const std::string path = Saved(g, [](auto& cells) {
+    for (std::size_t k = 0; k < cells.size(); ++k)
+      if (k % 7 != 0 && k % 11 != 0) cells[k] = mapping::CellStats{};  // unseen
+  });
+  std::ifstream in(path, std::ios::binary);
+  const std::string good((std::istreambuf_iterator<char>(in)), {});
+  ASSERT_EQ(good.substr(0, 8), "PLELEV02");
+  const auto fnv1a = [](const std::string& bytes) {
+    std::uint64_t h = 1469598103934665603ull;
+    for (unsigned char c : bytes) h = (h ^ c) * 1099511628211ull;
+    return h;
+  };
+  std::mt19937 rng(38);
+  int loaded = 0, refused = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    std::string body = good.substr(0, good.size() - 8);
+    switch (trial % 4) {
+      case 0:  // cut
+        body.resize(8 + rng() % (body.size() - 8));
+        break;
+      case 1:  // lengthened
+        body.append(1 + rng() % 64, static_cast<char>(rng()));
+        break;
+      default:  // 1-4 bytes changed after the header (72 bytes): the runs and the records
+        for (int b = 0, n = 1 + rng() % 4; b < n; ++b)
+          body[72 + rng() % (body.size() - 72)] = static_cast<char>(rng());
+    }
+    const std::uint64_t hash = fnv1a(body);
+    body.append(reinterpret_cast<const char*>(&hash), 8);
+    std::ofstream(dir_ / "mangled.plem", std::ios::binary | std::ios::trunc) << body;
+    const auto map = mapping::LoadElevationMap((dir_ / "mangled.plem").string());
+    if (map) {
+      ++loaded;
+      ASSERT_EQ(map->cells().size(), map->geometry().cell_count()) << "trial " << trial;
+    } else {
+      ++refused;
+      ASSERT_NE(map.error().message.find("not a pitchlab elevation map"), std::string::npos)
+          << "trial " << trial << ": " << map.error().message;
+    }
+  }
+  EXPECT_GT(refused, 1000);  // the mutations reach the checks, not only harmless values
+  EXPECT_GT(loaded, 0);      // and some change only a value, which loads
+
+  std::string huge = good.substr(0, good.size() - 8);
+  const std::int32_t side = 1 << 30;  // 2^60 cells
+  std::memcpy(huge.data() + 32, &side, 4);
+  std::memcpy(huge.data() + 36, &side, 4);
+  const std::uint64_t hash = fnv1a(huge);
+  huge.append(reinterpret_cast<const char*>(&hash), 8);
+  std::ofstream(dir_ / "huge.plem", std::ios::binary | std::ios::trunc) << huge;
+  const auto refused_huge = mapping::LoadElevationMap((dir_ / "huge.plem").string());
+  ASSERT_FALSE(refused_huge);
+  EXPECT_NE(refused_huge.error().message.find("a grid of 1073741824 x 1073741824 cells"),
+            std::string::npos)
+      << refused_huge.error().message;
 }
 
 TEST_F(CorruptMap, APathWithoutFinitePositionsIsNotWritten) {
