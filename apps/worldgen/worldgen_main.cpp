@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <map>
+#include <new>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -206,6 +207,10 @@ int main(int argc, char** argv) {
   } catch (const UsageError& e) {
     std::cerr << "pitchlab_worldgen: " << e.what() << " (see pitchlab_worldgen --help)\n";
     return 2;
+  } catch (const std::bad_alloc&) {  // a DEM header's size, or a cell too fine for the DEM
+    std::cerr << "pitchlab_worldgen: out of memory: the DEM (a size in its header) or --cell "
+                 "asks for more than this machine has\n";
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "pitchlab_worldgen: " << e.what() << "\n";
     return 1;

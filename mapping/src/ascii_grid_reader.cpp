@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -114,9 +115,19 @@ Result<AsciiGrid> ReadAsciiGrid(const std::string& path) {
     if (header.count(lower)) return bad(number, "header field '" + key + "' is given twice");
     header[lower] = {value, number};
   }
-  Result<AsciiGrid> grid = GridFromHeader(header, path, first_data_line ? first_data_line : number);
+  const int grid_line = first_data_line ? first_data_line : number;
+  Result<AsciiGrid> grid = GridFromHeader(header, path, grid_line);
   if (!grid) return grid;
   const std::size_t expected = static_cast<std::size_t>(grid->ncols) * grid->nrows;
+  // Each value takes a byte and a separator at least: a header that asks for more values than the
+  // file can hold is wrong, and is said before its count is allocated (10^16 cells, 80 PB).
+  std::error_code size_error;
+  const std::uintmax_t file_bytes = std::filesystem::file_size(path, size_error);
+  if (!size_error && expected > file_bytes / 2 + 1)
+    return bad(grid_line, "nrows x ncols = " + std::to_string(grid->nrows) + " x " +
+                              std::to_string(grid->ncols) + " = " + std::to_string(expected) +
+                              " values, more than the file's " + std::to_string(file_bytes) +
+                              " bytes can hold");
   grid->values.reserve(expected);
   const auto consume = [&](const std::string& text, int at) -> Result<void> {
     std::istringstream tokens(text);

@@ -91,6 +91,9 @@ TEST(AsciiGrid, BadFilesNameTheFileAndTheLine) {
       {"ncols 1\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\ndx 1\n1\n",
        ":6:", "'dx' is neither"},
       {"ncols 1\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n1e999\n", ":6:", "not a finite"},
+      // 10^16 values asked of 71 bytes: refused before they are allocated (worldgen died of it).
+      {"ncols 100000000\nnrows 100000000\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n", ":6:",
+       "= 10000000000000000 values, more than the file's 71 bytes can hold"},
   };
   for (const auto& c : cases) {
     const fs::path asc = dir / "bad.asc";

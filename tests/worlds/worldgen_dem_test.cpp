@@ -258,6 +258,19 @@ TEST(WorldgenDem, ACoordinateSystemAWorldCannotTakeIsRefusedNamingTheFile) {
     EXPECT_EQ(local.exit_code, 0) << c.file << ": " << local.err;
     EXPECT_TRUE(test::LoadModel(out)) << c.file;
   }
+  // A header asking for 10^16 cells is refused before they are allocated (it died of
+  // std::bad_alloc): the file cannot hold them.
+  test::WriteText(dir / "huge.asc",
+                  "ncols 100000000\nnrows 100000000\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n");
+  const Outcome huge = Worldgen(
+      "dem --in " + (dir / "huge.asc").string() + " --local --out " + (dir / "huge.xml").string(),
+      dir.path());
+  EXPECT_EQ(huge.exit_code, 1);
+  EXPECT_NE(huge.err.find("huge.asc:6: nrows x ncols = 100000000 x 100000000 = "
+                          "10000000000000000 values, more than the file's 71 bytes can hold"),
+            std::string::npos)
+      << huge.err;
+  EXPECT_FALSE(fs::exists(dir / "huge.xml"));
   test::WriteText(dir / "photo.tif", "this is no raster\n");
   const fs::path out = dir / "photo.xml";
   const Outcome junk =

@@ -117,7 +117,8 @@ EsriGrid ParseEsriGrid(std::istream& in, const std::string& source) {
   EsriGrid grid = MakeGrid(header, source);
 
   const size_t expected = static_cast<size_t>(grid.ncols) * grid.nrows;
-  grid.values.reserve(expected);
+  // Reserved up to a million values: the header's count is the file's word (up to 10^16).
+  grid.values.reserve(std::min<size_t>(expected, size_t{1} << 20));
   auto consume = [&](const std::string& text, int number) {
     std::istringstream tokens(text);
     std::string token;
