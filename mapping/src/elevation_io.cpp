@@ -146,6 +146,36 @@ std::string InvalidValues(const GridGeometry& g, const GeodeticOrigin* geo,
   return "";
 }
 
+// The cell records after the header at `pos` into `cells` (sized to the grid): every record in
+// order (PLELEV01), or runs of unseen and seen cells (PLELEV02), none reaching past the grid or
+// the file's hash. Why they do not fit, or empty.
+std::string ReadCells(const std::string& bytes, std::size_t pos, bool dense,
+                      std::vector<CellStats>& cells) {
+  const std::size_t end = bytes.size() - 8;  // the hash
+  if (dense) {
+    const std::size_t cells_bytes = cells.size() * sizeof(CellStats);
+    if (pos + cells_bytes != end) return "size does not match the grid";
+    std::memcpy(cells.data(), bytes.data() + pos, cells_bytes);
+    return "";
+  }
+  for (std::size_t k = 0; k < cells.size();) {
+    std::uint32_t unseen = 0, seen = 0;
+    if (pos + 8 > end || !Get(bytes, pos, &unseen) || !Get(bytes, pos, &seen))
+      return "cell runs end before cell " + std::to_string(k) + " of " +
+             std::to_string(cells.size());
+    if (unseen + std::uint64_t{seen} == 0 || k + unseen + std::uint64_t{seen} > cells.size())
+      return "a run of " + std::to_string(unseen) + " + " + std::to_string(seen) +
+             " cells at cell " + std::to_string(k) + " does not fit the grid of " +
+             std::to_string(cells.size());
+    k += unseen;  // left at CellStats' defaults
+    if (pos + std::uint64_t{seen} * sizeof(CellStats) > end) return "truncated cell records";
+    std::memcpy(cells.data() + k, bytes.data() + pos, seen * sizeof(CellStats));
+    pos += seen * sizeof(CellStats);
+    k += seen;
+  }
+  return pos == end ? "" : "size does not match the grid";
+}
+
 }  // namespace
 
 Result<ElevationMap> LoadElevationMap(const std::string& path) {
@@ -188,7 +218,6 @@ Result<ElevationMap> LoadElevationMap(const std::string& path) {
   if (sx <= 0 || sy <= 0 || !(g.cell_m > 0)) return bad("empty grid");
   g.size_x = sx;
   g.size_y = sy;
-  const std::size_t end = bytes.size() - 8;  // the hash
   // Runs describe a grid in a few bytes, so its size is checked before it is allocated: a 100-byte
   // file with a valid hash asked for 17 GB (a mutated header, corrupt_map_test.cpp). At most what
   // GridGeometry makes (2^31 cells) and what this machine's memory holds.
@@ -208,28 +237,7 @@ Result<ElevationMap> LoadElevationMap(const std::string& path) {
                                           std::to_string(sx) + " x " + std::to_string(sy) +
                                           " cells (" + NumberText(grid_bytes / 1e9) + " GB)");
   }
-  if (dense) {  // every record in order
-    const std::size_t cells_bytes = g.cell_count() * sizeof(CellStats);
-    if (pos + cells_bytes != end) return bad("size does not match the grid");
-    std::memcpy(cells.data(), bytes.data() + pos, cells_bytes);
-  } else {
-    for (std::size_t k = 0; k < cells.size();) {
-      std::uint32_t unseen = 0, seen = 0;
-      if (pos + 8 > end || !Get(bytes, pos, &unseen) || !Get(bytes, pos, &seen))
-        return bad("cell runs end before cell " + std::to_string(k) + " of " +
-                   std::to_string(cells.size()));
-      if (unseen + std::uint64_t{seen} == 0 || k + unseen + std::uint64_t{seen} > cells.size())
-        return bad("a run of " + std::to_string(unseen) + " + " + std::to_string(seen) +
-                   " cells at cell " + std::to_string(k) + " does not fit the grid of " +
-                   std::to_string(cells.size()));
-      k += unseen;  // left at CellStats' defaults
-      if (pos + std::uint64_t{seen} * sizeof(CellStats) > end) return bad("truncated cell records");
-      std::memcpy(cells.data() + k, bytes.data() + pos, seen * sizeof(CellStats));
-      pos += seen * sizeof(CellStats);
-      k += seen;
-    }
-    if (pos != end) return bad("size does not match the grid");
-  }
+  if (const std::string why = ReadCells(bytes, pos, dense, cells); !why.empty()) return bad(why);
   // The hash proves the bytes are as written, not that a writer wrote numbers: a crafted or
   // foreign file with an infinite cell or a NaN height would plan "paths" of NaN coordinates.
   if (const std::string why = InvalidValues(g, has_geo ? &geo : nullptr, cells); !why.empty())
