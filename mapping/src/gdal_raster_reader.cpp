@@ -6,6 +6,7 @@
 #include <cpl_error.h>
 #include <cpl_vsi.h>
 #include <dlfcn.h>
+#include <unistd.h>
 #include <gdal.h>
 #include <ogr_srs_api.h>
 
@@ -251,6 +252,17 @@ Result<RasterDem> ReadGdalRaster(const std::string& path) {
     return bad("its cells are " + NumberText(dx) + " by " + NumberText(gt[5]) + ": not a grid");
   }
   const int nx = Gdal().GetRasterXSize(d), ny = Gdal().GetRasterYSize(d);
+  // A tiled, compressed or sparse raster describes its size in a few bytes: one no memory holds
+  // is refused before its heights are read (a 3 KB GeoTIFF can say 200000 x 200000).
+  const double height_bytes = static_cast<double>(nx) * ny * sizeof(double);
+  const double memory_bytes = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) *
+                              static_cast<double>(::sysconf(_SC_PAGE_SIZE));
+  if (height_bytes > memory_bytes) {
+    return bad("its " + std::to_string(nx) + " x " + std::to_string(ny) + " cells (" +
+               NumberText(height_bytes / 1e9) + " GB of heights) are more than this machine's " +
+               NumberText(memory_bytes / 1e9) +
+               " GB of memory: cut the part you need (gdal_translate -projwin)");
+  }
   Result<std::vector<double>> heights =
       Heights(Gdal().GetRasterBand(d, 1), nx, ny, gt[5] > 0, path);
   if (!heights) return tl::make_unexpected(heights.error());

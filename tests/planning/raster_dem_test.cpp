@@ -246,6 +246,18 @@ TEST(RasterDem, RastersPitchlabCannotTakeAreRefusedSayingWhy) {
   refused(dir / "nocrs.tif", "looks like degrees, but the file gives no coordinate system");
   std::ofstream(dir / "text.tif") << "not a raster\n";
   refused(dir / "text.tif", "cannot be read as a raster");
+  {  // 200000 x 200000 cells in a few KB (sparse tiles): 320 GB of heights, refused unread
+    GDALAllRegister();
+    const char* options[] = {"TILED=YES", "SPARSE_OK=TRUE", "COMPRESS=DEFLATE", nullptr};
+    GDALDatasetH d = GDALCreate(GDALGetDriverByName("GTiff"), (dir / "vast.tif").string().c_str(),
+                                200000, 200000, 1, GDT_Float32, const_cast<char**>(options));
+    ASSERT_NE(d, nullptr);
+    double vast_gt[6] = {0, 1, 0, 0, 0, -1};
+    GDALSetGeoTransform(d, vast_gt);
+    GDALClose(d);
+  }
+  ASSERT_LT(fs::file_size(dir / "vast.tif"), 10'000'000u);
+  refused(dir / "vast.tif", "its 200000 x 200000 cells (320 GB of heights) are more than this");
   refused(dir / "missing.tif", "cannot be read: No such file or directory");
   // And one it can: the same 0.0003 deg cells with EPSG:4326 set.
   WriteGeoTiff(dir / "wgs84.tif", 4, 4, 1, degrees, flat, EpsgWkt(4326).c_str());
