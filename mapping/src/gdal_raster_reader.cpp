@@ -253,7 +253,7 @@ Result<RasterDem> ReadGdalRaster(const std::string& path) {
   }
   const int nx = Gdal().GetRasterXSize(d), ny = Gdal().GetRasterYSize(d);
   // A tiled, compressed or sparse raster describes its size in a few bytes: one no memory holds
-  // is refused before its heights are read (a 3 KB GeoTIFF can say 200000 x 200000).
+  // is refused before its heights are read (a 5 MB GeoTIFF of sparse tiles says 200000 x 200000).
   const double height_bytes = static_cast<double>(nx) * ny * sizeof(double);
   const double memory_bytes = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) *
                               static_cast<double>(::sysconf(_SC_PAGE_SIZE));

@@ -246,7 +246,7 @@ TEST(RasterDem, RastersPitchlabCannotTakeAreRefusedSayingWhy) {
   refused(dir / "nocrs.tif", "looks like degrees, but the file gives no coordinate system");
   std::ofstream(dir / "text.tif") << "not a raster\n";
   refused(dir / "text.tif", "cannot be read as a raster");
-  {  // 200000 x 200000 cells in a few KB (sparse tiles): 320 GB of heights, refused unread
+  {  // 200000 x 200000 cells in 5 MB (sparse tiles: their index only): 320 GB of heights, refused
     GDALAllRegister();
     const char* options[] = {"TILED=YES", "SPARSE_OK=TRUE", "COMPRESS=DEFLATE", nullptr};
     GDALDatasetH d = GDALCreate(GDALGetDriverByName("GTiff"), (dir / "vast.tif").string().c_str(),
