@@ -20,6 +20,7 @@
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/elevation_map.hpp"
+#include "pitchlab/mapping/physical_memory.hpp"
 #include "pitchlab/mapping/elevation_truth.hpp"
 #include "pitchlab/mapping/ground_level.hpp"
 #include "pitchlab/mission/map_figure.hpp"
@@ -176,8 +177,8 @@ std::string StrayPoint(const std::vector<LoadedCloud>& clouds,
 // names nothing a user can act on): empty when they fit, else what they would take.
 std::string MemoryShortfall(const mapping::GridGeometry& g) {
   const double bytes = double(g.cell_count()) * mapping::ElevationMap::kBytesPerCell;
-  const double memory = double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGE_SIZE));
-  if (memory <= 0 || bytes <= memory) return "";
+  const double memory = mapping::PhysicalMemoryBytes();
+  if (bytes <= memory) return "";
   char text[200];
   std::snprintf(text, sizeof(text),
                 "the map would be %d x %d cells of %g m, %.3g GB, more than this machine's "

@@ -1,7 +1,5 @@
 #include "pitchlab/mapping/elevation_io.hpp"
 
-#include <unistd.h>
-
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +11,7 @@
 #include <string_view>
 
 #include "pitchlab/mapping/atomic_file.hpp"
+#include "pitchlab/mapping/physical_memory.hpp"
 #include "pitchlab/sensors/number_text.hpp"
 #include "pitchlab/sensors/scan3d.hpp"
 
@@ -222,8 +221,7 @@ Result<ElevationMap> LoadElevationMap(const std::string& path) {
   // file with a valid hash asked for 17 GB (a mutated header, corrupt_map_test.cpp). At most what
   // GridGeometry makes (2^31 cells) and what this machine's memory holds.
   const double grid_bytes = static_cast<double>(g.cell_count()) * sizeof(CellStats);
-  const double memory_bytes = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) *
-                              static_cast<double>(::sysconf(_SC_PAGE_SIZE));
+  const double memory_bytes = PhysicalMemoryBytes();
   if (g.cell_count() > 2147483647u || grid_bytes > memory_bytes) {
     return bad("a grid of " + std::to_string(sx) + " x " + std::to_string(sy) + " cells (" +
                NumberText(grid_bytes / 1e9) + " GB) is more than a map holds or this machine's " +

@@ -6,7 +6,6 @@
 #include <cpl_error.h>
 #include <cpl_vsi.h>
 #include <dlfcn.h>
-#include <unistd.h>
 #include <gdal.h>
 #include <ogr_srs_api.h>
 
@@ -21,6 +20,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "pitchlab/mapping/physical_memory.hpp"
 #include "pitchlab/sensors/number_text.hpp"
 
 namespace pitchlab::mapping::internal {
@@ -255,8 +255,7 @@ Result<RasterDem> ReadGdalRaster(const std::string& path) {
   // A tiled, compressed or sparse raster describes its size in a few bytes: one no memory holds
   // is refused before its heights are read (a 5 MB GeoTIFF of sparse tiles says 200000 x 200000).
   const double height_bytes = static_cast<double>(nx) * ny * sizeof(double);
-  const double memory_bytes = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) *
-                              static_cast<double>(::sysconf(_SC_PAGE_SIZE));
+  const double memory_bytes = PhysicalMemoryBytes();
   if (height_bytes > memory_bytes) {
     return bad("its " + std::to_string(nx) + " x " + std::to_string(ny) + " cells (" +
                NumberText(height_bytes / 1e9) + " GB of heights) are more than this machine's " +
