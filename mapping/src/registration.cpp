@@ -159,6 +159,18 @@ FreeSpaceCheck FreeSpaceAround(const IcpTarget& target, const PointCloud& source
   return FreeSpaceCheck(target.seen, source, target.source_seen, target.points, at);
 }
 
+// The free-space evidence at `T` from both views (FreeSpaceAt).
+RegistrationResult::FreeSpace FreeSpaceOf(const IcpTarget& target, const PointCloud& source,
+                                          const Eigen::Isometry3d& T) {
+  return FreeSpaceAt(target.seen, source, target.source_seen, target.points, T);
+}
+
+// Why free space refutes `T` outright (FreeSpaceRefutation), or empty.
+std::string FreeSpaceRejection(const IcpTarget& target, const PointCloud& source,
+                               const Eigen::Isometry3d& T) {
+  return FreeSpaceRefutation(FreeSpaceOf(target, source, T), source.size(), target.points.size());
+}
+
 // ICP restarted off `at` along a weak direction, one way (sign +1) or the other (-1), and whether
 // it ended away (beyond a quarter of the restart's offset), i.e. did not come back.
 struct Probe {
@@ -1256,9 +1268,12 @@ FeatureStage AlignByFeatures(const Stages& s, Progress& run) {
     return stage;
   }
   const Verified v = RefineInitialAlignment(s, sac, run.out);
-  const std::string rejection = Rejection(v.icp, s.prior, s.config);
+  std::string rejection = Rejection(v.icp, s.prior, s.config);
   if (s.config.backend == RegistrationBackend::kFast && rejection.empty()) {
-    stage.ambiguous = AmbiguousDirections(s.scene.target, s.scene.source, v.icp, s.config);
+    rejection = FreeSpaceRejection(s.scene.target, s.scene.source, v.icp.T_target_source);
+    if (rejection.empty()) {
+      stage.ambiguous = AmbiguousDirections(s.scene.target, s.scene.source, v.icp, s.config);
+    }
   }
   run.out.timings.icp_s += run.lap.Lap();
   Fill(run.out, v.icp, v.path);
@@ -1347,6 +1362,9 @@ Verdict AlignFromGuess(const Stages& s, const Weakness& ambiguous, Progress& run
   FromGuess g = IcpFromGuess(s.scene.target, s.scene.source, s.prep, guess->T, guess->path,
                              ambiguous, s.prior, s.config);
   const bool searched = SearchAroundRejectedGuess(s, *guess, g, run);
+  if (s.config.backend == RegistrationBackend::kFast && g.rejection.empty()) {
+    g.rejection = FreeSpaceRejection(s.scene.target, s.scene.source, g.icp.T_target_source);
+  }
   run.out.timings.icp_s += run.lap.Lap();
   Fill(run.out, g.icp, guess->path);
   if (!g.descended.empty()) run.notes.push_back(g.descended);
@@ -1415,6 +1433,9 @@ void Finish(const Stages& s, const Verdict& verdict, Progress& run) {
     run.out.timings.icp_s += run.lap.Lap();
   }
   Conclude(run.out, verdict.ambiguous, verdict.frozen, s.prior, s.config);
+  if (run.out.iterations > 0) {
+    run.out.free_space = FreeSpaceOf(s.scene.target, s.scene.source, run.out.T_target_source);
+  }
 }
 
 }  // namespace

@@ -37,9 +37,10 @@ bool SeenSpace::Bin(const Eigen::Vector3f& d, int& row, int& col) const {
   return true;
 }
 
-int SeenSpace::Violations(const PointCloud& cloud, const Eigen::Isometry3d& T_scan_cloud) const {
+SeenSpace::Tally SeenSpace::Count(const PointCloud& cloud,
+                                  const Eigen::Isometry3d& T_scan_cloud) const {
   const Eigen::Isometry3f T = T_scan_cloud.cast<float>();
-  int violations = 0;
+  Tally tally;
   for (const Eigen::Vector3f& p : cloud) {
     const Eigen::Vector3f d = T * p - sensor_;
     const float r = d.norm();
@@ -56,9 +57,11 @@ int SeenSpace::Violations(const PointCloud& cloud, const Eigen::Isometry3d& T_sc
         nearest = std::min(nearest, n);
       }
     }
-    if (seen && r < nearest - margins_.margin_m - margins_.margin_fraction * r) ++violations;
+    if (!seen) continue;
+    ++tally.judged;
+    if (r < nearest - margins_.margin_m - margins_.margin_fraction * r) ++tally.violations;
   }
-  return violations;
+  return tally;
 }
 
 }  // namespace pitchlab::mapping

@@ -37,7 +37,18 @@ class SeenSpace {
   /// least min_range_m from the sensor and nearer than every return of their bin and its eight
   /// neighbours by more than margin_m + margin_fraction x their range. A bin without a return
   /// (outside the field of view, no echo) says nothing, nor does any bin next to one.
-  int Violations(const PointCloud& cloud, const Eigen::Isometry3d& T_scan_cloud) const;
+  int Violations(const PointCloud& cloud, const Eigen::Isometry3d& T_scan_cloud) const {
+    return Count(cloud, T_scan_cloud).violations;
+  }
+
+  /// What Violations counts, and how many of the points the scan's view could judge at all (at
+  /// least min_range_m away, in a bin whose eight neighbours all hold a return): the share of the
+  /// common view a pose contradicts, whatever the overlap.
+  struct Tally {
+    int violations = 0;
+    int judged = 0;
+  };
+  Tally Count(const PointCloud& cloud, const Eigen::Isometry3d& T_scan_cloud) const;
 
  private:
   /// The bin of direction `d` (row: elevation, col: azimuth); false for a zero or non-finite `d`.

@@ -85,5 +85,78 @@ TEST(FreeSpaceCheck, NothingSeenRefutesNothing) {
   EXPECT_FALSE(empty.Refutes(Along(1.0)));
 }
 
+// The points of `scan` on the plane x = x_end (the end wall), or off it.
+PointCloud EndWall(const PointCloud& scan, float x_end, bool on) {
+  PointCloud out;
+  for (const Eigen::Vector3f& p : scan) {
+    if ((std::abs(p.x() - x_end) < 1e-3f) == on) out.push_back(p);
+  }
+  return out;
+}
+
+TEST(FreeSpaceAt, TheTruthLeavesNothingWhereEitherScanSawThrough) {
+  Corridor c;
+  const RegistrationResult::FreeSpace at =
+      FreeSpaceAt(&c.target_seen, c.source, &c.source_seen, c.target, Along(2.0));
+  // Every point but those nearer than the mirror's offset or at the view's edge is judged.
+  EXPECT_GT(at.source_judged, static_cast<int>(0.8 * c.source.size()));
+  EXPECT_GT(at.target_judged, static_cast<int>(0.5 * c.target.size()));
+  EXPECT_EQ(at.source_violating, 0.0);
+  EXPECT_EQ(at.target_violating, 0.0);
+  EXPECT_EQ(FreeSpaceRefutation(at, c.source.size(), c.target.size()), "");
+}
+
+TEST(FreeSpaceAt, APoseShortOfTheTruthPutsTheEndWallWhereTheTargetSawThrough) {
+  // 1 m short, the source's floor and walls slide along the target's; its end wall (x = 8 in its
+  // own frame) stands 1 m in front of the target's: those points, and only those, violate.
+  Corridor c;
+  const RegistrationResult::FreeSpace at =
+      FreeSpaceAt(&c.target_seen, c.source, &c.source_seen, c.target, Along(1.0));
+  // Only the end wall: off it the source violates nothing, and of the wall's points those whose
+  // bins lie clear of the floor's and the side walls' returns (nearer than the margin) all do.
+  const PointCloud wall = EndWall(c.source, 8.0f, true), rest = EndWall(c.source, 8.0f, false);
+  const RegistrationResult::FreeSpace off_wall =
+      FreeSpaceAt(&c.target_seen, rest, nullptr, c.target, Along(1.0));
+  EXPECT_GT(off_wall.source_judged, static_cast<int>(0.8 * rest.size()));
+  EXPECT_EQ(off_wall.source_violating, 0.0);
+  const RegistrationResult::FreeSpace on_wall =
+      FreeSpaceAt(&c.target_seen, wall, nullptr, c.target, Along(1.0));
+  EXPECT_GT(on_wall.source_violating, 0.5);
+  EXPECT_NEAR(at.source_violating * at.source_judged,
+              on_wall.source_violating * on_wall.source_judged, 0.5);
+  EXPECT_GT(at.source_violating, kChangedViewShare);
+  const std::string why = FreeSpaceRefutation(at, c.source.size(), c.target.size());
+  EXPECT_NE(why.find("of the source's points the target's scan could judge"), std::string::npos)
+      << why;
+  // Without the target's view nothing judges the source: the source's view alone sees the
+  // target's end wall behind its own, where it saw nothing.
+  const RegistrationResult::FreeSpace blind =
+      FreeSpaceAt(nullptr, c.source, &c.source_seen, c.target, Along(1.0));
+  EXPECT_EQ(blind.source_judged, 0);
+  EXPECT_EQ(blind.target_violating, 0.0);
+  EXPECT_EQ(FreeSpaceRefutation(blind, c.source.size(), c.target.size()), "");
+}
+
+TEST(FreeSpaceRefutation, NeedsMoreThanTheChangedShareAndMoreThanAFewPoints) {
+  RegistrationResult::FreeSpace at;
+  at.source_judged = 2000;
+  at.source_violating = kChangedViewShare;  // a scene that changed this much is still accepted
+  EXPECT_EQ(FreeSpaceRefutation(at, 3000, 50000), "");
+  at.source_violating = 0.06;  // 120 points, 4 % of the source's 3000
+  EXPECT_NE(FreeSpaceRefutation(at, 3000, 50000).find("6 % of the source's points"),
+            std::string::npos)
+      << FreeSpaceRefutation(at, 3000, 50000);
+  // Half of 20 judged points: 10 points, a thin pole's worth, under kRefuted of 3000.
+  at.source_judged = 20;
+  at.source_violating = 0.5;
+  EXPECT_EQ(FreeSpaceRefutation(at, 3000, 50000), "");
+  // The target's view decides alike, against the target's size.
+  at = {};
+  at.target_judged = 40000;
+  at.target_violating = 0.08;
+  EXPECT_NE(FreeSpaceRefutation(at, 3000, 50000).find("8 % of the target's points"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace pitchlab::mapping

@@ -107,6 +107,17 @@ struct RegistrationResult {
   /// the guess. Both are zero when no ICP result was scored.
   Matrix6d information = Matrix6d::Zero();
   Matrix6d covariance = Matrix6d::Zero();
+  /// Free-space evidence at T_target_source (Huber and Hebert 2003): of the points a scan's view
+  /// can judge (in its field of view, beyond the mirror's offset), the share the pose puts where
+  /// that scan's beams passed through. A static scene at the right pose leaves next to none
+  /// there; a scene that changed between the scans (a door, a person) or a wrong pose does.
+  struct FreeSpace {
+    int source_judged = 0;        ///< the source's ICP points the target's view judges [1]
+    double source_violating = 0;  ///< share of those where the target saw through [1]
+    int target_judged = 0;        ///< the target's ICP points the source's view judges [1]
+    double target_violating = 0;  ///< share of those where the source saw through [1]
+  };
+  FreeSpace free_space;  ///< all zero when no pose was scored
   /// What the clouds measured (scale, spacing, noise) and the settings they resolved to: every
   /// `auto` of the config replaced by its value (RegistrationConfig::Resolve).
   CloudStatistics source_statistics, target_statistics;

@@ -30,7 +30,12 @@ inline nlohmann::json ObservabilityJson(const mapping::RegistrationResult& r) {
           {"covariance_order", "roll pitch yaw [rad] x y z [m], perturbation in the target frame"},
           {"noise_m", {{"source", r.source_statistics.noise_m},
                        {"target", r.target_statistics.noise_m}}},
-          {"length_scale", r.settings.length_scale}};
+          {"length_scale", r.settings.length_scale},
+          {"free_space",
+           {{"source_judged", r.free_space.source_judged},
+            {"source_violating", r.free_space.source_violating},
+            {"target_judged", r.free_space.target_judged},
+            {"target_violating", r.free_space.target_violating}}}};
 }
 
 /// {"voxel", "normals", "features", "initial_alignment", "icp", "total"} in seconds.
