@@ -178,6 +178,11 @@ int RunRegister(int argc, char** argv) {
       sd["roll_deg"].get<double>(), sd["pitch_deg"].get<double>(), sd["yaw_deg"].get<double>(),
       sd["x_m"].get<double>(), sd["y_m"].get<double>(), sd["z_m"].get<double>(),
       r->source_statistics.noise_m, r->target_statistics.noise_m, r->settings.length_scale);
+  const mapping::RegistrationResult::FreeSpace& fs = r->free_space;
+  std::printf(
+      "free space: %.2g %% of %d source points the target's scan could judge lie where its beams "
+      "passed, %.2g %% of %d target points in the source's (a pose is refused above 5 %%)\n",
+      100 * fs.source_violating, fs.source_judged, 100 * fs.target_violating, fs.target_judged);
   const mapping::StageTimings& t = r->timings;
   std::printf(
       "time %.3f s: voxel %.3f, normals %.3f, features %.3f, initial alignment %.3f, "

@@ -1,6 +1,7 @@
 // `pitchlab register` and `pitchlab merge` (apps/register_command.cpp, apps/merge_command.cpp)
 // called directly on simulated scans written as PCD.
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -59,6 +60,13 @@ TEST_F(Cli, RegisterPrintsTheMatrixResultFieldsAndTheGroundTruthErrorAsJson) {
   EXPECT_TRUE(j["timings_s"].contains("initial_alignment"));
   EXPECT_LT(j["ground_truth_error"]["rotation_deg"].get<double>(), 0.5);
   EXPECT_LT(j["ground_truth_error"]["translation_m"].get<double>(), 0.03);
+  // Free space at the pose: most of the source in the target's view, none where its beams passed.
+  EXPECT_GT(j["free_space"]["source_judged"].get<int>(), 1000);
+  EXPECT_LT(j["free_space"]["source_violating"].get<double>(), 0.01);
+  auto [text_code, text] =
+      RunCommand(apps::RunRegister, {source, target, "--prior", "0.8,0.3,0,0,0,12"});
+  ASSERT_EQ(text_code, 0) << text;
+  EXPECT_NE(text.find("free space: "), std::string::npos) << text;
 }
 
 // The real 3DTK pair (a nodding SICK): register sets each scan's lines right by its floor and
@@ -87,6 +95,12 @@ TEST_F(Cli, RegisterSetsARealNoddingScansLinesRightUnlessAskedToKeepThemAsRecord
     b(k / 4, k % 4) = as_recorded["T_target_source"][k].get<double>();
   }
   EXPECT_GT((a.block<3, 1>(0, 3) - b.block<3, 1>(0, 3)).norm(), 0.02);
+  // A real scene changes between scans (a door or a person): some points lie where the other
+  // scan saw through at the right pose, under the 5 % that refutes a pose (mapping/README.md).
+  const double changed = std::max(set_right["free_space"]["source_violating"].get<double>(),
+                                  set_right["free_space"]["target_violating"].get<double>());
+  EXPECT_GT(changed, 0.01);
+  EXPECT_LT(changed, 0.05);
 }
 
 TEST_F(Cli, RegisterOfScansWithoutOverlapExitsNonZeroWithTheReason) {
