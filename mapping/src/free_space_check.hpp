@@ -33,9 +33,9 @@ inline constexpr int kRefutedOverAt = 10;
 ///   most 1.1 %;
 /// - the real 3DTK corridor pair at its right pose: 3.1 % and 3.2 % (both ways round; a door
 ///   leaf or a person 2 m wide that moved between the scans, and near points at the margin);
-/// - wrong poses: simulated office aliases 2 m along a desk row, 8.4-11 %; the real pair from
+/// - wrong poses: simulated office aliases 2 m along a desk row, 8.0-11 %; the real pair from
 ///   priors 2-4 m along the corridor or 20 deg off, 17-20 %.
-/// 5 % lies between a real scene's change and an alias, at the geometric mean of 3.2 and 8.4. A
+/// 5 % lies between a real scene's change and an alias, about the geometric mean of 3.2 and 8.0. A
 /// scene where more changed between two scans (a crowd passing) is refused with its reason.
 inline constexpr double kChangedViewShare = 0.05;
 
