@@ -181,8 +181,9 @@ int RunRegister(int argc, char** argv) {
   const mapping::RegistrationResult::FreeSpace& fs = r->free_space;
   std::printf(
       "free space: %.2g %% of %d source points the target's scan could judge lie where its beams "
-      "passed, %.2g %% of %d target points in the source's (a pose is refused above 5 %%)\n",
-      100 * fs.source_violating, fs.source_judged, 100 * fs.target_violating, fs.target_judged);
+      "passed, %.2g %% of %d target points in the source's (a pose is refused above %g %%)\n",
+      100 * fs.source_violating, fs.source_judged, 100 * fs.target_violating, fs.target_judged,
+      100 * mapping::kChangedViewShare);
   const mapping::StageTimings& t = r->timings;
   std::printf(
       "time %.3f s: voxel %.3f, normals %.3f, features %.3f, initial alignment %.3f, "

@@ -23,22 +23,6 @@ namespace pitchlab::mapping {
 inline constexpr double kRefuted = 0.005;
 inline constexpr int kRefutedOverAt = 10;
 
-/// A pose is refuted outright when more than kChangedViewShare of the points one scan's view can
-/// judge lie where that scan's beams passed (and at least kRefuted of all its points: a few
-/// points of a thin pole never decide). At the right pose only what changed between the two
-/// scans lies there. Measured (RegistrationResult::free_space, register --json):
-/// - simulated pairs at their right pose: at most 0.26 % (registration_eval seeds 20120917, 4
-///   and 5: 2642 correct successes; thin poles and chair legs one scan's beams hit and the
-///   other's pass); scan-to-map in missions (office, urban, terrain seeds 1..20: 765 stops) at
-///   most 1.1 %;
-/// - the real 3DTK corridor pair at its right pose: 3.1 % and 3.2 % (both ways round; a door
-///   leaf or a person 2 m wide that moved between the scans, and near points at the margin);
-/// - wrong poses: simulated office aliases 2 m along a desk row, 8.0-11 %; the real pair from
-///   priors 2-4 m along the corridor or 20 deg off, 17-20 %.
-/// 5 % lies between a real scene's change and an alias, about the geometric mean of 3.2 and 8.0. A
-/// scene where more changed between two scans (a crowd passing) is refused with its reason.
-inline constexpr double kChangedViewShare = 0.05;
-
 /// The free-space evidence at T_target_source, from both views (RegistrationResult::free_space);
 /// a null view judges nothing.
 RegistrationResult::FreeSpace FreeSpaceAt(const LazySeenSpace* target_seen,
@@ -47,8 +31,9 @@ RegistrationResult::FreeSpace FreeSpaceAt(const LazySeenSpace* target_seen,
                                           const PointCloud& target,
                                           const Eigen::Isometry3d& T_target_source);
 
-/// Why the evidence `at` refutes its pose (kChangedViewShare), or empty when it does not;
-/// `source_points`, `target_points`: the sizes of the clouds it was counted over.
+/// Why the evidence `at` refutes its pose (kChangedViewShare, registration.hpp; and kRefuted), or
+/// empty when it does not; `source_points`, `target_points`: the sizes of the clouds it was
+/// counted over.
 std::string FreeSpaceRefutation(const RegistrationResult::FreeSpace& at, std::size_t source_points,
                                 std::size_t target_points);
 
