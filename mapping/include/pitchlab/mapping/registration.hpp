@@ -91,8 +91,9 @@ using Matrix6d = Eigen::Matrix<double, 6, 6>;
 ///   and 5: 2642 correct successes; thin poles and chair legs one scan's beams hit and the
 ///   other's pass); scan-to-map in missions (office, urban, terrain seeds 1..20: 765 stops) at
 ///   most 1.1 %;
-/// - the real 3DTK corridor pair at its right pose: 3.1 % and 3.2 % (both ways round; a door
-///   leaf or a person 2 m wide that moved between the scans, and near points at the margin);
+/// - the real 3DTK corridor pair at its right pose: 3.1 % and 3.2 % (both ways round; mostly a
+///   patch in the room behind a doorway that one scan's beams passed and the other's hit: a door
+///   leaf moved, or the doorway's edges seen at two angles);
 /// - wrong poses: simulated office aliases 2 m along a desk row, 8.0-11 %; the real pair from
 ///   priors 2-4 m along the corridor or 20 deg off, 17-20 %.
 /// 5 % lies between a real scene's change and an alias, about the geometric mean of 3.2 and 8.0. A
