@@ -2,7 +2,6 @@
 // ESRI ASCII rasters (elevation, inclination, roughness) with their projection, as a map_server
 // occupancy grid (traversability) and as a PNG; with --world, scored against ground truth.
 
-#include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
@@ -20,9 +19,9 @@
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/mapping/elevation_map.hpp"
-#include "pitchlab/mapping/physical_memory.hpp"
 #include "pitchlab/mapping/elevation_truth.hpp"
 #include "pitchlab/mapping/ground_level.hpp"
+#include "pitchlab/mapping/physical_memory.hpp"
 #include "pitchlab/mission/map_figure.hpp"
 #include "pitchlab/planning/occupancy_grid.hpp"
 #include "pitchlab/planning/traversability.hpp"

@@ -188,10 +188,7 @@ json Run(const Scan& target, const Scan& source, const Grid& grid, bool with_pri
               {"length_scale", r->settings.length_scale},
               // At our pose: how much of each scan's judged view the other puts where its beams
               // passed (a real scene changes between scans; above 5 % a pose is refused).
-              {"free_space", {{"source_violating", r->free_space.source_violating},
-                              {"source_judged", r->free_space.source_judged},
-                              {"target_violating", r->free_space.target_violating},
-                              {"target_judged", r->free_space.target_judged}}},
+              {"free_space", mission::FreeSpaceJson(r->free_space)},
               {"cpu_s", cpu_s}};
   if (with_prior) {
     const mapping::PoseError o = mapping::ComparePoses(*prior.odometry, reference);

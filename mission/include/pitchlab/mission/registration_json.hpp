@@ -22,8 +22,16 @@ inline nlohmann::json Matrix6Json(const mapping::Matrix6d& m) {
   return rows;
 }
 
-/// What a registration concluded and how sure it is: outcome, covariance, the clouds' noise and
-/// the length scale they resolved to.
+/// The free-space evidence at a registration's pose (RegistrationResult::free_space).
+inline nlohmann::json FreeSpaceJson(const mapping::RegistrationResult::FreeSpace& f) {
+  return {{"source_judged", f.source_judged},
+          {"source_violating", f.source_violating},
+          {"target_judged", f.target_judged},
+          {"target_violating", f.target_violating}};
+}
+
+/// What a registration concluded and how sure it is: outcome, covariance, the clouds' noise, the
+/// length scale they resolved to and the free-space evidence at the pose.
 inline nlohmann::json ObservabilityJson(const mapping::RegistrationResult& r) {
   return {{"outcome", mapping::ToString(r.outcome)},
           {"covariance", Matrix6Json(r.covariance)},
@@ -31,11 +39,7 @@ inline nlohmann::json ObservabilityJson(const mapping::RegistrationResult& r) {
           {"noise_m", {{"source", r.source_statistics.noise_m},
                        {"target", r.target_statistics.noise_m}}},
           {"length_scale", r.settings.length_scale},
-          {"free_space",
-           {{"source_judged", r.free_space.source_judged},
-            {"source_violating", r.free_space.source_violating},
-            {"target_judged", r.free_space.target_judged},
-            {"target_violating", r.free_space.target_violating}}}};
+          {"free_space", FreeSpaceJson(r.free_space)}};
 }
 
 /// {"voxel", "normals", "features", "initial_alignment", "icp", "total"} in seconds.
