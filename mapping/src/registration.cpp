@@ -171,6 +171,26 @@ std::string FreeSpaceRejection(const IcpTarget& target, const PointCloud& source
   return FreeSpaceRefutation(FreeSpaceOf(target, source, T), source.size(), target.points.size());
 }
 
+// How many times another pose's inliers must outnumber a pose's for the scans to prefer it: below,
+// the two fit comparably and fit alone does not choose. What both sides measured: aliases along
+// registration_eval's simulated corridor (poses 0.5-1.9 m apart along its axis) fit 1.02-1.04x
+// the true pose's inliers; on the real corridor pair, from a prior 2 m back bounded to 1 m, the
+// bound held a pose 1.69 m off at 38.7 % and the reference's fitted 55.3 % (1.43x) with the lines
+// as recorded, 53.8 % (1.39x) with them set right (line_pitch.hpp). 1.2 lies between, with room
+// on both sides (it was 1.4, a grid search's margin, which the set-right pair missed).
+constexpr double kContradictionMargin = 1.2;
+
+// Whether the scene leaves a translation at `T` free: constrained below free_ratio, where a handful
+// of points decide it (RegistrationConfig::free_ratio). ICP stops at such a pose because the cost
+// is flat along the direction there, not because the scans single it out.
+std::optional<Eigen::Vector3d> FreeTranslation(const IcpTarget& target, const PointCloud& source,
+                                               const Eigen::Isometry3d& T,
+                                               const RegistrationConfig& config) {
+  const Weakness weak = WeakDirections(target, source, T, config, config.free_ratio, 1);
+  if (weak.translations.empty()) return std::nullopt;
+  return weak.translations.front();
+}
+
 // ICP restarted off `at` along a weak direction, one way (sign +1) or the other (-1), and whether
 // it ended away (beyond a quarter of the restart's offset), i.e. did not come back.
 struct Probe {
@@ -594,16 +614,10 @@ SacResult FastFeatureAlignment(const Prepared& prep, internal::TargetMemo& memo,
 // consensus, asked again without the region, finds a pose outside it that ICP refines to a fit
 // kContradictionMargin times better, the scans contradict the prior and nothing says which to
 // believe: ambiguous (the reason, else empty). Comparably good poses are the region's to decide:
-// that is what a bound is for. The margin rests on what both sides measured: aliases along
-// registration_eval's simulated corridor (poses 0.5-1.9 m apart along its axis) fit 1.02-1.04x
-// the true pose's inliers; on the real corridor pair, from a prior 2 m back bounded to 1 m, the
-// bound held a pose 1.69 m off at 38.7 % and the reference's fitted 55.3 % (1.43x) with the lines
-// as recorded, 53.8 % (1.39x) with them set right (line_pitch.hpp). 1.2 lies between, with room
-// on both sides (it was 1.4, a grid search's margin, which the set-right pair missed). Only
-// between two scans: a map holds many places, and a scan that overlaps it partly fits some other
-// place better by chance of repeated structure (a yard mission: a pose turned 180 deg, 6 m off,
-// fitted 66.9 % where the right one, entering new ground, fitted 32.8 %).
-constexpr double kContradictionMargin = 1.2;
+// that is what a bound is for. Only between two scans: a map holds many places, and a scan that
+// overlaps it partly fits some other place better by chance of repeated structure (a yard
+// mission: a pose turned 180 deg, 6 m off, fitted 66.9 % where the right one, entering new
+// ground, fitted 32.8 %).
 
 // Whether ContradictedByTheScans is asked: a registration between two scans whose odometry is not
 // trusted to carry what the scans leave free. Odometry whose bound is within carry_max_m and
@@ -760,11 +774,26 @@ class Verification {
   }
 
   // `icp`, run from `from`, wins when it ends in another pose than the winner's, passes the
-  // acceptance test and fits better (or the winner did not pass).
+  // acceptance test and fits better (or the winner did not pass). Two poses one slide apart along
+  // a translation the scene leaves free at one of them and not at the other (FreeTranslation):
+  // along a free direction the inliers follow the overlap, not the pose (a street's zero-motion
+  // alias fitted 82.6 % of the source with its weakest translation at 0.0025 of the strongest; the
+  // truth, 0.49 m along the street, fitted 81.2 % at 0.082: registration_eval's urban 120, seed 3),
+  // so there the pose the scene pins down wins unless the free one fits kContradictionMargin times
+  // better, or free space refutes the pinned one.
   void Offer(const IcpResult& icp, const Start& from) {
     if (SamePose(icp.T_target_source, best_.icp.T_target_source, config_)) return;
     if (!Rejection(icp, prior_, config_).empty()) return;
-    if (accepted_ && icp.inlier_ratio <= best_.icp.inlier_ratio) return;
+    std::optional<std::optional<Eigen::Vector3d>> free;  // asked only where the fits are comparable
+    if (accepted_) {
+      const double ours = icp.inlier_ratio, theirs = best_.icp.inlier_ratio;
+      bool wins = ours > theirs;
+      if (kContradictionMargin * ours >= theirs && ours <= kContradictionMargin * theirs) {
+        free = FreeTranslation(target_, source_, icp.T_target_source, config_);
+        wins = Beats(icp, *free);
+      }
+      if (!wins) return;
+    }
     std::ostringstream os;
     os.precision(3);
     os << "ICP from " << from.name << " fits best (" << Percent(icp.inlier_ratio) << " inliers vs "
@@ -772,6 +801,7 @@ class Verification {
     best_.note = os.str();
     best_.icp = icp;
     best_.path = from.path;
+    best_free_ = free;
     accepted_ = true;
   }
 
@@ -807,11 +837,40 @@ class Verification {
   const Verified& best() const { return best_; }
 
  private:
+  // Whether `icp` (free along a translation: `free`) fits the scans better than the winner (see
+  // Offer).
+  bool Beats(const IcpResult& icp, const std::optional<Eigen::Vector3d>& free) {
+    const double theirs = best_.icp.inlier_ratio;
+    if (!best_free_) {
+      best_free_ = FreeTranslation(target_, source_, best_.icp.T_target_source, config_);
+    }
+    const std::optional<Eigen::Vector3d>& best_free = *best_free_;
+    if (free.has_value() != best_free.has_value() &&
+        SlidAlong(free ? *free : *best_free, icp.T_target_source, best_.icp.T_target_source)) {
+      const IcpResult& pinned = free ? best_.icp : icp;
+      if (FreeSpaceRejection(target_, source_, pinned.T_target_source).empty()) {
+        return free ? icp.inlier_ratio > kContradictionMargin * theirs
+                    : kContradictionMargin * icp.inlier_ratio >= theirs;
+      }
+    }
+    return icp.inlier_ratio > theirs;
+  }
+  // Whether `a` and `b` are one pose but for a slide along `direction`: turned apart less than
+  // SamePose's 2 deg, and apart across the direction by less than its half capture range.
+  bool SlidAlong(const Eigen::Vector3d& direction, const Eigen::Isometry3d& a,
+                 const Eigen::Isometry3d& b) const {
+    const Eigen::Vector3d d = a.translation() - b.translation();
+    return ComparePoses(a, b).rotation_deg < 2.0 &&
+           (d - d.dot(direction) * direction).norm() < 0.5 * config_.icp_max_distance_m;
+  }
+
   const IcpTarget& target_;
   const PointCloud& source_;
   const RegistrationPrior& prior_;
   const RegistrationConfig& config_;
   Verified best_;
+  // The winner's free translation (FreeTranslation), once asked.
+  std::optional<std::optional<Eigen::Vector3d>> best_free_;
   bool accepted_ = false;  // the winner passes the acceptance test
 };
 
