@@ -73,7 +73,9 @@ struct RegistrationConfig {
   double sac_edge_similarity = 0.9;  ///< prerejection: sampled edge lengths agree to this ratio [1]
   int sac_min_inliers = 10;          ///< fewer agreeing correspondences: alignment failed [1]
   /// Distinct hypotheses of the consensus (best and runners-up) that ICP refines; the one that
-  /// fits best (inlier ratio) wins. 1: only the consensus' best [1].
+  /// fits best (inlier ratio) wins, but of two poses one slide apart whose fits lie within 1.2x,
+  /// the one the scene pins more firmly (free_ratio, degeneracy_ratio; mapping/README.md). 1: only
+  /// the consensus' best [1].
   int sac_hypotheses = 4;
   /// Weakest / strongest point-to-plane constraint (translation or rotation) below this: the
   /// solution is probed for degeneracy (a corridor, an open plane) by restarting ICP off it [1].
