@@ -185,14 +185,17 @@ constexpr double kContradictionMargin = 1.2;
 // the scans single the pose out), weak (below degeneracy_ratio: probed) or firm; and that
 // translation (zero when firm).
 struct Pinning {
-  int rank = 2;  // 0 free, 1 weak, 2 firm
+  enum class Rank { kFree, kWeak, kFirm };
+  Rank rank = Rank::kFirm;
   Eigen::Vector3d weakest = Eigen::Vector3d::Zero();
 };
 Pinning PinningAt(const IcpTarget& target, const PointCloud& source, const Eigen::Isometry3d& T,
                   const RegistrationConfig& config) {
   const Weakness weak = WeakDirections(target, source, T, config, config.degeneracy_ratio, 1);
   if (weak.translations.empty()) return {};
-  return {weak.translation_ratios.front() < config.free_ratio ? 0 : 1, weak.translations.front()};
+  return {weak.translation_ratios.front() < config.free_ratio ? Pinning::Rank::kFree
+                                                              : Pinning::Rank::kWeak,
+          weak.translations.front()};
 }
 
 // ICP restarted off `at` along a weak direction, one way (sign +1) or the other (-1), and whether
@@ -687,11 +690,12 @@ std::vector<IcpResult> Screen(const IcpTarget& target, const PointCloud& source,
   return out;
 }
 
-// Two poses in the same ICP minimum (closer than half its capture range).
+// Two poses in the same ICP minimum (closer than half its capture range, kSamePoseDeg).
+constexpr double kSamePoseDeg = 2.0;
 bool SamePose(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b,
               const RegistrationConfig& config) {
   const PoseError d = ComparePoses(a, b);
-  return d.translation_m < 0.5 * config.icp_max_distance_m && d.rotation_deg < 2.0;
+  return d.translation_m < 0.5 * config.icp_max_distance_m && d.rotation_deg < kSamePoseDeg;
 }
 
 // A start to verify and what to call it.
@@ -789,16 +793,8 @@ class Verification {
   void Offer(const IcpResult& icp, const Start& from) {
     if (SamePose(icp.T_target_source, best_.icp.T_target_source, config_)) return;
     if (!Rejection(icp, prior_, config_).empty()) return;
-    std::optional<Pinning> pin;  // asked only where the fits are comparable
-    if (accepted_) {
-      const double ours = icp.inlier_ratio, theirs = best_.icp.inlier_ratio;
-      bool wins = ours > theirs;
-      if (kContradictionMargin * ours >= theirs && ours <= kContradictionMargin * theirs) {
-        pin = PinningAt(target_, source_, icp.T_target_source, config_);
-        wins = Beats(icp, *pin);
-      }
-      if (!wins) return;
-    }
+    std::optional<Pinning> pin;  // icp's, when Beats asked
+    if (accepted_ && !Beats(icp, pin)) return;
     std::ostringstream os;
     os.precision(3);
     os << "ICP from " << from.name << " fits best (" << Percent(icp.inlier_ratio) << " inliers vs "
@@ -842,29 +838,32 @@ class Verification {
   const Verified& best() const { return best_; }
 
  private:
-  // Whether `icp` (pinned as `pin` says) fits the scans better than the winner (see Offer).
-  bool Beats(const IcpResult& icp, const Pinning& pin) {
-    const double theirs = best_.icp.inlier_ratio;
+  // Whether `icp` fits the scans better than the winner (see Offer). Fits kContradictionMargin
+  // apart decide alone; only comparable ones ask how firmly each pose is pinned (`pin` gets icp's).
+  bool Beats(const IcpResult& icp, std::optional<Pinning>& pin) {
+    const double ours = icp.inlier_ratio, theirs = best_.icp.inlier_ratio;
+    if (ours > kContradictionMargin * theirs || kContradictionMargin * ours < theirs) {
+      return ours > theirs;
+    }
+    pin = PinningAt(target_, source_, icp.T_target_source, config_);
     if (!best_pin_) best_pin_ = PinningAt(target_, source_, best_.icp.T_target_source, config_);
-    const Pinning& best_pin = *best_pin_;
-    if (pin.rank != best_pin.rank &&
-        SlidAlong(pin.rank < best_pin.rank ? pin.weakest : best_pin.weakest, icp.T_target_source,
-                  best_.icp.T_target_source)) {
-      const bool firmer = pin.rank > best_pin.rank;
+    const Pinning::Rank mine = pin->rank, held = best_pin_->rank;
+    if (mine != held && SlidAlong(mine < held ? pin->weakest : best_pin_->weakest,
+                                  icp.T_target_source, best_.icp.T_target_source)) {
+      const bool firmer = mine > held;
       const IcpResult& firmer_pose = firmer ? icp : best_.icp;
       if (FreeSpaceRejection(target_, source_, firmer_pose.T_target_source).empty()) {
-        return firmer ? kContradictionMargin * icp.inlier_ratio >= theirs
-                      : icp.inlier_ratio > kContradictionMargin * theirs;
+        return firmer ? kContradictionMargin * ours >= theirs : ours > kContradictionMargin * theirs;
       }
     }
-    return icp.inlier_ratio > theirs;
+    return ours > theirs;
   }
   // Whether `a` and `b` are one pose but for a slide along `direction`: turned apart less than
-  // SamePose's 2 deg, and apart across the direction by less than its half capture range.
+  // SamePose's kSamePoseDeg, and apart across the direction by less than its half capture range.
   bool SlidAlong(const Eigen::Vector3d& direction, const Eigen::Isometry3d& a,
                  const Eigen::Isometry3d& b) const {
     const Eigen::Vector3d d = a.translation() - b.translation();
-    return ComparePoses(a, b).rotation_deg < 2.0 &&
+    return ComparePoses(a, b).rotation_deg < kSamePoseDeg &&
            (d - d.dot(direction) * direction).norm() < 0.5 * config_.icp_max_distance_m;
   }
 
