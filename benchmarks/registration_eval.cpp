@@ -83,6 +83,10 @@ struct Options {
   std::string sensor;                              // YAML of the lms200 section, if given
   std::set<int> only_pairs;                        // register only these pair ids (all if empty)
   std::string dump_pairs;  // directory the registered pairs' scans are written to, if given
+  // With a prior, its roll and pitch measured within this, as a mission's attitude sensor gives
+  // them (MissionConfig::tilt_tolerance_deg) [deg]; unset: the prior carries no tilt (the CLI's
+  // case).
+  std::optional<double> tilt_deg;
   std::set<std::string> near_start = {"terrain"};  // worlds sampled around their start only
   double near_start_radius_m = 3.0;
 };
@@ -92,6 +96,18 @@ std::vector<std::string> Split(const std::string& s, char sep) {
   std::stringstream ss(s);
   for (std::string item; std::getline(ss, item, sep);) out.push_back(item);
   return out;
+}
+
+// `text` read whole as a T, else an error naming the option.
+template <typename T>
+T Number(const std::string& option, const std::string& text) {
+  std::istringstream in(text);
+  T v{};
+  char extra = 0;
+  if (!(in >> v) || in >> extra) {
+    throw std::invalid_argument(option + ": '" + text + "' is not a number");
+  }
+  return v;
 }
 
 Options ParseOptions(int argc, char** argv) {
@@ -105,15 +121,15 @@ Options ParseOptions(int argc, char** argv) {
     if (a == "--worlds")
       o.worlds = Split(value(), ',');
     else if (a == "--targets")
-      o.targets = std::stoi(value());
+      o.targets = Number<int>(a, value());
     else if (a == "--baseline-pairs")
-      o.baseline_pairs = std::stoi(value());
+      o.baseline_pairs = Number<int>(a, value());
     else if (a == "--table1-pairs")
-      o.table1_pairs = std::stoi(value());
+      o.table1_pairs = Number<int>(a, value());
     else if (a == "--sequence-scans")
-      o.sequence_scans = std::stoi(value());
+      o.sequence_scans = Number<int>(a, value());
     else if (a == "--seed")
-      o.seed = std::stoull(value());
+      o.seed = Number<std::uint64_t>(a, value());
     else if (a == "--paper-table")
       o.paper_table = value();
     else if (a == "--pair-cache")
@@ -124,22 +140,27 @@ Options ParseOptions(int argc, char** argv) {
       o.sensor = value();
     else if (a == "--dump-pairs")
       o.dump_pairs = value();
-    else if (a == "--only-pairs") {
-      for (const std::string& id : Split(value(), ',')) o.only_pairs.insert(std::stoi(id));
+    else if (a == "--tilt") {
+      o.tilt_deg = Number<double>(a, value());
+      if (!(*o.tilt_deg > 0 && *o.tilt_deg <= 90)) {
+        throw std::invalid_argument("--tilt wants a tolerance in (0, 90] deg");
+      }
+    } else if (a == "--only-pairs") {
+      for (const std::string& id : Split(value(), ',')) o.only_pairs.insert(Number<int>(a, id));
     } else if (a == "--near-start") {
       const auto v = Split(value(), ',');
       o.near_start = std::set<std::string>(v.begin(), v.end());
     } else if (a == "--near-start-radius")
-      o.near_start_radius_m = std::stod(value());
+      o.near_start_radius_m = Number<double>(a, value());
     else if (a == "--noise") {
       o.noise_m.clear();
-      for (const std::string& n : Split(value(), ',')) o.noise_m.push_back(std::stod(n));
+      for (const std::string& n : Split(value(), ',')) o.noise_m.push_back(Number<double>(a, n));
     } else if (a == "--levels") {
       o.levels.clear();
       for (const std::string& l : Split(value(), ',')) {
         const auto mt = Split(l, ':');
         if (mt.size() != 2) throw std::invalid_argument("--levels wants m:deg,m:deg");
-        o.levels.emplace_back(std::stod(mt[0]), std::stod(mt[1]));
+        o.levels.emplace_back(Number<double>(a, mt[0]), Number<double>(a, mt[1]));
       }
     } else if (a == "--help") {
       std::cout
@@ -147,12 +168,15 @@ Options ParseOptions(int argc, char** argv) {
              "[--noise s,...] [--baseline-pairs N] [--table1-pairs N] [--sequence-scans N] "
              "[--seed S] [--paper-table FILE.json] [--near-start w1,w2] [--near-start-radius M] "
              "[--pair-cache DIR] [--config FILE.yaml] [--sensor FILE.yaml] [--only-pairs id,...]\n"
-             "[--dump-pairs DIR]\n"
+             "[--dump-pairs DIR] [--tilt DEG]\n"
              "--sensor: the simulated LMS200 (its lms200 section) over the defaults; --noise\n"
              "sets its noise_sigma_m.\n"
              "--dump-pairs: each registered pair's scans as DIR/pair_ID_target.pcd and\n"
              "pair_ID_source.pcd (VIEWPOINT the true pose), e.g. to replay one with\n"
-             "`pitchlab register DIR/pair_ID_source.pcd DIR/pair_ID_target.pcd`.\n";
+             "`pitchlab register DIR/pair_ID_source.pcd DIR/pair_ID_target.pcd`.\n"
+             "--tilt: each prior's roll and pitch (the truth's) measured within DEG, as a\n"
+             "mission's attitude sensor gives them (run.tilt_tolerance_deg, default 0.5): a\n"
+             "result tilted further from them is refined with them held, or refused.\n";
       std::exit(0);
     } else {
       throw std::invalid_argument("unknown option " + a);
@@ -716,8 +740,14 @@ json Sequence(const std::string& world, int scans, std::mt19937_64& rng,
 }  // namespace
 
 int main(int argc, char** argv) {
+  Options o;
   try {
-    const Options o = ParseOptions(argc, argv);
+    o = ParseOptions(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "registration_eval: " << e.what() << " (see --help)\n";
+    return 2;
+  }
+  try {
     std::mt19937_64 rng(o.seed);
     if (!o.pair_cache.empty()) std::filesystem::create_directories(o.pair_cache);
     const mapping::RegistrationConfig ours = o.config.empty()
@@ -732,7 +762,8 @@ int main(int argc, char** argv) {
                 {"sensor", sensors::SensorConfigToYaml({SensorModel(o), {}, {}, {}})},
                 {"baseline_config", mapping::RegistrationConfigToYaml(pcl_default)},
                 {"targets",
-                 {{"rotation_deg", kTargetRotation_deg}, {"translation_m", kTargetTranslation_m}}}};
+                 {{"rotation_deg", kTargetRotation_deg}, {"translation_m", kTargetTranslation_m}}},
+                {"prior_tilt_tolerance_deg", o.tilt_deg ? json(*o.tilt_deg) : json()}};
     json pairs = json::array(), stats = json::object();
     std::vector<Pair> all;
     for (const std::string& world : o.worlds) {
@@ -765,6 +796,17 @@ int main(int argc, char** argv) {
         mapping::RegistrationPrior prior;
         prior.odometry = OffsetGuess(p.truth, level_m, level_deg, rng);
         prior.odometry_uncertainty = mapping::GuessUncertainty{level_m, level_deg};  // its bound
+        if (o.tilt_deg) {
+          // The guess's heading error turned about the world's up, as odometry's lies, so that
+          // its roll and pitch are the truth's, as an attitude sensor measures them (OffsetGuess
+          // turns about the source's own z, which tilts a tilted source: terrain pairs by 1 deg).
+          const Eigen::Vector3d up =
+              p.target.T_world_base.linear().transpose() * Eigen::Vector3d::UnitZ();
+          const Eigen::Matrix3d turn = p.truth.linear().transpose() * prior.odometry->linear();
+          const double yaw = std::atan2(turn(1, 0), turn(0, 0));
+          prior.odometry->linear() = Eigen::AngleAxisd(yaw, up) * p.truth.linear();
+          prior.tilt = mapping::MeasuredTilt{up, *o.tilt_deg};
+        }
         if (!o.only_pairs.empty() && !o.only_pairs.count(p.id))
           continue;  // guess drawn all the same
         if (l == 0 && !o.dump_pairs.empty()) {
