@@ -1,8 +1,23 @@
 #include "drive_length.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace pitchlab::mission {
+
+KnownStretch PlanKnownStretch(const planning::Path& path, const planning::TraversabilityGrid& grid) {
+  KnownStretch known;
+  known.to_the_end = path.waypoints.size() <= 1;
+  const mapping::GridGeometry& g = grid.geometry;
+  for (std::size_t i = 1; i < path.waypoints.size(); ++i) {
+    const planning::Waypoint &v = path.waypoints[i - 1], &w = path.waypoints[i];
+    const std::size_t k = g.Linear(g.IndexOf(w.x_m, w.y_m));
+    if (!std::isfinite(grid.z_m[k]) || grid.line_gap[k]) break;
+    known.length_m += std::hypot(w.x_m - v.x_m, w.y_m - v.y_m);
+    known.to_the_end = i + 1 == path.waypoints.size();
+  }
+  return known;
+}
 
 DriveLength PlanDriveLength(double drive_per_stop_m, double unknown_margin_m, double plan_known_m,
                             bool seen_to_the_end, bool last_turned_only,

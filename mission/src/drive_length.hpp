@@ -4,7 +4,23 @@
 
 #include <optional>
 
+#include "pitchlab/planning/planner.hpp"
+#include "pitchlab/planning/traversability.hpp"
+
 namespace pitchlab::mission {
+
+/// How far a plan runs over known ground from its start.
+struct KnownStretch {
+  double length_m = 0;      ///< along the plan to the first cell not known [m]
+  bool to_the_end = false;  ///< every cell of the plan is known
+};
+
+/// The stretch of `path` (its start, the robot's own cell, counts) up to the first waypoint whose
+/// cell the laser has not made known ground: unobserved in `grid`, or a line gap (ground only
+/// until a look from closer says otherwise, line_gaps.hpp). A cell seen without a supported slope
+/// counts as seen (benchmarks/README.md, session 42: counting it as unseen made the robot stop
+/// short of such cells and look again, and moved no crossing of a true hazard).
+KnownStretch PlanKnownStretch(const planning::Path& path, const planning::TraversabilityGrid& grid);
 
 /// A drive's length, or only a turn to face the path.
 struct DriveLength {

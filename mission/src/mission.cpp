@@ -777,19 +777,9 @@ void Mission::Plan(StopRecord& stop) {
     stop.plan_error = path.error().message;
     return;
   }
-  // How far the plan runs over ground the laser has seen (the robot's own cells count).
-  stop.plan_known_m = 0;
-  stop.plan_seen_to_end = path->waypoints.size() <= 1;
-  for (std::size_t i = 1; i < path->waypoints.size(); ++i) {
-    const planning::Waypoint& w = path->waypoints[i];
-    const mapping::CellIndex c = grid.geometry.IndexOf(w.x_m, w.y_m);
-    // A line gap is ground only until a look from closer says otherwise (line_gaps.hpp).
-    const std::size_t k = grid.geometry.Linear(c);
-    if (!std::isfinite(grid.z_m[k]) || grid.line_gap[k]) break;
-    const planning::Waypoint& v = path->waypoints[i - 1];
-    stop.plan_known_m += std::hypot(w.x_m - v.x_m, w.y_m - v.y_m);
-    stop.plan_seen_to_end = i + 1 == path->waypoints.size();
-  }
+  const KnownStretch known = PlanKnownStretch(*path, grid);
+  stop.plan_known_m = known.length_m;
+  stop.plan_seen_to_end = known.to_the_end;
   stop.plan = std::move(*path);
 }
 

@@ -1,9 +1,13 @@
 // How far a stop drives (mission/src/drive_length.hpp): up to the unknown margin short of the
-// first unobserved cell, a turn when that is too close, a metre into the blind zone after a turn.
+// first unobserved cell, a turn when that is too close, a metre into the blind zone after a turn;
+// and how far a plan runs over known ground.
 
 #include "drive_length.hpp"
 
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
 
 namespace pitchlab::mission {
 namespace {
@@ -55,6 +59,63 @@ TEST(PlanDriveLength, ARecoveryStopsTheMarginShortOfTheDoubtedCellsEvenAfterATur
   EXPECT_FALSE(drive.turn_only);
   EXPECT_NEAR(drive.length_m, 0.4, 1e-12);
   EXPECT_LT(PlanDriveLength(kDrive_m, kMargin_m, 5.0, false, false, 0.5).length_m, 0.1);  // no way on
+}
+
+// A straight plan along row 0 of a 10 x 1 grid of 0.5 m cells, every cell seen level.
+struct Corridor {
+  mapping::GridGeometry g = mapping::GridGeometry::FromArea(0, 0, 5, 0.5, 0.5);
+  planning::TraversabilityGrid grid;
+  planning::Path path;
+  Corridor() {
+    grid.geometry = g;
+    grid.z_m.assign(g.cell_count(), 0.0f);
+    grid.line_gap.assign(g.cell_count(), false);
+    for (int i = 0; i < g.size_x; ++i) {
+      const Eigen::Vector2d c = g.CenterOf({i, 0});
+      path.cells.push_back({i, 0});
+      path.waypoints.push_back({c.x(), c.y(), 0.0});
+    }
+  }
+};
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+TEST(PlanKnownStretch, AllKnownIsSeenToTheEnd) {
+  const Corridor c;
+  const KnownStretch known = PlanKnownStretch(c.path, c.grid);
+  EXPECT_TRUE(known.to_the_end);
+  EXPECT_NEAR(known.length_m, 4.5, 1e-12);  // centre of cell 0 to centre of cell 9
+}
+
+TEST(PlanKnownStretch, EndsBeforeAnUnseenCellAndBeforeALineGap) {
+  Corridor unseen;
+  unseen.grid.z_m[6] = kNaN;
+  KnownStretch known = PlanKnownStretch(unseen.path, unseen.grid);
+  EXPECT_FALSE(known.to_the_end);
+  EXPECT_NEAR(known.length_m, 2.5, 1e-12);  // cell 0 to cell 5
+  Corridor gap;
+  gap.grid.line_gap[3] = true;
+  known = PlanKnownStretch(gap.path, gap.grid);
+  EXPECT_FALSE(known.to_the_end);
+  EXPECT_NEAR(known.length_m, 1.0, 1e-12);
+}
+
+// The robot's own cell is where it stands: it counts whatever the map says of it.
+TEST(PlanKnownStretch, TheRobotsOwnCellCountsAsKnown) {
+  Corridor c;
+  c.grid.z_m[0] = kNaN;
+  const KnownStretch known = PlanKnownStretch(c.path, c.grid);
+  EXPECT_TRUE(known.to_the_end);
+  EXPECT_NEAR(known.length_m, 4.5, 1e-12);
+}
+
+TEST(PlanKnownStretch, APlanOfOneCellIsSeenToItsEnd) {
+  Corridor c;
+  c.path.waypoints.resize(1);
+  c.path.cells.resize(1);
+  const KnownStretch known = PlanKnownStretch(c.path, c.grid);
+  EXPECT_TRUE(known.to_the_end);
+  EXPECT_EQ(known.length_m, 0.0);
 }
 
 }  // namespace
