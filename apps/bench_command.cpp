@@ -476,6 +476,7 @@ json MakeRecord(const SweepSettings& s, const BenchRun& run, std::optional<int> 
   r["closest_approach_to_forbidden_m"] = Field(metrics, "/closest_approach_to_forbidden_m");
   r["forbidden_cells_crossed"] = Field(metrics, "/forbidden_cells_crossed");
   r["hazard_cells_crossed"] = Field(metrics, "/hazard_cells_crossed");
+  r["hazards_touched_steepest_deg"] = Field(metrics, "/hazards_touched/steepest_deg");
   r["map_cells_compared"] = Field(metrics, "/map_hazards/cells_compared");
   r["false_hazard_cells"] = Field(metrics, "/map_hazards/false_hazard_cells");
   r["missed_hazard_cells"] = Field(metrics, "/map_hazards/missed_hazard_cells");
@@ -694,6 +695,8 @@ json SummaryRow(const std::string& world, const std::vector<const json*>& record
           {"median_false_hazard_percent", Median(FalseHazardPercent(records))},
           {"runs_over_forbidden_cells", CountPositive(records, "forbidden_cells_crossed")},
           {"runs_over_true_hazards", CountPositive(records, "hazard_cells_crossed")},
+          // How steep the worst of those was: 16.4 deg against the planner's 16 is a margin used.
+          {"steepest_hazard_touched_deg", Max(Numbers(records, "hazards_touched_steepest_deg"))},
           {"failure_reasons", reasons}};
 }
 

@@ -31,6 +31,25 @@ std::string Count(std::size_t n, const std::string& one, const std::string& many
   return std::to_string(n) + " " + (n == 1 ? one : many);
 }
 
+// metrics.json's hazards_touched in words ("4 too-steep cells (the steepest 16.4 deg; the
+// limit 16 deg), 1 step cell"), or empty when it records none.
+std::string TouchedText(const nlohmann::json& m) {
+  const nlohmann::json* t = At(m, "hazards_touched");
+  if (!t || !t->is_object()) return {};
+  std::string text;
+  const auto add = [&](const std::string& part) { text += (text.empty() ? "" : ", ") + part; };
+  if (const std::size_t n = t->value("too_steep", std::size_t{0}); n > 0) {
+    add(Count(n, "too-steep cell", "too-steep cells") + " (the steepest " +
+        Significant(t->value("steepest_deg", 0.0)) + " deg; the limit " +
+        Significant(t->value("too_steep_limit_deg", 0.0)) + " deg)");
+  }
+  if (const std::size_t n = t->value("step", std::size_t{0}); n > 0)
+    add(Count(n, "step cell", "step cells"));
+  if (const std::size_t n = t->value("drop", std::size_t{0}); n > 0)
+    add(Count(n, "drop cell", "drop cells"));
+  return text;
+}
+
 // A stage's words in the report.
 const char* StageLabel(Stage stage) {
   switch (stage) {
@@ -140,6 +159,12 @@ Outcome ReadOutcome(const nlohmann::json& m) {
   if (const auto* d = At(m, "closest_approach_to_forbidden_m"); d && d->get<double>() < kTouch_m) {
     o.safety.push_back("its centre came " + Significant(d->get<double>(), 2) +
                        " m from a true hazard cell");
+  }
+  // What those hazards were: a cell a fraction of a degree over the planner's slope limit (set
+  // with a margin below where the robot tips) reads otherwise than a cliff's edge.
+  if (!o.safety.empty()) {
+    if (std::string what = TouchedText(m); !what.empty())
+      o.safety.push_back("the true hazards under its footprint: " + what);
   }
   o.safe = o.safety.empty();
   o.headline = !o.success ? "Failed" : o.safe ? "Goal reached" : "Goal reached, but unsafe";

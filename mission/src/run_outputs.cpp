@@ -275,6 +275,10 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
     m["forbidden_cells_crossed"] = score->forbidden_cells_crossed;
     m["hazard_cells_crossed"] = score->hazard_cells_crossed;
     m["hazard_cells_crossed_as"] = KindsJson(score->crossed_as);
+    nlohmann::json touched = KindsJson(score->touched);
+    touched["steepest_deg"] = score->touched_steepest_deg;
+    touched["too_steep_limit_deg"] = score->too_steep_limit_deg;
+    m["hazards_touched"] = touched;
     m["map_hazards"] = {{"cells_compared", score->map_cells_compared},
                         {"false_hazard_cells", score->false_hazard_cells},
                         {"false_as", KindsJson(score->false_as)},

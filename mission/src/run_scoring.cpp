@@ -70,6 +70,36 @@ double ClosestHazard(const std::vector<Eigen::Vector2d>& xy, const planning::Tra
   return best;
 }
 
+// RunScore::touched and its steepest tilt: every true hazard cell the centre crossed, or within
+// the footprint's reach of a crossed forbidden cell, counted once.
+void TouchedHazards(const planning::TraversabilityGrid& truth, const planning::Path& driven,
+                    RunScore& s) {
+  const mapping::GridGeometry& g = truth.geometry;
+  const double reach_m = planning::FootprintReach(truth);
+  const int r = static_cast<int>(std::ceil(reach_m / g.cell_m));
+  std::vector<bool> seen(g.cell_count(), false);
+  const auto touch = [&](std::size_t k) {
+    if (seen[k] || !IsHazard(truth.blocked[k])) return;
+    seen[k] = true;
+    s.touched.Count(truth.blocked[k]);
+    if (truth.blocked[k] == planning::Blocked::kTooSteep)
+      s.touched_steepest_deg = std::max(s.touched_steepest_deg, truth.Tilt(k) * kRadToDeg);
+  };
+  for (std::size_t n = 1; n < driven.cells.size(); ++n) {  // the start excluded, as above
+    const mapping::CellIndex c = driven.cells[n];
+    const std::size_t k = g.Linear(c);
+    if (truth.Free(k)) continue;
+    touch(k);
+    if (truth.blocked[k] != planning::Blocked::kNearHazard) continue;
+    for (int dj = -r; dj <= r; ++dj)
+      for (int di = -r; di <= r; ++di) {
+        const mapping::CellIndex nb{c.i + di, c.j + dj};
+        if (g.Contains(nb) && std::hypot(di, dj) * g.cell_m < reach_m - 1e-9) touch(g.Linear(nb));
+      }
+  }
+  s.too_steep_limit_deg = truth.config.robot.max_inclination_rad * kRadToDeg;
+}
+
 }  // namespace
 
 HazardVerdict CompareHazard(const planning::TraversabilityGrid& estimated,
@@ -147,6 +177,7 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
     if (!truth.Free(k)) s.forbidden_crossed_at.push_back(truth.geometry.CenterOf(driven.cells[i]));
   }
   s.hazard_cells_crossed = s.crossed_as.Total();
+  TouchedHazards(truth, driven, s);
   auto optimum = PlanRoute(truth, start_m, via_m, goal_m, algorithm);
   if (optimum) {
     s.true_optimal_cost = optimum->cost;

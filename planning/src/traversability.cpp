@@ -118,12 +118,6 @@ std::vector<std::pair<int, int>> Disc(double reach_m, double cell_m) {
   return disc;
 }
 
-// How far the footprint reaches: a cell whose centre is closer than this to a hazard cell's
-// centre puts the robot over it (half the width, plus half a cell for the hazard's edge) [m].
-double FootprintReach(const TraversabilityGrid& T) {
-  return 0.5 * T.config.robot.width_m + 0.5 * T.geometry.cell_m;
-}
-
 // Footprint: every free cell whose centre is closer than the footprint's reach to the centre of
 // a hazard cell is blocked. Stamps a disc around the hazard cells that border a non-hazard cell.
 void InflateHazards(TraversabilityGrid& T, const std::vector<std::size_t>& border) {
@@ -330,6 +324,10 @@ void ComputeMoveCosts(TraversabilityGrid& T) {
 }
 
 }  // namespace
+
+double FootprintReach(const TraversabilityGrid& T) {
+  return 0.5 * T.config.robot.width_m + 0.5 * T.geometry.cell_m;
+}
 
 float MoveCostOf(const TraversabilityGrid& T, std::size_t k, int b) {
   const CellIndex c = T.geometry.FromLinear(k);

@@ -4,6 +4,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -92,6 +93,7 @@ TEST_F(BenchCli, ShardsCoverEveryRunOnceAndMergeToTheUnshardedSummary) {
     EXPECT_TRUE(r["max_registration_error_m"].is_number());
     EXPECT_TRUE(r["registration_step_max_m"].is_number());
     EXPECT_TRUE(r["cost_ratio"].is_number());
+    EXPECT_TRUE(r["hazards_touched_steepest_deg"].is_number());
     EXPECT_TRUE(fs::exists(dir_ / "whole" / r["run_dir"].get<std::string>() / "metrics.json"));
   }
   // The unsafe runs the table counts are the runs whose robot crossed such cells.
@@ -102,6 +104,10 @@ TEST_F(BenchCli, ShardsCoverEveryRunOnceAndMergeToTheUnshardedSummary) {
   }
   EXPECT_EQ(summary["total"]["runs_over_forbidden_cells"], over_forbidden);
   EXPECT_EQ(summary["total"]["runs_over_true_hazards"], over_hazards);
+  double steepest = 0;
+  for (const json& r : all)
+    steepest = std::max(steepest, r["hazards_touched_steepest_deg"].get<double>());
+  EXPECT_DOUBLE_EQ(summary["total"]["steepest_hazard_touched_deg"].get<double>(), steepest);
   EXPECT_NE(whole.err.find("unsafe forb/haz"), std::string::npos) << whole.err;
 
   for (const char* shard : {"1/2", "2/2"}) {

@@ -79,6 +79,30 @@ TEST(ReadOutcome, CrossingTrueHazardsMakesASuccessUnsafe) {
   EXPECT_NE(o.safety[2].find("0 m from a true hazard cell"), std::string::npos);
 }
 
+// The truth's hazards under the footprint, by kind, and how steep the steepest was against the
+// limit the truth judged it by.
+TEST(ReadOutcome, SaysWhatTheHazardsUnderTheFootprintWere) {
+  nlohmann::json m = SafeSuccess();
+  m["forbidden_cells_crossed"] = 5;
+  m["hazards_touched"] = {{"too_steep", 4}, {"step", 1}, {"drop", 0},
+                          {"steepest_deg", 16.4213}, {"too_steep_limit_deg", 16.0}};
+  Outcome o = ReadOutcome(m);
+  ASSERT_EQ(o.safety.size(), 2u);
+  EXPECT_EQ(o.safety[1],
+            "the true hazards under its footprint: 4 too-steep cells (the steepest 16.4 deg; the "
+            "limit 16.0 deg), 1 step cell");
+  // A safe run says nothing of hazards, whatever the metrics hold.
+  m["forbidden_cells_crossed"] = 0;
+  o = ReadOutcome(m);
+  EXPECT_TRUE(o.safe);
+  EXPECT_TRUE(o.safety.empty());
+  // Forbidden cells by the grid's edge alone: no hazard to describe.
+  m["forbidden_cells_crossed"] = 2;
+  m["hazards_touched"] = {{"too_steep", 0}, {"step", 0}, {"drop", 0},
+                          {"steepest_deg", 0.0}, {"too_steep_limit_deg", 16.0}};
+  EXPECT_EQ(ReadOutcome(m).safety.size(), 1u);
+}
+
 TEST(ReadOutcome, TouchingAHazardIsUnsafeEvenWithoutCrossingIt) {
   nlohmann::json m = SafeSuccess();
   m["closest_approach_to_forbidden_m"] = 0.02;  // prints as 0.0 m at the report's precision

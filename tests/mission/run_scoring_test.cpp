@@ -46,6 +46,47 @@ TEST(ScoreRun, MissedTooSteepCellsReportTheMapsAndTheTruthsTilt) {
   EXPECT_NEAR(s.missed_steep_true_tilt_deg, 25.0, 1e-4);  // of 20, 25 and 30
 }
 
+// A track along a row of five 1 m cells crosses cells 1-4, built from layers as a run's truth is:
+// three too-steep cells (20, 30, 25 deg; the limit 16) and a step inside cell 4. The hazards under
+// it are those four, the steepest 30 deg.
+TEST(ScoreRun, SaysWhatTheHazardsTheRobotCameOverWere) {
+  mapping::ElevationLayers L;
+  L.geometry = mapping::GridGeometry::FromArea(0, 0, 5, 1, 1.0);
+  const std::size_t n = L.geometry.cell_count();
+  L.state.assign(n, mapping::CellState::kObserved);
+  L.count.assign(n, 10);
+  L.mean_z.assign(n, 0.0f);
+  L.min_z.assign(n, 0.0f);
+  L.max_z.assign(n, 0.0f);
+  L.roughness.assign(n, 0.0f);
+  L.phi_x.assign(n, 0.0f);
+  L.phi_y.assign(n, 0.0f);
+  L.clearance_z.assign(n, INFINITY);
+  L.phi_x[1] = float(20 * kDeg);
+  L.phi_y[2] = float(-30 * kDeg);
+  L.phi_x[3] = float(25 * kDeg);
+  L.max_z[4] = 0.5f;  // a step within the cell
+  planning::PlannerConfig config;
+  config.robot.max_inclination_rad = 16 * kDeg;
+  const planning::TraversabilityGrid truth = planning::BuildTraversability(L, config);
+  ASSERT_EQ(truth.blocked[2], planning::Blocked::kTooSteep);
+  ASSERT_EQ(truth.blocked[4], planning::Blocked::kStep);
+  MissionResult run;
+  for (double x = 0.5; x <= 4.5; x += 0.25) {
+    TrajectorySample s;
+    s.T_world_base_true = Eigen::Isometry3d(Eigen::Translation3d(x, 0.5, 0));
+    run.trajectory.push_back(s);
+  }
+  const RunScore s =
+      ScoreRun(run, truth, truth, {0.5, 0.5}, {4.5, 0.5}, planning::Algorithm::kAStar);
+  EXPECT_EQ(s.hazard_cells_crossed, 4u);
+  EXPECT_EQ(s.touched.too_steep, 3u);
+  EXPECT_EQ(s.touched.step, 1u);
+  EXPECT_EQ(s.touched.drop, 0u);
+  EXPECT_NEAR(s.touched_steepest_deg, 30.0, 1e-4);
+  EXPECT_NEAR(s.too_steep_limit_deg, 16.0, 1e-9);
+}
+
 // A 4 x 2 m floor of 0.1 m cells with a box 0.3 m tall (x 2.0-2.4, y 1.2-2.0), a P3-AT's
 // traversability of it, and a true track along y = 1.05: 0.15 m from the box, closer than half the
 // robot's width (0.25 m), so the cells beside the box it drives over are forbidden. The score says
@@ -78,6 +119,12 @@ TEST(ScoreRun, SaysWhereTheRunCrossedForbiddenCells) {
     EXPECT_GT(at.x(), 2.0 - 0.25 - 0.1);
     EXPECT_LT(at.x(), 2.4 + 0.25 + 0.1);
   }
+  // The hazards under the footprint: the box's near row of step cells (y 1.2-1.3, 0.2 m from the
+  // track's centre line, within the footprint's 0.3 m reach; the next row is 0.3 m away), each once
+  // however many forbidden cells reach it.
+  EXPECT_EQ(s.touched.step, 4u);
+  EXPECT_EQ(s.touched.too_steep + s.touched.drop, 0u);
+  EXPECT_EQ(s.touched_steepest_deg, 0.0);
 }
 
 }  // namespace

@@ -71,6 +71,14 @@ struct RunScore {
   std::size_t missed_steep_tilt_unknown = 0;
   /// Of hazard_cells_crossed, what the truth calls them [1].
   HazardKinds crossed_as;
+  /// The true hazard cells the footprint came over: those the centre crossed and those within
+  /// the footprint's reach (planning::FootprintReach) of a forbidden cell it crossed, by kind [1].
+  HazardKinds touched;
+  /// Of the too-steep ones, the steepest true plane tilt, and the limit the truth judged them by
+  /// (the planner's max_inclination) [deg]; 0 when none. A cell half a degree over the planning
+  /// limit (terrain: 16 deg, the loaded P3-AT tips at 31) is not a cliff's edge.
+  double touched_steepest_deg = 0;
+  double too_steep_limit_deg = 0;
 };
 
 /// How a map's cell compares with the truth's (both on one grid): kNotCompared where either does

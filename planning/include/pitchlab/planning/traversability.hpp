@@ -167,6 +167,11 @@ struct TraversabilityGrid {
   double Tilt(std::size_t k) const;
 };
 
+/// How far the footprint reaches: a cell whose centre is closer than this to a hazard cell's
+/// centre puts the robot over it, and is kNearHazard (half the robot's width, plus half a cell for
+/// the hazard's edge) [m].
+double FootprintReach(const TraversabilityGrid& grid);
+
 /// Classifies every cell and precomputes its entry cost. Throws std::invalid_argument on a bad
 /// config.
 TraversabilityGrid BuildTraversability(const mapping::ElevationLayers& layers,
