@@ -8,6 +8,8 @@
 #include "pitchlab/mapping/elevation_map.hpp"
 #include "pitchlab/mission/run_scoring.hpp"
 
+#include "level_layers.hpp"
+
 namespace pitchlab::mission {
 namespace {
 
@@ -46,22 +48,23 @@ TEST(ScoreRun, MissedTooSteepCellsReportTheMapsAndTheTruthsTilt) {
   EXPECT_NEAR(s.missed_steep_true_tilt_deg, 25.0, 1e-4);  // of 20, 25 and 30
 }
 
+// A run whose true trajectory runs along y = y_m from x0_m to x1_m, a sample every step_m.
+MissionResult TrackAlongX(double x0_m, double x1_m, double y_m, double step_m) {
+  MissionResult run;
+  for (double x = x0_m; x <= x1_m + 1e-9; x += step_m) {
+    TrajectorySample s;
+    s.T_world_base_true = Eigen::Isometry3d(Eigen::Translation3d(x, y_m, 0));
+    run.trajectory.push_back(s);
+  }
+  return run;
+}
+
 // A track along a row of five 1 m cells crosses cells 1-4, built from layers as a run's truth is:
 // three too-steep cells (20, 30, 25 deg; the limit 16) and a step inside cell 4. The hazards under
 // it are those four, the steepest 30 deg.
 TEST(ScoreRun, SaysWhatTheHazardsTheRobotCameOverWere) {
-  mapping::ElevationLayers L;
-  L.geometry = mapping::GridGeometry::FromArea(0, 0, 5, 1, 1.0);
-  const std::size_t n = L.geometry.cell_count();
-  L.state.assign(n, mapping::CellState::kObserved);
-  L.count.assign(n, 10);
-  L.mean_z.assign(n, 0.0f);
-  L.min_z.assign(n, 0.0f);
-  L.max_z.assign(n, 0.0f);
-  L.roughness.assign(n, 0.0f);
-  L.phi_x.assign(n, 0.0f);
-  L.phi_y.assign(n, 0.0f);
-  L.clearance_z.assign(n, INFINITY);
+  mapping::ElevationLayers L =
+      test_support::LevelLayers(mapping::GridGeometry::FromArea(0, 0, 5, 1, 1.0));
   L.phi_x[1] = float(20 * kDeg);
   L.phi_y[2] = float(-30 * kDeg);
   L.phi_x[3] = float(25 * kDeg);
@@ -71,14 +74,8 @@ TEST(ScoreRun, SaysWhatTheHazardsTheRobotCameOverWere) {
   const planning::TraversabilityGrid truth = planning::BuildTraversability(L, config);
   ASSERT_EQ(truth.blocked[2], planning::Blocked::kTooSteep);
   ASSERT_EQ(truth.blocked[4], planning::Blocked::kStep);
-  MissionResult run;
-  for (double x = 0.5; x <= 4.5; x += 0.25) {
-    TrajectorySample s;
-    s.T_world_base_true = Eigen::Isometry3d(Eigen::Translation3d(x, 0.5, 0));
-    run.trajectory.push_back(s);
-  }
-  const RunScore s =
-      ScoreRun(run, truth, truth, {0.5, 0.5}, {4.5, 0.5}, planning::Algorithm::kAStar);
+  const RunScore s = ScoreRun(TrackAlongX(0.5, 4.5, 0.5, 0.25), truth, truth, {0.5, 0.5},
+                              {4.5, 0.5}, planning::Algorithm::kAStar);
   EXPECT_EQ(s.hazard_cells_crossed, 4u);
   EXPECT_EQ(s.touched.too_steep, 3u);
   EXPECT_EQ(s.touched.step, 1u);
@@ -102,14 +99,8 @@ TEST(ScoreRun, SaysWhereTheRunCrossedForbiddenCells) {
   (void)map.InsertPoints(points.data(), points.size());
   const planning::TraversabilityGrid truth =
       planning::BuildTraversability(mapping::ComputeLayers(map), planning::PlannerConfig{});
-  MissionResult run;
-  for (double x = 0.2; x <= 3.8; x += 0.05) {
-    TrajectorySample s;
-    s.T_world_base_true = Eigen::Isometry3d(Eigen::Translation3d(x, 1.05, 0));
-    run.trajectory.push_back(s);
-  }
-  const RunScore s =
-      ScoreRun(run, truth, truth, {0.2, 1.05}, {3.8, 1.05}, planning::Algorithm::kAStar);
+  const RunScore s = ScoreRun(TrackAlongX(0.2, 3.8, 1.05, 0.05), truth, truth, {0.2, 1.05},
+                              {3.8, 1.05}, planning::Algorithm::kAStar);
   ASSERT_GT(s.forbidden_cells_crossed, 0u);
   EXPECT_EQ(s.hazard_cells_crossed, 0u);  // beside the box, never on it
   ASSERT_EQ(s.forbidden_crossed_at.size(), s.forbidden_cells_crossed);

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "pitchlab/planning/traversability.hpp"
+#include "level_layers.hpp"
 
 namespace pitchlab::mission {
 namespace {
@@ -42,18 +43,8 @@ TEST(MaxGrade, APathShorterThanTheBaselineHasNoGrade) {
 // A 4 x 4 m map of 0.1 m cells: flat and observed at z = 0, except the unknown column x in
 // [3.0, 3.1) and one drop cell at (2.05, 2.05).
 mapping::ElevationLayers FlatLayers() {
-  mapping::ElevationLayers L;
-  L.geometry = mapping::GridGeometry::FromArea(0.0, 0.0, 4.0, 4.0, 0.1);
-  const std::size_t n = L.geometry.cell_count();
-  L.state.assign(n, mapping::CellState::kObserved);
-  L.count.assign(n, 10);
-  L.mean_z.assign(n, 0.0f);
-  L.min_z.assign(n, 0.0f);
-  L.max_z.assign(n, 0.0f);
-  L.roughness.assign(n, 0.0f);
-  L.phi_x.assign(n, 0.0f);
-  L.phi_y.assign(n, 0.0f);
-  L.clearance_z.assign(n, std::numeric_limits<float>::infinity());
+  mapping::ElevationLayers L =
+      test_support::LevelLayers(mapping::GridGeometry::FromArea(0.0, 0.0, 4.0, 4.0, 0.1));
   for (int j = 0; j < L.geometry.size_y; ++j) {
     const std::size_t k = L.geometry.Linear({30, j});
     L.state[k] = mapping::CellState::kUnknown;

@@ -10,6 +10,7 @@
 #include "pitchlab/mapping/elevation_layers.hpp"
 #include "pitchlab/planning/occupancy_grid.hpp"
 #include "pitchlab/planning/planner.hpp"
+#include "level_layers.hpp"
 #include "scoped_temp_dir.hpp"
 
 namespace pitchlab::planning {
@@ -126,15 +127,8 @@ TEST(OccupancyGrid, BadFilesNameTheFileAndTheLine) {
 // Layers of a 6 x 4 grid of 0.5 m cells: level ground at 0 with a 0.3 m block on cell (3, 2),
 // cell (0, 3) unknown, cell (5, 0) on a 10 deg slope.
 mapping::ElevationLayers SmallLayers() {
-  mapping::ElevationLayers L;
-  L.geometry = {0, 0, 0.5, 6, 4};
-  const std::size_t n = L.geometry.cell_count();
-  L.state.assign(n, mapping::CellState::kObserved);
-  L.count.assign(n, 10);
-  for (auto* v : {&L.mean_z, &L.min_z, &L.max_z, &L.roughness, &L.phi_x, &L.phi_y})
-    v->assign(n, 0.0f);
-  L.clearance_z.assign(n, INFINITY);
-  L.plane_residual.assign(n, NAN);
+  mapping::ElevationLayers L = test_support::LevelLayers({0, 0, 0.5, 6, 4});
+  L.plane_residual.assign(L.geometry.cell_count(), NAN);
   const std::size_t block = L.geometry.Linear({3, 2}), unknown = L.geometry.Linear({0, 3});
   L.mean_z[block] = L.min_z[block] = L.max_z[block] = 0.3f;
   L.state[unknown] = mapping::CellState::kUnknown;
