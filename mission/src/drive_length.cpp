@@ -33,4 +33,9 @@ DriveLength PlanDriveLength(double drive_per_stop_m, double unknown_margin_m, do
   return drive;
 }
 
+double MinDriveLength(const PurePursuitConfig& follower) {
+  constexpr double kMinDrive_m = 0.1;  // a drive shorter than this is no progress
+  return std::max(kMinDrive_m, follower.goal_tolerance_m);
+}
+
 }  // namespace pitchlab::mission

@@ -37,7 +37,6 @@ constexpr double kTurnGain_per_s = 2.0;                    // yaw rate per radia
 // `reverse`): terrain seeds 11 and 234 turned 55 and 47 deg at the end of a drive and slid 0.27 m
 // into a crack's edge.
 constexpr double kInView_rad = 60.0 * kPi / 180;
-constexpr double kMinDrive_m = 0.1;  // a drive shorter than this is no progress
 constexpr double kBackOff_m = 0.6;   // reverse this far from a tilt beyond caution
 constexpr double kBackOffSpeed_mps = 0.2;
 constexpr double kBackOffTiltRise_rad = 4.0 * kPi / 180;  // reversing tilts it this much more: stop
@@ -800,7 +799,7 @@ bool Mission::Drive(const StopRecord& stop) {
       last_stop_turned_only_, stop.look_closer ? std::optional(stop.plan_to_doubt_m) : std::nullopt);
   const bool turn_only = drive.turn_only;
   const double length = drive.length_m;
-  if (stop.look_closer && !turn_only && length < kMinDrive_m) {
+  if (stop.look_closer && !turn_only && length < MinDriveLength(config_.follower)) {
     // Looked from as close as it may go: the hazards stand, so there is no way on.
     result_.reason = "no path at stop " + std::to_string(stop.index) +
                      ": the hazards that block the way stay hazards seen from close by";

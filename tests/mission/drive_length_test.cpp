@@ -118,5 +118,20 @@ TEST(PlanKnownStretch, APlanOfOneCellIsSeenToItsEnd) {
   EXPECT_EQ(known.length_m, 0.0);
 }
 
+// The shortest drive is one the path follower drives: a straight path just that long is not done
+// at its start, one just shorter than the follower's tolerance is (and the robot would not move).
+TEST(MinDriveLength, IsADriveThePathFollowerDoesNotCountAsDoneBeforeItMoves) {
+  for (double tolerance_m : {0.05, 0.15, 0.4}) {
+    PurePursuitConfig follower;
+    follower.goal_tolerance_m = tolerance_m;
+    const double min_m = MinDriveLength(follower);
+    EXPECT_GE(min_m, 0.1);
+    PurePursuit long_enough({{0, 0}, {min_m + 1e-6, 0}}, follower);
+    EXPECT_FALSE(long_enough.Command(0, 0, 0).done) << "tolerance " << tolerance_m;
+    PurePursuit too_short({{0, 0}, {tolerance_m - 1e-6, 0}}, follower);
+    EXPECT_TRUE(too_short.Command(0, 0, 0).done) << "tolerance " << tolerance_m;
+  }
+}
+
 }  // namespace
 }  // namespace pitchlab::mission
