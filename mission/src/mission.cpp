@@ -15,6 +15,7 @@
 #include "pitchlab/mission/slope_guard.hpp"
 #include "pitchlab/sensors/number_text.hpp"
 
+#include "back_trail.hpp"
 #include "drive_length.hpp"
 #include "line_gaps.hpp"
 #include "optimised_elevation.hpp"
@@ -273,6 +274,7 @@ class Mission {
   bool last_stop_turned_only_ = false;  // the previous stop only turned to look ahead
   bool closing_look_ = false;           // ClosingLook's stop is under way
   bool backed_off_ = false;             // the last drive ended backing off from a tilt
+  BackTrail trail_{2 * kBackOff_m};     // the way back for DriveBack
   std::vector<FeltHazard> felt_;
   // Per map cell, the shortest range a registered scan saw it from [m] (+inf: never so). A
   // recovery doubts only what was never seen from close: doubt measured from where the robot
@@ -810,16 +812,21 @@ bool Mission::Drive(const StopRecord& stop) {
   if (!turn_only && !Follow(path, length)) return false;
   // After backing off, the next scan looks at the slope from where the robot stands.
   if (!backed_off_ && !FacePath(PathHeading(path, turn_only ? 0.0 : length))) return false;
-  // Never scan standing steeply: back off the way it came (once) and mark what it stood on.
-  if (!backed_off_ && Tilt() > config_.scan_tilt_deg * kPi / 180) {
+  if (backed_off_) return Brake();
+  if (!Brake()) return false;
+  // Never scan standing steeply: back off the way it came (once) and mark what it stood on. The
+  // tilt is read standing, once the base has braked: a base still moving reads a tilt it does not
+  // stand at (terrain seed 19 rolled on from 15 to 23 deg in the half second after its drive).
+  if (Tilt() > config_.scan_tilt_deg * kPi / 180) {
     Result<sensors::Odometry> odo = base_.ReadOdometry();
     if (!odo) {
       result_.reason = "base: " + odo.error().message;
       return false;
     }
     if (!BackOff(*odo, Tilt(), false)) return false;
+    return Brake();
   }
-  return Brake();
+  return true;
 }
 
 bool Mission::Brake() {
@@ -891,6 +898,7 @@ bool Mission::RecordSample(const sensors::Odometry& odo) {
   TrajectorySample sample{probes_.now_s(), Estimate(odo), std::nullopt};
   if (probes_.true_pose) sample.T_world_base_true = probes_.true_pose();
   result_.trajectory.push_back(sample);
+  trail_.Add(Eigen::Vector2d(odo.x_m, odo.y_m));
   if (!probes_.roll_pitch_rad) return true;
   const double tilt = Tilt();
   result_.max_tilt_rad = std::max(result_.max_tilt_rad, tilt);
@@ -1000,13 +1008,21 @@ bool Mission::DriveBack(const sensors::Odometry& odo, bool forwards) {
   const double start_tilt = Tilt();
   const double stop_tilt = std::min(start_tilt + kBackOffTiltRise_rad,
                                     std::max(start_tilt, config_.caution_tilt_deg * kPi / 180));
+  // The way it came, where the track holds enough of it; else straight back along the heading.
+  std::optional<PurePursuit> retrace;
+  if (std::vector<Eigen::Vector2d> way = trail_.WayBack(from, kBackOff_m);
+      PolylineLength(way) >= kMinRetrace_m) {
+    retrace.emplace(std::move(way), RetraceFollower(kBackOffSpeed_mps, kSlopeYawRate_rps));
+  }
   sensors::Odometry now = odo;
-  while ((Eigen::Vector2d(now.x_m, now.y_m) - from).norm() < kBackOff_m) {
+  while (retrace || (Eigen::Vector2d(now.x_m, now.y_m) - from).norm() < kBackOff_m) {
     if (OverBudget()) return false;
     if (probes_.now_s() - start_s > config_.stuck_timeout_s) break;  // as far as it goes
     if (Tilt() > stop_tilt) break;
-    Result<sensors::Odometry> next =
-        DriveBase(forwards ? kBackOffSpeed_mps : -kBackOffSpeed_mps, 0.0, config_.control_period_s);
+    DriveCommand cmd{forwards ? kBackOffSpeed_mps : -kBackOffSpeed_mps, 0.0, false};
+    if (retrace) cmd = retrace->Command(now.x_m, now.y_m, now.yaw_rad);
+    if (cmd.done) break;
+    Result<sensors::Odometry> next = DriveBase(cmd.v_mps, cmd.omega_rps, config_.control_period_s);
     if (!next) {
       result_.reason = "base: " + next.error().message;
       return false;
