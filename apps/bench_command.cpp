@@ -575,7 +575,9 @@ bool StopRuns(const SweepSettings& s, std::vector<Running>& running, int signal)
     }
     RemoveStaging(s.out, r.run);
   }
-  return !running.empty();
+  const bool stopped = !running.empty();
+  running.clear();  // reaped here: the sweep must not poll them again and record them as crashes
+  return stopped;
 }
 
 /// Runs `pending` with at most `jobs` at once, appending each record to the log as it ends.
@@ -583,9 +585,14 @@ void RunSweep(const SweepSettings& s, const std::vector<BenchRun>& pending, Reco
               bool quiet) {
   std::vector<Running> running;
   std::mutex running_mutex;  // the interruption's watcher thread reads `running`
+  // Set under running_mutex when the interruption takes the runs over: from then on the sweep
+  // starts and records nothing (a run it stopped is no result, and a resumed sweep must run it;
+  // the sweep used to poll the reaped runs and record them as "crashed: signal 0").
+  bool stopping = false;
   const int cleanup = mission::RegisterCleanup(
       [&](int signal) {
         std::lock_guard<std::mutex> lock(running_mutex);
+        stopping = true;
         return StopRuns(s, running, signal);
       },
       "the unfinished runs' folders (their logs stay in " + (s.out / "logs").string() + ")");
@@ -615,10 +622,15 @@ void RunSweep(const SweepSettings& s, const std::vector<BenchRun>& pending, Reco
                      static_cast<unsigned long long>(run.seed), next, pending.size());
       }
       std::lock_guard<std::mutex> lock(running_mutex);
+      if (stopping) break;
       running.push_back({run, StartRun(s, run), Clock::now(), false});
     }
     bool reaped = false;
     std::unique_lock<std::mutex> lock(running_mutex);
+    if (stopping) {
+      lock.unlock();
+      mission::WaitIfInterrupted();  // the watcher ends the process
+    }
     for (auto it = running.begin(); it != running.end();) {
       if (std::optional<json> record = Poll(s, *it)) {
         finish(*record);

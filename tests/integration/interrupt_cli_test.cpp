@@ -162,6 +162,9 @@ TEST_F(InterruptCli, BenchStopsItsRunsAndLeavesNoStagingFolder) {
   EXPECT_NE(e.err.find("interrupted by SIGTERM"), std::string::npos) << e.err;
   EXPECT_TRUE(Staging(bench / "runs", ".yard-s1").empty());
   EXPECT_FALSE(fs::exists(bench / "runs" / "yard-s1"));
+  // The stopped run is no result: nothing recorded, so a resumed sweep runs it.
+  EXPECT_EQ(Slurp(bench / "runs.jsonl").find("yard"), std::string::npos)
+      << Slurp(bench / "runs.jsonl");
 }
 
 }  // namespace
