@@ -816,7 +816,7 @@ bool Mission::Drive(const StopRecord& stop) {
   if (!Brake()) return false;
   // Never scan standing steeply: back off the way it came (once) and mark what it stood on. The
   // tilt is read standing, once the base has braked: a base still moving reads a tilt it does not
-  // stand at (terrain seed 19 rolled on from 15 to 23 deg in the half second after its drive).
+  // stand at (terrain seed 19 rolled on from 18 to 23 deg in the half second after its drive).
   if (Tilt() > config_.scan_tilt_deg * kPi / 180) {
     Result<sensors::Odometry> odo = base_.ReadOdometry();
     if (!odo) {
