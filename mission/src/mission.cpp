@@ -909,8 +909,7 @@ bool Mission::RecordSample(const sensors::Odometry& odo) {
 
 bool Mission::Follow(const planning::Path& path, double length_m) {
   const std::vector<Eigen::Vector2d> prefix = PathPrefix(path, length_m);
-  double prefix_m = 0;
-  for (std::size_t i = 1; i < prefix.size(); ++i) prefix_m += (prefix[i] - prefix[i - 1]).norm();
+  const double prefix_m = PolylineLength(prefix);
   const double slope_grade = std::tan(config_.slope_tilt_deg * kPi / 180);
   const PathGrade grade(path);
   PurePursuit follower(prefix, config_.follower);
