@@ -96,7 +96,7 @@ TEST(RunSettings, TheRunRegistersWithScanToMapDefaultsAKeyGivenWins) {
   const RunSettings s = ParseRunSettings("", "t", sim::P3Model::kP3AT);
   const mapping::RegistrationConfig& r = s.mission.registration.registration;
   EXPECT_EQ(r.max_rmse_m, 0.06);
-  EXPECT_EQ(r.min_inlier_ratio, 0.15);
+  EXPECT_EQ(r.min_inlier_ratio, 0.05);
   EXPECT_EQ(r.constraint_translation_m, 2.0)
       << "odometry slips up to 2.5 m on rugged ground; the office repeats every 2 m";
   EXPECT_GT(r.carry_max_m, s.mission.odometry_error_m + 4 * s.mission.odometry_error_per_m)
@@ -107,7 +107,7 @@ TEST(RunSettings, TheRunRegistersWithScanToMapDefaultsAKeyGivenWins) {
   const mapping::RegistrationConfig& g = given.mission.registration.registration;
   EXPECT_EQ(g.max_rmse_m, 0.02);
   EXPECT_EQ(g.icp_max_iterations, 30);
-  EXPECT_EQ(g.min_inlier_ratio, 0.15);  // not given: the run's
+  EXPECT_EQ(g.min_inlier_ratio, 0.05);  // not given: the run's
   EXPECT_EQ(g.carry_max_m, r.carry_max_m);
 }
 
