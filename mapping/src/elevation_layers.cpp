@@ -262,6 +262,7 @@ void ComputeLayersInto(const ElevationMap& map, const LayerConfig& config, Eleva
   const GridGeometry& g = map.geometry();
   const std::size_t n = g.cell_count();
   L.geometry = g;
+  L.height_noise_m = config.height_noise_m;
   L.state.assign(n, CellState::kUnknown);
   L.count.assign(n, 0);
   L.mean_z.assign(n, kNaN);

@@ -12,7 +12,8 @@ namespace pitchlab::planning {
 namespace {
 
 // A terrace: 10 x 5 cells of `cell_m`, columns 0-4 at 0 m, columns 5-9 at `rise_m`, one height
-// per cell (a DEM's sample).
+// per cell (a DEM's sample), exact: a laser point's noise would leave a step of one point a side
+// doubtful.
 mapping::ElevationLayers Terrace(double cell_m, double rise_m) {
   mapping::ElevationMap map(mapping::GridGeometry{0, 0, cell_m, 10, 5});
   std::vector<Eigen::Vector3f> pts;
@@ -20,7 +21,9 @@ mapping::ElevationLayers Terrace(double cell_m, double rise_m) {
     for (int i = 0; i < 10; ++i)
       pts.emplace_back((i + 0.5) * cell_m, (j + 0.5) * cell_m, i >= 5 ? rise_m : 0.0);
   (void)map.InsertPoints(pts.data(), pts.size());
-  return mapping::ComputeLayers(map);
+  mapping::LayerConfig exact;
+  exact.height_noise_m = 1e-4;
+  return mapping::ComputeLayers(map, exact);
 }
 
 Blocked At(const TraversabilityGrid& T, int i, int j) {

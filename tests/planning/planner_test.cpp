@@ -470,6 +470,64 @@ TEST(Planner, SlopeBeyondTheRobotLimitIsTooSteep) {
   EXPECT_EQ(BuildTraversability(L, steep).blocked[T.geometry.Linear({10, 10})], Blocked::kFree);
 }
 
+// The P3-DX's 2.5 cm step limit lies within a far floor's noise. A rise between cell means, or a
+// spread within a cell, counts as a step only where it stands out of the layers' point noise
+// (2 cm) by twice its standard error; short of that the cell is doubtful, and the unknown policy
+// decides. Near, dense ground keeps its real steps; a far obstacle well over the noise too.
+TEST(Planner, AFarFloorsNoiseIsNoStepForTheP3DxButRealStepsStay) {
+  const double cell = 0.1;
+  const int sx = 60, sy = 20;
+  ElevationMap map(GridGeometry::FromArea(0, 0, sx * cell, sy * cell, cell));
+  std::mt19937 rng(7);
+  std::normal_distribution<double> near_noise(0.0, 0.003), far_noise(0.0, 0.012);
+  const auto box = [](int i, int j) { return i >= 10 && i <= 12 && j >= 8 && j <= 10; };
+  const auto pole = [](int i, int j) { return i == 45 && j == 10; };
+  std::vector<Eigen::Vector3f> pts;
+  std::vector<double> far_z(sx * sy, 0.0);
+  for (int j = 0; j < sy; ++j)
+    for (int i = 0; i < sx; ++i) {
+      const Eigen::Vector2d c = map.geometry().CenterOf({i, j});
+      if (i < 30) {  // near: 20 points a cell, a 10 cm box among them
+        for (int p = 0; p < 20; ++p)
+          pts.emplace_back(float(c.x()), float(c.y()),
+                           float((box(i, j) ? 0.10 : 0.0) + near_noise(rng)));
+      } else {  // far: one point a cell, a 20 cm obstacle among them
+        far_z[j * sx + i] = (pole(i, j) ? 0.20 : 0.0) + far_noise(rng);
+        pts.emplace_back(float(c.x()), float(c.y()), float(far_z[j * sx + i]));
+      }
+    }
+  (void)map.InsertPoints(pts.data(), pts.size());
+  const ElevationLayers L = mapping::ComputeLayers(map);  // 2 cm a point
+  ASSERT_DOUBLE_EQ(L.height_noise_m, 0.02);
+  PlannerConfig dx;
+  dx.robot = RobotLimits::P3DX();
+  dx.unknown = UnknownPolicy::kPenalise;
+  const TraversabilityGrid T = BuildTraversability(L, dx);
+  const GridGeometry& g = T.geometry;
+  // Not vacuous: far neighbours' noise rises past 2.5 cm.
+  int noisy_rises = 0;
+  for (int j = 1; j + 1 < sy; ++j)
+    for (int i = 31; i + 1 < sx; ++i)
+      if (!pole(i, j) && !pole(i + 1, j))
+        noisy_rises += std::abs(far_z[j * sx + i] - far_z[j * sx + i + 1]) > 0.025;
+  ASSERT_GT(noisy_rises, 10);
+  for (int j = 2; j + 2 < sy; ++j)
+    for (int i = 2; i + 2 < sx; ++i) {
+      const std::size_t k = g.Linear({i, j});
+      if (i == 11 && j == 9) {  // the box's top, inside its edge
+        EXPECT_FALSE(T.Free(k));
+      } else if (box(i, j) || pole(i, j)) {  // a step, or too steep for the 3 x 3 plane
+        EXPECT_TRUE(IsFootprintHazard(T.blocked[k])) << i << ", " << j;
+      } else if (i >= 31 && (std::abs(i - 45) > 1 || std::abs(j - 10) > 1)) {  // off the pole's fit
+        EXPECT_FALSE(IsFootprintHazard(T.blocked[k])) << "far floor " << i << ", " << j;
+      }
+    }
+  // The near floor beside the box, more than the footprint's reach from it, stays free at no
+  // unknown penalty: dense ground is judged as before.
+  EXPECT_EQ(T.blocked[g.Linear({20, 10})], Blocked::kFree);
+  EXPECT_LT(T.enter_cost[g.Linear({20, 10})], dx.unknown_penalty);
+}
+
 TEST(PlannerConfig, YamlWeightsPresetsAndErrors) {
   const PlannerConfig c = ParsePlannerConfig(
       "robot: p3dx\nweights: {roughness: 4, length: 2, inclination_x: 0.5, inclination_y: 0.25}\n"

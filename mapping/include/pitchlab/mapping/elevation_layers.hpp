@@ -100,6 +100,9 @@ struct ElevationLayers {
   /// is measured between the points that bound it, not between cell edges. All zero when unknown;
   /// may be empty (layers made by hand): every cell's points are then taken at its centre.
   std::vector<PointSpan> point_span;
+  /// One point's height noise the layers were computed for (LayerConfig::height_noise_m) [m]: what
+  /// a step between cells of few points must stand out of (planning's step support).
+  double height_noise_m = 0.02;
 
   /// Overall tilt of the cell's plane, atan(sqrt(tan^2 phi_x + tan^2 phi_y)) [rad]; NaN unknown.
   float Tilt(std::size_t k) const;
