@@ -419,9 +419,8 @@ int RunMap(int argc, char** argv) {
         sensors::MakeEmbreeRayCaster(sim->model(), sim->data());
     mapping::TruthConfig truth_config;
     truth_config.progress = QuarterProgress("map: ground truth", "rows", quiet);
-    mapping::ElevationLayers truth =
-        mapping::ComputeLayers(mapping::ComputeTrueElevationMap(*caster, geometry, truth_config));
-    truth.height_noise_m = 0;  // one exact height a cell: its steps need no support
+    const mapping::ElevationLayers truth = mapping::ComputeTruthLayers(
+        mapping::ComputeTrueElevationMap(*caster, geometry, truth_config));
     summary["truth"] = ErrorJson(mapping::CompareToTruth(layers, truth));
     summary["world"] = *world;
   }

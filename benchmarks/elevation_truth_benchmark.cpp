@@ -138,14 +138,14 @@ int main(int argc, char** argv) {
         (void)map.InsertScan(scans.clouds[s].data(), scans.clouds[s].size(), scans.origins[s]);
       const mapping::ElevationLayers est = mapping::ComputeLayers(map);
       const mapping::ElevationLayers truth =
-          mapping::ComputeLayers(mapping::ComputeTrueElevationMap(rig.caster(), g));
+          mapping::ComputeTruthLayers(mapping::ComputeTrueElevationMap(rig.caster(), g));
       const mapping::MapErrorReport r = mapping::CompareToTruth(est, truth);
       // The former truth, the first surface from above (canopies count), for comparison.
       mapping::TruthConfig first_hit;
       first_hit.min_headroom_m = 0;
       const mapping::MapErrorReport r0 = mapping::CompareToTruth(
           est,
-          mapping::ComputeLayers(mapping::ComputeTrueElevationMap(rig.caster(), g, first_hit)));
+          mapping::ComputeTruthLayers(mapping::ComputeTrueElevationMap(rig.caster(), g, first_hit)));
       std::printf(
           "{\"world\": \"%s\", \"scans\": %zu, \"points\": %zu, \"cell_m\": %.3f, "
           "\"cells\": %zu, \"coverage\": %.4f, \"surface_cells\": %zu, \"rmse_m\": %.4f, "

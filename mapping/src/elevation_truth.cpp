@@ -211,4 +211,10 @@ MapErrorReport CompareToTruth(const ElevationLayers& estimate, const ElevationLa
   return rep;
 }
 
+ElevationLayers ComputeTruthLayers(const ElevationMap& truth, const LayerConfig& config) {
+  ElevationLayers layers = ComputeLayers(truth, config);
+  layers.height_noise_m = 0;
+  return layers;
+}
+
 }  // namespace pitchlab::mapping

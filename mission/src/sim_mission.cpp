@@ -86,8 +86,7 @@ struct Truth {
 Truth TruthOf(const mapping::ElevationMap& map, const MissionConfig& mission,
               const Eigen::Vector2d& start) {
   Truth truth;
-  truth.layers = mapping::ComputeLayers(map, mission.layers);
-  truth.layers.height_noise_m = 0;  // one exact height a cell: its steps need no support
+  truth.layers = mapping::ComputeTruthLayers(map, mission.layers);
   truth.grid = planning::BuildTraversability(truth.layers, mission.planner);
   auto optimum = PlanRoute(truth.grid, start, mission.via_m, mission.goal_m, mission.algorithm);
   if (!optimum) {

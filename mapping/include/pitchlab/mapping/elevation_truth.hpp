@@ -50,6 +50,11 @@ struct TruthConfig {
 ElevationMap ComputeTrueElevationMap(const sensors::RayCaster& caster, const GridGeometry& geometry,
                                      const TruthConfig& config = {});
 
+/// The layers of a true elevation map (ComputeTrueElevationMap): ComputeLayers with `config`, but
+/// its heights are exact, one a cell, so they carry no point noise (`height_noise_m` 0): its
+/// steps are judged as measured, not as a laser's few noisy points.
+ElevationLayers ComputeTruthLayers(const ElevationMap& truth, const LayerConfig& config = {});
+
 /// How an estimate is scored against the truth.
 ///
 /// What the truth means at a wall. The truth of a cell is the surface a ground robot stands on
