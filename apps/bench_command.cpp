@@ -481,6 +481,7 @@ json MakeRecord(const SweepSettings& s, const BenchRun& run, std::optional<int> 
   r["false_hazard_cells"] = Field(metrics, "/map_hazards/false_hazard_cells");
   r["missed_hazard_cells"] = Field(metrics, "/map_hazards/missed_hazard_cells");
   r["max_tilt_deg"] = Field(metrics, "/max_tilt_deg");
+  r["odometry_drift_p90_per_m"] = Field(metrics, "/odometry_drift/p90_per_m");
   return r;
 }
 

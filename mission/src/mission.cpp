@@ -267,6 +267,7 @@ class Mission {
   // Odometry distance [m] and clock [s] at the last merged scan: the prior's error bound grows
   // from there.
   double merged_distance_m_ = 0, merged_stamp_s_ = 0;
+  double stop_distance_m_ = 0;  // odometry distance at the last stop's scan [m]
   // Of the odometry distance, how much was driven on level ground (kLevelTilt_rad): in total, and
   // at the last merged scan [m].
   double level_distance_m_ = 0, merged_level_m_ = 0;
@@ -412,6 +413,8 @@ bool Mission::Stop(int k) {
   }
   const std::optional<Eigen::Vector2d> attitude = StillAttitude();
   stop.T_world_base_odom = Propagate(T_world_base_, odo_ref_, *odo, attitude);
+  stop.driven_m = result_.odometry_distance_m - stop_distance_m_;
+  stop_distance_m_ = result_.odometry_distance_m;
   // Algorithm 1 against the map, odometry as the prior (none for the scan that starts the map).
   const std::optional<Eigen::Isometry3d> prior =
       k == 0 ? std::nullopt
@@ -781,6 +784,7 @@ void Mission::Plan(StopRecord& stop) {
   const KnownStretch known = PlanKnownStretch(*path, grid);
   stop.plan_known_m = known.length_m;
   stop.plan_seen_to_end = known.to_the_end;
+  stop.plan_clear_m = PlanClearStretch(*path, grid, config_.drift_per_m);
   stop.plan = std::move(*path);
 }
 
@@ -800,7 +804,7 @@ bool Mission::Drive(const StopRecord& stop) {
       config_.drive_per_stop_m, config_.unknown_margin_m, stop.plan_known_m, stop.plan_seen_to_end,
       last_stop_turned_only_, stop.look_closer ? std::optional(stop.plan_to_doubt_m) : std::nullopt);
   const bool turn_only = drive.turn_only;
-  const double length = drive.length_m;
+  const double length = turn_only ? drive.length_m : CutForDrift(drive.length_m, stop.plan_clear_m);
   if (stop.look_closer && !turn_only && length < MinDriveLength(config_.follower)) {
     // Looked from as close as it may go: the hazards stand, so there is no way on.
     result_.reason = "no path at stop " + std::to_string(stop.index) +

@@ -207,6 +207,8 @@ std::vector<MetricRow> KeyMetrics(const nlohmann::json& m) {
       {"map_hazards.missed_hazard_cells", "missed hazard cells in the final map", "",
        "true hazards the map calls free"},
       {"max_tilt_deg", "largest tilt", "deg", "roll/pitch of the base"},
+      {"odometry_drift.p90_per_m", "odometry drift, 9 drives in 10", "m/m",
+       "odometry's pose against the registered one, per metre driven (run.drift_per_m)"},
       {"wall_time_s", "wall time", "s", "including set-up"},
   };
   std::vector<MetricRow> rows;

@@ -93,6 +93,7 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
       {"inclination_radius_m", &s.inclination_radius_m},
       {"safety_margin_m", &m.safety_margin_m},
       {"unknown_margin_m", &m.unknown_margin_m},
+      {"drift_per_m", &m.drift_per_m},
       {"map_range_m", &m.map_range_m},
       {"odometry_error_m", &m.odometry_error_m},
       {"odometry_error_per_m", &m.odometry_error_per_m},
@@ -148,7 +149,8 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
                                     {"odometry_error_per_m", m.odometry_error_per_m},
                                     {"odometry_error_level_per_m", m.odometry_error_level_per_m},
                                     {"odometry_error_deg", m.odometry_error_deg},
-                                    {"odometry_error_dps", m.odometry_error_dps}}) {
+                                    {"odometry_error_dps", m.odometry_error_dps},
+                                    {"drift_per_m", m.drift_per_m}}) {
     if (!(value >= 0 && std::isfinite(value))) {
       throw std::invalid_argument(source + ": run." + name + " = " + NumberText(value) +
                                   " must be finite and >= 0");
@@ -253,6 +255,7 @@ std::string RunSettingsToYaml(const RunSettings& s) {
      << (s.map_size_m ? "  map_size_m: " + std::to_string(*s.map_size_m) + "\n" : std::string())
      << "  safety_margin_m: " << m.safety_margin_m << "\n"
      << "  unknown_margin_m: " << m.unknown_margin_m << "\n"
+     << "  drift_per_m: " << m.drift_per_m << "\n"
      << "  map_range_m: " << m.map_range_m << "\n"
      << "  loop_closure: " << (m.registration.loop_closure.enabled ? "true" : "false") << "\n"
      << "  set_lines_right: " << (m.set_lines_right ? "true" : "false") << "\n"

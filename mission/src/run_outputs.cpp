@@ -1,5 +1,6 @@
 #include "pitchlab/mission/run_outputs.hpp"
 #include "pitchlab/mission/loop_closure_metrics.hpp"
+#include "pitchlab/mission/odometry_drift.hpp"
 #include "pitchlab/mission/registration_json.hpp"
 #include "pitchlab/mission/trajectory_outputs.hpp"
 #include "run_pictures.hpp"
@@ -155,6 +156,7 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
   // The plan of this stop: how it was found, or why there was none.
   j["plan"] = {{"found", stop.plan.has_value()},
                {"known_m", stop.plan_known_m},
+               {"clear_m", stop.plan_clear_m},
                {"felt_hazards", stop.felt_hazards},
                {"look_closer", stop.look_closer}};
   if (!stop.plan_note.empty()) j["plan"]["note"] = stop.plan_note;
@@ -243,6 +245,12 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
   std::size_t failed = 0;
   for (const StopRecord& s : r.stops) failed += !s.merge.merged && s.index > 0;
   m["registration_failures"] = failed;
+  // What run.drift_per_m plans for, as this run's registered scans measured it.
+  const OdometryDrift drift = MeasureOdometryDrift(r.stops);
+  m["odometry_drift"] = {{"drives", drift.drives},
+                         {"median_per_m", drift.median_per_m},
+                         {"p90_per_m", drift.p90_per_m},
+                         {"max_per_m", drift.max_per_m}};
   if (!r.stops.empty()) m["final_estimate"] = PoseJson(r.stops.back().T_world_base);
   if (!c.via.empty()) m["route"] = RouteJson(c, r);  // run --via, --round-trip
   if (c.loop_closure) m["loop_closures"] = LoopClosureJson(r);  // run: {loop_closure: true}

@@ -118,6 +118,96 @@ TEST(PlanKnownStretch, APlanOfOneCellIsSeenToItsEnd) {
   EXPECT_EQ(known.length_m, 0.0);
 }
 
+// A straight plan along y = 0.55 m over a 6 x 2 m grid of 0.1 m cells for a 0.5 m wide robot
+// (the footprint reaches 0.3 m: half its width and half a cell), all of it a 10 deg side slope
+// (where odometry drifts), free but for the cells set as hazards.
+struct OpenGround {
+  mapping::GridGeometry g = mapping::GridGeometry::FromArea(0, 0, 6, 2, 0.1);
+  planning::TraversabilityGrid grid;
+  planning::Path path;
+  explicit OpenGround(double tilt_deg = 10.0) {
+    grid.geometry = g;
+    grid.config.robot.width_m = 0.5;
+    grid.z_m.assign(g.cell_count(), 0.0f);
+    grid.phi_x_rad.assign(g.cell_count(), 0.0f);
+    grid.phi_y_rad.assign(g.cell_count(), static_cast<float>(tilt_deg * M_PI / 180));
+    grid.blocked.assign(g.cell_count(), planning::Blocked::kFree);
+    for (int i = 0; i < g.size_x; ++i) {
+      const Eigen::Vector2d c = g.CenterOf({i, 5});
+      path.cells.push_back({i, 5});
+      path.waypoints.push_back({c.x(), c.y(), 0.0});
+    }
+  }
+  void Set(int i, int j, planning::Blocked b) { grid.blocked[g.Linear({i, j})] = b; }
+};
+
+// A step cell centred at (4.05, 1.25), 0.7 m beside the plan. With 0.2 m of drift a metre, the
+// waypoint 3.4 m on is the first closer to it than the reach and the drift: at x = 3.45 the cell
+// is sqrt(0.6^2 + 0.7^2) = 0.922 m away, under 0.3 + 0.2 x 3.4 = 0.98 (at x = 3.35: 0.990 against
+// 0.96).
+TEST(PlanClearStretch, EndsWhereTheDriftCouldReachAHazardBesideThePlan) {
+  OpenGround o;
+  o.Set(40, 12, planning::Blocked::kStep);
+  EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.2), 3.4, 1e-9);
+  // Without drift the plan keeps the footprint off it all the way (0.7 m > 0.3 m).
+  EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.0), 5.9, 1e-9);
+  // Twice the drift: at x = 2.85 the cell is 1.389 m away, under 0.3 + 0.4 x 2.8 = 1.42 (at
+  // x = 2.75: 1.476 against 1.38).
+  EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.4), 2.8, 1e-9);
+}
+
+// A floor (within kFloorTilt_rad) accrues no drift: the hazard 0.7 m beside
+// the plan never comes within the footprint's reach. The plan sloped only from cell 20 on (its
+// waypoints from x = 2.05): the drift counts from the step into it, 0.2 m a metre; at x = 3.95 the
+// cell is 0.707 m away against 0.3 + 0.2 x 2.0 = 0.70, at x = 4.05 0.7 m against 0.72.
+TEST(PlanClearStretch, AFloorAccruesNoDrift) {
+  OpenGround level(0.5);
+  level.Set(40, 12, planning::Blocked::kStep);
+  EXPECT_NEAR(PlanClearStretch(level.path, level.grid, 0.2), 5.9, 1e-9);
+  OpenGround half(0.0);
+  half.Set(40, 12, planning::Blocked::kStep);
+  for (int j = 0; j < half.g.size_y; ++j)
+    for (int i = 20; i < half.g.size_x; ++i)
+      half.grid.phi_y_rad[half.g.Linear({i, j})] = static_cast<float>(10 * M_PI / 180);
+  EXPECT_NEAR(PlanClearStretch(half.path, half.grid, 0.2), 4.0, 1e-9);
+}
+
+// Every kind of hazard the footprint may not stand on counts (a step, a too-steep and a drop
+// cell); the margin around them (kNearHazard) and unseen ground do not: the plan already keeps off
+// the one, and the other is for the unknown margin.
+TEST(PlanClearStretch, CountsStepsSlopesAndDropsNotTheirMarginsOrTheUnseen) {
+  for (const planning::Blocked b :
+       {planning::Blocked::kStep, planning::Blocked::kTooSteep, planning::Blocked::kDrop}) {
+    OpenGround o;
+    o.Set(40, 12, b);
+    EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.2), 3.4, 1e-9) << static_cast<int>(b);
+  }
+  for (const planning::Blocked b : {planning::Blocked::kNearHazard, planning::Blocked::kUnknown}) {
+    OpenGround o;
+    for (int i = 0; i < o.g.size_x; ++i) o.Set(i, 8, b);
+    EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.2), 5.9, 1e-9) << static_cast<int>(b);
+  }
+}
+
+// A hazard by the plan's start: the robot stands beside it, and the stretch is nothing.
+TEST(PlanClearStretch, AHazardWithinTheReachOfTheStartLeavesNoStretch) {
+  OpenGround o;
+  o.Set(0, 7, planning::Blocked::kTooSteep);  // (0.05, 0.75): 0.2 m from the start
+  EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.2), 0.0, 1e-12);
+  o.path.waypoints.resize(1);
+  EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.2), 0.0, 1e-12);
+}
+
+// A drive the plan's clearance allows is not cut; one it does not is cut to the clear stretch, but
+// to a metre at least, and never longer than it was.
+TEST(CutForDrift, CutsToTheClearStretchButNotBelowAMetre) {
+  EXPECT_DOUBLE_EQ(CutForDrift(3.0, 5.0), 3.0);
+  EXPECT_DOUBLE_EQ(CutForDrift(3.0, 2.2), 2.2);
+  EXPECT_DOUBLE_EQ(CutForDrift(3.0, 0.4), kMinDriftCut_m);
+  EXPECT_DOUBLE_EQ(CutForDrift(0.6, 0.0), 0.6);
+  EXPECT_DOUBLE_EQ(CutForDrift(0.6, 0.8), 0.6);
+}
+
 // The shortest drive is one the path follower drives: a straight path just that long is not done
 // at its start, one just shorter than the follower's tolerance is (and the robot would not move).
 TEST(MinDriveLength, IsADriveThePathFollowerDoesNotCountAsDoneBeforeItMoves) {

@@ -129,6 +129,23 @@ TEST(RunSettings, TheOdometryErrorBoundIsReadAndANegativeOneNamed) {
   }
 }
 
+TEST(RunSettings, TheDriftPerMetreIsReadWrittenBackAndANegativeOneNamed) {
+  EXPECT_EQ(ParseRunSettings("", "f.yaml", sim::P3Model::kP3AT).mission.drift_per_m, 0.2);
+  const RunSettings off = ParseRunSettings("run: {drift_per_m: 0}\n", "f.yaml", sim::P3Model::kP3AT);
+  EXPECT_EQ(off.mission.drift_per_m, 0.0);
+  EXPECT_EQ(ParseRunSettings(RunSettingsToYaml(off), "back", sim::P3Model::kP3AT).mission.drift_per_m,
+            0.0);
+  for (const char* bad : {"run: {drift_per_m: -0.1}\n", "run: {drift_per_m: .inf}\n"}) {
+    try {
+      ParseRunSettings(bad, "f.yaml", sim::P3Model::kP3AT);
+      FAIL() << "accepted: " << bad;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("f.yaml: run.drift_per_m"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 TEST(RunSettings, TheTiltToleranceIsReadAndAnImpossibleOneNamed) {
   EXPECT_EQ(ParseRunSettings("", "f.yaml", sim::P3Model::kP3DX).mission.tilt_tolerance_deg, 0.5);
   EXPECT_EQ(ParseRunSettings("run: {tilt_tolerance_deg: 1.5}\n", "f.yaml", sim::P3Model::kP3DX)

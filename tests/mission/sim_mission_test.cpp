@@ -322,6 +322,26 @@ TEST(RunSimMission, TheP3DxCrossesTheClutteredRoomsFloor) {
   EXPECT_EQ(run.metrics["forbidden_cells_crossed"], 0) << run.metrics.dump();
 }
 
+// The README's main command. Steering by odometry, the robot slid up to 0.5 m off a plan that kept
+// clear of the crack's south-west end and came over 14 forbidden and 2 true hazard cells there.
+// Its drives now end where the drift could reach a hazard beside the plan (drift_per_m), and the
+// next scan puts it back on its map.
+TEST(RunSimMission, TheDefaultRunsDrivesEndBeforeDriftTakesThemOntoAHazard) {
+  const ScopedTempDir dir("simmission");
+  SimMissionSpec spec = LoadSimMissionSpec(std::nullopt, 1);
+  spec.world_file = fs::path(PITCHLAB_WORLDS_DIR) / "terrain.xml";
+  const SimMissionOutcome run = RunSimMission(spec, dir / "run");
+  ASSERT_TRUE(run.result.success) << run.result.reason;
+  EXPECT_EQ(run.metrics["forbidden_cells_crossed"], 0) << run.metrics.dump();
+  EXPECT_EQ(run.metrics["hazard_cells_crossed"], 0) << run.metrics.dump();
+  int cut = 0;
+  for (const StopRecord& s : run.result.stops) {
+    cut += s.plan && s.plan_clear_m < std::min(s.plan_known_m, spec.settings.mission.drive_per_stop_m);
+  }
+  EXPECT_GE(cut, 1) << "no drive was cut for drift: nothing tested";
+  EXPECT_GT(run.metrics["odometry_drift"]["drives"].get<int>(), 10);
+}
+
 TEST(RunSimMission, NoWorldFileIsABadSpec) {
   const ScopedTempDir dir("simmission");
   EXPECT_THROW(RunSimMission(LoadSimMissionSpec(std::nullopt), dir / "run"), std::invalid_argument);
