@@ -20,7 +20,7 @@ KnownStretch PlanKnownStretch(const planning::Path& path, const planning::Traver
 }
 
 double PlanClearStretch(const planning::Path& path, const planning::TraversabilityGrid& grid,
-                        double error_per_m) {
+                        double error_per_m, double up_to_m) {
   const mapping::GridGeometry& g = grid.geometry;
   const double reach_m = planning::FootprintReach(grid);
   double arc_m = 0, drift_m = 0;
@@ -35,6 +35,7 @@ double PlanClearStretch(const planning::Path& path, const planning::Traversabili
         drift_m += error_per_m * step_m;
       }
     }
+    if (arc_m >= up_to_m) return arc_m;
     const double keep_m = reach_m + drift_m;
     const int r = static_cast<int>(std::ceil(keep_m / g.cell_m));
     for (int dj = -r; dj <= r; ++dj)

@@ -36,9 +36,11 @@ constexpr double kFloorTilt_rad = 1.0 * 3.14159265358979323846 / 180;
 /// and urban drives: 0.5 % median), within the planner's safety margin over a whole drive, and it
 /// accrues none: cutting the indoor drives short cost the P3-DX, whose 2.5 cm step limit is
 /// within a merged floor's outliers, 12 of its 19 goals over office, cluttered and corridor seeds
-/// 1..8. The whole path's length when no waypoint is that close.
+/// 1..8. Looks no farther than `up_to_m` along the plan (a stop's drive at most: the drift beyond
+/// grows the search around a waypoint to metres): returns the arc of the first waypoint at or past
+/// it, or the whole path's length, when no waypoint before is that close.
 double PlanClearStretch(const planning::Path& path, const planning::TraversabilityGrid& grid,
-                        double error_per_m);
+                        double error_per_m, double up_to_m);
 
 /// A drive's length, or only a turn to face the path.
 struct DriveLength {

@@ -784,7 +784,7 @@ void Mission::Plan(StopRecord& stop) {
   const KnownStretch known = PlanKnownStretch(*path, grid);
   stop.plan_known_m = known.length_m;
   stop.plan_seen_to_end = known.to_the_end;
-  stop.plan_clear_m = PlanClearStretch(*path, grid, config_.drift_per_m);
+  stop.plan_clear_m = PlanClearStretch(*path, grid, config_.drift_per_m, config_.drive_per_stop_m);
   stop.plan = std::move(*path);
 }
 

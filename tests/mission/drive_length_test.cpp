@@ -148,12 +148,12 @@ struct OpenGround {
 TEST(PlanClearStretch, EndsWhereTheDriftCouldReachAHazardBesideThePlan) {
   OpenGround o;
   o.Set(40, 12, planning::Blocked::kStep);
-  EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.2), 3.4, 1e-9);
+  EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.2, 10.0), 3.4, 1e-9);
   // Without drift the plan keeps the footprint off it all the way (0.7 m > 0.3 m).
-  EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.0), 5.9, 1e-9);
+  EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.0, 10.0), 5.9, 1e-9);
   // Twice the drift: at x = 2.85 the cell is 1.389 m away, under 0.3 + 0.4 x 2.8 = 1.42 (at
   // x = 2.75: 1.476 against 1.38).
-  EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.4), 2.8, 1e-9);
+  EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.4, 10.0), 2.8, 1e-9);
 }
 
 // A floor (within kFloorTilt_rad) accrues no drift: the hazard 0.7 m beside
@@ -163,13 +163,13 @@ TEST(PlanClearStretch, EndsWhereTheDriftCouldReachAHazardBesideThePlan) {
 TEST(PlanClearStretch, AFloorAccruesNoDrift) {
   OpenGround level(0.5);
   level.Set(40, 12, planning::Blocked::kStep);
-  EXPECT_NEAR(PlanClearStretch(level.path, level.grid, 0.2), 5.9, 1e-9);
+  EXPECT_NEAR(PlanClearStretch(level.path, level.grid, 0.2, 10.0), 5.9, 1e-9);
   OpenGround half(0.0);
   half.Set(40, 12, planning::Blocked::kStep);
   for (int j = 0; j < half.g.size_y; ++j)
     for (int i = 20; i < half.g.size_x; ++i)
       half.grid.phi_y_rad[half.g.Linear({i, j})] = static_cast<float>(10 * M_PI / 180);
-  EXPECT_NEAR(PlanClearStretch(half.path, half.grid, 0.2), 4.0, 1e-9);
+  EXPECT_NEAR(PlanClearStretch(half.path, half.grid, 0.2, 10.0), 4.0, 1e-9);
 }
 
 // Every kind of hazard the footprint may not stand on counts (a step, a too-steep and a drop
@@ -180,22 +180,31 @@ TEST(PlanClearStretch, CountsStepsSlopesAndDropsNotTheirMarginsOrTheUnseen) {
        {planning::Blocked::kStep, planning::Blocked::kTooSteep, planning::Blocked::kDrop}) {
     OpenGround o;
     o.Set(40, 12, b);
-    EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.2), 3.4, 1e-9) << static_cast<int>(b);
+    EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.2, 10.0), 3.4, 1e-9) << static_cast<int>(b);
   }
   for (const planning::Blocked b : {planning::Blocked::kNearHazard, planning::Blocked::kUnknown}) {
     OpenGround o;
     for (int i = 0; i < o.g.size_x; ++i) o.Set(i, 8, b);
-    EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.2), 5.9, 1e-9) << static_cast<int>(b);
+    EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.2, 10.0), 5.9, 1e-9) << static_cast<int>(b);
   }
+}
+
+// The search ends at `up_to_m` along the plan (a stop's drive): the hazard 3.4 m on is not looked
+// for by a 2.95 m drive, and the stretch is the arc of the first waypoint at or past it (3.0 m).
+TEST(PlanClearStretch, LooksNoFartherThanItIsAskedTo) {
+  OpenGround o;
+  o.Set(40, 12, planning::Blocked::kStep);
+  EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.2, 2.95), 3.0, 1e-9);
+  EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.2, 4.0), 3.4, 1e-9);
 }
 
 // A hazard by the plan's start: the robot stands beside it, and the stretch is nothing.
 TEST(PlanClearStretch, AHazardWithinTheReachOfTheStartLeavesNoStretch) {
   OpenGround o;
   o.Set(0, 7, planning::Blocked::kTooSteep);  // (0.05, 0.75): 0.2 m from the start
-  EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.2), 0.0, 1e-12);
+  EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.2, 10.0), 0.0, 1e-12);
   o.path.waypoints.resize(1);
-  EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.2), 0.0, 1e-12);
+  EXPECT_NEAR(PlanClearStretch(o.path, o.grid, 0.2, 10.0), 0.0, 1e-12);
 }
 
 // A drive the plan's clearance allows is not cut; one it does not is cut to the clear stretch, but

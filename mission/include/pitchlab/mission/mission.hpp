@@ -177,7 +177,7 @@ struct StopRecord {
   double plan_to_doubt_m = 0;  ///< with look_closer: plan length before the first such cell [m]
   double plan_known_m = 0;     ///< length of the plan over observed cells [m]
   /// Length of the plan before its hazards come within the robot's drift (MissionConfig's
-  /// drift_per_m, PlanClearStretch) [m].
+  /// drift_per_m, PlanClearStretch), looked for up to a stop's drive (drive_per_stop_m) [m].
   double plan_clear_m = 0;
   bool plan_seen_to_end = false;  ///< every cell of the plan observed: plan_known_m is its length
   int felt_hazards = 0;        ///< places marked too steep by the tilt so far
