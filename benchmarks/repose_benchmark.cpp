@@ -107,9 +107,9 @@ void BM_ReposeMapCloud(benchmark::State& state) {
 }
 BENCHMARK(BM_ReposeMapCloud)->Unit(benchmark::kMillisecond);
 
-// FNV-1a over the bytes of every cell (CellStats has no padding: 4 + 12 x 4 bytes).
+// FNV-1a over the bytes of every cell (CellStats has no padding: 4 + 14 x 4 bytes).
 std::uint32_t Fingerprint(const pitchlab::mapping::ElevationMap& map) {
-  static_assert(sizeof(pitchlab::mapping::CellStats) == 52, "no padding in CellStats");
+  static_assert(sizeof(pitchlab::mapping::CellStats) == 60, "no padding in CellStats");
   std::uint32_t h = 2166136261u;
   for (const pitchlab::mapping::CellStats& c : map.cells()) {
     unsigned char bytes[sizeof c];

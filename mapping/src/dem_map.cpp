@@ -28,7 +28,7 @@ using Kind = DemCrs::Kind;
 CellStats SampleCell(double z) {
   CellStats c;
   c.count = 1;
-  c.mean_z = c.min_z = c.max_z = static_cast<float>(z);
+  c.mean_z = c.min_z = c.max_z = static_cast<float>(z);  // one point: no second extremes
   return c;
 }
 

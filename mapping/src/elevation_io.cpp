@@ -1,6 +1,7 @@
 #include "pitchlab/mapping/elevation_io.hpp"
 
 #include <cerrno>
+#include <cstddef>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -18,12 +19,17 @@
 namespace pitchlab::mapping {
 namespace {
 
-constexpr char kMagic[8] = {'P', 'L', 'E', 'L', 'E', 'V', '0', '2'};
-// Every record in order, no runs: read, no longer written.
+constexpr char kMagic[8] = {'P', 'L', 'E', 'L', 'E', 'V', '0', '3'};
+// Runs of 52-byte records without the second extremes: read, no longer written.
+constexpr char kMagicRuns52[8] = {'P', 'L', 'E', 'L', 'E', 'V', '0', '2'};
+// Every 52-byte record in order, no runs: read, no longer written.
 constexpr char kMagicDense[8] = {'P', 'L', 'E', 'L', 'E', 'V', '0', '1'};
-static_assert(sizeof(CellStats) == 52, "the .plem record layout is 13 packed 4-byte fields");
+static_assert(sizeof(CellStats) == 60, "the .plem record layout is 15 packed 4-byte fields");
+// PLELEV01/02 records: CellStats up to clearance_z.
+constexpr std::size_t kRecord52 = 52;
+static_assert(offsetof(CellStats, next_min_z) == kRecord52, "the new fields follow the old record");
 
-// A cell nothing reached: no point, no ray (CellStats' defaults, byte for byte: 13 packed fields).
+// A cell nothing reached: no point, no ray (CellStats' defaults, byte for byte: 15 packed fields).
 bool Unseen(const CellStats& c) {
   static const CellStats kUnseen{};
   return std::memcmp(&c, &kUnseen, sizeof(CellStats)) == 0;
@@ -141,20 +147,42 @@ std::string InvalidValues(const GridGeometry& g, const GeodeticOrigin* geo,
       }
     }
     if (std::isnan(c.clearance_z)) return "cell " + std::to_string(i) + " has a NaN clearance";
+    // Second extremes within the extremes: +-inf for one point, finite for more.
+    if (!(c.min_z <= c.next_min_z && c.next_max_z <= c.max_z) ||
+        (c.count > 1 && !(std::isfinite(c.next_min_z) && std::isfinite(c.next_max_z)))) {
+      return "cell " + std::to_string(i) + " has second extremes (" + number(c.next_min_z) + ", " +
+             number(c.next_max_z) + ") outside its extremes (" + number(c.min_z) + ", " +
+             number(c.max_z) + ")";
+    }
   }
   return "";
 }
 
-// The cell records after the header at `pos` into `cells` (sized to the grid): every record in
-// order (PLELEV01), or runs of unseen and seen cells (PLELEV02), none reaching past the grid or
-// the file's hash. Why they do not fit, or empty.
-std::string ReadCells(const std::string& bytes, std::size_t pos, bool dense,
+// `count` records of `record` bytes at `from` into `to`. A 52-byte record of earlier versions
+// holds no second extremes: its extremes stand for them, so the map's steps read as they did.
+void CopyRecords(const char* from, std::size_t count, std::size_t record, CellStats* to) {
+  if (record == sizeof(CellStats)) {
+    std::memcpy(to, from, count * sizeof(CellStats));
+    return;
+  }
+  for (std::size_t k = 0; k < count; ++k) {
+    std::memcpy(static_cast<void*>(&to[k]), from + k * record, kRecord52);
+    if (to[k].known()) {
+      to[k].next_min_z = to[k].min_z;
+      to[k].next_max_z = to[k].max_z;
+    }
+  }
+}
+
+// The cell records of `record` bytes after the header at `pos` into `cells` (sized to the grid):
+// every record in order (PLELEV01), or runs of unseen and seen cells (PLELEV02/03), none reaching
+// past the grid or the file's hash. Why they do not fit, or empty.
+std::string ReadCells(const std::string& bytes, std::size_t pos, bool dense, std::size_t record,
                       std::vector<CellStats>& cells) {
   const std::size_t end = bytes.size() - 8;  // the hash
   if (dense) {
-    const std::size_t cells_bytes = cells.size() * sizeof(CellStats);
-    if (pos + cells_bytes != end) return "size does not match the grid";
-    std::memcpy(cells.data(), bytes.data() + pos, cells_bytes);
+    if (pos + cells.size() * record != end) return "size does not match the grid";
+    CopyRecords(bytes.data() + pos, cells.size(), record, cells.data());
     return "";
   }
   for (std::size_t k = 0; k < cells.size();) {
@@ -167,9 +195,9 @@ std::string ReadCells(const std::string& bytes, std::size_t pos, bool dense,
              " cells at cell " + std::to_string(k) + " does not fit the grid of " +
              std::to_string(cells.size());
     k += unseen;  // left at CellStats' defaults
-    if (pos + std::uint64_t{seen} * sizeof(CellStats) > end) return "truncated cell records";
-    std::memcpy(cells.data() + k, bytes.data() + pos, seen * sizeof(CellStats));
-    pos += seen * sizeof(CellStats);
+    if (pos + std::uint64_t{seen} * record > end) return "truncated cell records";
+    CopyRecords(bytes.data() + pos, seen, record, cells.data() + k);
+    pos += seen * record;
     k += seen;
   }
   return pos == end ? "" : "size does not match the grid";
@@ -193,11 +221,13 @@ Result<ElevationMap> LoadElevationMap(const std::string& path) {
   const auto bad = [&](const std::string& why) {
     return Fail(Error::Code::kInvalidArgument, path + ": not a pitchlab elevation map: " + why);
   };
-  const bool dense = bytes.size() >= sizeof(kMagic) + 8 &&
-                     std::memcmp(bytes.data(), kMagicDense, sizeof(kMagicDense)) == 0;
-  if (bytes.size() < sizeof(kMagic) + 8 ||
-      (!dense && std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0))
-    return bad("bad magic (expected PLELEV02, or PLELEV01 of earlier versions)");
+  const auto magic = [&](const char* m) {
+    return bytes.size() >= sizeof(kMagic) + 8 && std::memcmp(bytes.data(), m, sizeof(kMagic)) == 0;
+  };
+  const bool dense = magic(kMagicDense);
+  const std::size_t expected_record = magic(kMagic) ? sizeof(CellStats) : kRecord52;
+  if (!magic(kMagic) && !magic(kMagicRuns52) && !dense)
+    return bad("bad magic (expected PLELEV03, or PLELEV02/01 of earlier versions)");
   std::uint64_t stored_hash = 0;
   std::memcpy(&stored_hash, bytes.data() + bytes.size() - 8, 8);
   if (Fnv1a(std::string_view(bytes).substr(0, bytes.size() - 8)) != stored_hash)
@@ -212,8 +242,9 @@ Result<ElevationMap> LoadElevationMap(const std::string& path) {
       !Get(bytes, pos, &geo.latitude_deg) || !Get(bytes, pos, &geo.longitude_deg) ||
       !Get(bytes, pos, &geo.height_m) || !Get(bytes, pos, &record))
     return bad("truncated header");
-  if (record != sizeof(CellStats))
-    return bad("cell record of " + std::to_string(record) + " bytes");
+  if (record != expected_record)
+    return bad("cell record of " + std::to_string(record) + " bytes (expected " +
+               std::to_string(expected_record) + ")");
   if (sx <= 0 || sy <= 0 || !(g.cell_m > 0)) return bad("empty grid");
   g.size_x = sx;
   g.size_y = sy;
@@ -235,7 +266,8 @@ Result<ElevationMap> LoadElevationMap(const std::string& path) {
                                           std::to_string(sx) + " x " + std::to_string(sy) +
                                           " cells (" + NumberText(grid_bytes / 1e9) + " GB)");
   }
-  if (const std::string why = ReadCells(bytes, pos, dense, cells); !why.empty()) return bad(why);
+  if (const std::string why = ReadCells(bytes, pos, dense, record, cells); !why.empty())
+    return bad(why);
   // The hash proves the bytes are as written, not that a writer wrote numbers: a crafted or
   // foreign file with an infinite cell or a NaN height would plan "paths" of NaN coordinates.
   if (const std::string why = InvalidValues(g, has_geo ? &geo : nullptr, cells); !why.empty())

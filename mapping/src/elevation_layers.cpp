@@ -268,6 +268,8 @@ void ComputeLayersInto(const ElevationMap& map, const LayerConfig& config, Eleva
   L.mean_z.assign(n, kNaN);
   L.min_z.assign(n, kNaN);
   L.max_z.assign(n, kNaN);
+  L.next_min_z.assign(n, kNaN);
+  L.next_max_z.assign(n, kNaN);
   L.roughness.assign(n, kNaN);
   L.phi_x.assign(n, kNaN);
   L.phi_y.assign(n, kNaN);
@@ -287,6 +289,8 @@ void ComputeLayersInto(const ElevationMap& map, const LayerConfig& config, Eleva
         L.mean_z[k] = c.mean_z;  // Eq. 2
         L.min_z[k] = c.min_z;
         L.max_z[k] = c.max_z;
+        L.next_min_z[k] = c.next_min_z;
+        L.next_max_z[k] = c.next_max_z;
         L.roughness[k] = Roughness(c);  // Eq. 3
         L.plane_residual[k] = PlaneResidual(c, config.min_spread_m);
         L.point_span[k] = SpanOf(c, g.cell_m);

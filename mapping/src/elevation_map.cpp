@@ -31,8 +31,18 @@ inline void AddToCell(CellStats& c, float lx, float ly, float z) {
   c.c_yy += dy * ey;
   c.c_yz += dy * ez;
   c.c_zz += dz * ez;
-  c.min_z = std::min(c.min_z, z);
-  c.max_z = std::max(c.max_z, z);
+  if (z < c.min_z) {
+    c.next_min_z = c.min_z;
+    c.min_z = z;
+  } else if (z < c.next_min_z) {
+    c.next_min_z = z;
+  }
+  if (z > c.max_z) {
+    c.next_max_z = c.max_z;
+    c.max_z = z;
+  } else if (z > c.next_max_z) {
+    c.next_max_z = z;
+  }
 }
 
 // Chan et al.'s parallel combination: `a` becomes the statistics of a's and b's points, where b's
@@ -56,6 +66,9 @@ void CombineInto(CellStats& a, const CellStats& b, float ox, float oy) {
   a.mean_y = static_cast<float>(a.mean_y + dy * nb / n);
   a.mean_z = static_cast<float>(a.mean_z + dz * nb / n);
   a.count += b.count;
+  // The second extreme of the union: the lesser of the two extremes or the greater second one.
+  a.next_min_z = std::min(std::max(a.min_z, b.min_z), std::min(a.next_min_z, b.next_min_z));
+  a.next_max_z = std::max(std::min(a.max_z, b.max_z), std::max(a.next_max_z, b.next_max_z));
   a.min_z = std::min(a.min_z, b.min_z);
   a.max_z = std::max(a.max_z, b.max_z);
   a.clearance_z = std::min(a.clearance_z, b.clearance_z);

@@ -214,6 +214,10 @@ MapErrorReport CompareToTruth(const ElevationLayers& estimate, const ElevationLa
 ElevationLayers ComputeTruthLayers(const ElevationMap& truth, const LayerConfig& config) {
   ElevationLayers layers = ComputeLayers(truth, config);
   layers.height_noise_m = 0;
+  // No mixed pixel or outlier among exact heights: one point of a wall's top in a floor cell is
+  // the wall, so a step needs no second point (the extremes stand for the second ones).
+  layers.next_min_z = layers.min_z;
+  layers.next_max_z = layers.max_z;
   return layers;
 }
 

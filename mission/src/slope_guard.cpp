@@ -70,9 +70,14 @@ void MarkFelt(mapping::ElevationLayers& L, const FeltHazard& f) {
         L.mean_z[k] = L.min_z[k] = L.max_z[k] = static_cast<float>(f.z_m);
         L.roughness[k] = 0.0f;
       }
+      const float top = L.mean_z[k] + static_cast<float>(kObstacleHeight_m);
       L.phi_x[k] = phi_x;
       L.phi_y[k] = phi_y;
-      if (f.obstacle) L.max_z[k] = std::max(L.max_z[k], L.mean_z[k] + kObstacleHeight_m);
+      // Felt, not seen: a step however many points the scan put in the cell.
+      if (f.obstacle) {
+        L.max_z[k] = std::max(L.max_z[k], top);
+        if (k < L.next_max_z.size()) L.next_max_z[k] = std::max(L.next_max_z[k], top);
+      }
     }
   }
 }

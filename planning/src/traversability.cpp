@@ -46,6 +46,15 @@ void Read(const YAML::Node& node, const std::string& key, const std::string& sou
 // robot's limits leaves millimetres (p99 0.022 m on terrain's rough slopes at 0.2 m cells).
 constexpr double kResidualPerStep = 0.25;
 
+// The cell's second lowest and second highest point, where the layers hold them (built by hand
+// they may not), else its extremes.
+float NextMin(const ElevationLayers& L, std::size_t k) {
+  return k < L.next_min_z.size() ? L.next_min_z[k] : L.min_z[k];
+}
+float NextMax(const ElevationLayers& L, std::size_t k) {
+  return k < L.next_max_z.size() ? L.next_max_z[k] : L.max_z[k];
+}
+
 // Steps within a cell (something sticking up or down from its mean, or points off their plane by
 // a step's residual), or this cell standing higher than an observed neighbour by more than
 // step_max: the upper side of a step is the hazard cell (a wall, a curb's top, a cliff's edge),
@@ -60,8 +69,12 @@ constexpr double kResidualPerStep = 0.25;
 // a point's noise (kDoubtful below: the unknown policy decides, and a closer look brings the
 // points). The P3-DX's 2.5 cm step limit is within a far floor's noise: far cells of one or two
 // points stood as steps, and its missions were walled in by floors they could drive on (office,
-// cluttered, corridor seeds 1..4: 0 of 12 reached the goal). A dense cell's extremes are judged
-// as before: one point of a hundred 3 cm off still stands as a step for the P3-DX.
+// cluttered, corridor seeds 1..4: 0 of 12 reached the goal).
+// Within a cell of three points or more a step needs two of them beyond the limit (the second
+// extremes): a step the scan saw has points along its face or on its top, while one point alone
+// off a dense cell is a mixed pixel at a depth edge or an outlier (the P3-DX's office floors
+// stood as steps where one point of a hundred lay 2.6-3.6 cm off the mean). That one point makes
+// the cell doubtful, not free.
 // `max_grade` is tan(robot.max_inclination_rad).
 enum class StepVerdict { kNone, kStep, kTooSteep, kDoubtful };
 StepVerdict StepOrSlope(const ElevationLayers& L, int i, int j, const RobotLimits& robot,
@@ -73,10 +86,12 @@ StepVerdict StepOrSlope(const ElevationLayers& L, int i, int j, const RobotLimit
   const double in_cell = step_max + (coarse ? M_SQRT1_2 * g.cell_m * max_grade : 0.0);
   const float z = L.mean_z[k];
   const double noise = coarse ? 0.0 : L.height_noise_m;
+  const bool dense = L.count[k] > 2;
   bool doubtful = false;
   const double spread = std::max(L.max_z[k] - z, z - L.min_z[k]);
   if (spread > in_cell) {
-    if (L.count[k] > 2 || spread > in_cell + 2 * noise) return StepVerdict::kStep;
+    const double spread_of_two = std::max(NextMax(L, k) - z, z - NextMin(L, k));
+    if (dense ? spread_of_two > in_cell : spread > in_cell + 2 * noise) return StepVerdict::kStep;
     doubtful = true;
   }
   // NaN: no verdict; layers built by hand may leave the residual out. A step over the limit
@@ -86,7 +101,7 @@ StepVerdict StepOrSlope(const ElevationLayers& L, int i, int j, const RobotLimit
   // row of "steps" across a flat floor).
   if (k < L.plane_residual.size() && L.plane_residual[k] > kResidualPerStep * step_max &&
       L.max_z[k] - L.min_z[k] > step_max) {
-    if (L.max_z[k] - L.min_z[k] > step_max + 2 * noise) return StepVerdict::kStep;
+    if (NextMax(L, k) - NextMin(L, k) > step_max + 2 * noise) return StepVerdict::kStep;
     doubtful = true;
   }
   const double n = std::max<std::uint32_t>(L.count[k], 1);

@@ -35,6 +35,9 @@ inline void AddToCell(CellStats& c, float lx, float ly, float z) {
   c.c_yy += dy * ey;
   c.c_yz += dy * ez;
   c.c_zz += dz * ez;
+  // The two lowest and two highest heights, as a sorted list's ends would give them.
+  c.next_min_z = std::max(c.min_z, std::min(c.next_min_z, z));
+  c.next_max_z = std::min(c.max_z, std::max(c.next_max_z, z));
   c.min_z = std::min(c.min_z, z);
   c.max_z = std::max(c.max_z, z);
 }

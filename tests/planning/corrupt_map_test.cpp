@@ -61,6 +61,27 @@ TEST_F(CorruptMap, ANanHeightInAKnownCellIsRefusedOnLoad) {
       << loaded.error().message;
 }
 
+// A second highest point above the highest (or a second extreme missing from a cell of several
+// points) is no cell's statistics: the step rule would read a step that no point holds.
+TEST_F(CorruptMap, SecondExtremesOutsideTheExtremesAreRefusedOnLoad) {
+  const GridGeometry g = GridGeometry::FromArea(0, 0, 0.4, 0.3, 0.1);
+  const auto above = mapping::LoadElevationMap(Saved(g, [](auto& cells) {
+    cells[7].count = 3;
+    cells[7].next_min_z = 1.0f;
+    cells[7].next_max_z = 1.5f;
+  }));
+  ASSERT_FALSE(above);
+  EXPECT_NE(above.error().message.find("cell 7 has second extremes (1, 1.5) outside its "
+                                       "extremes (1, 1)"),
+            std::string::npos)
+      << above.error().message;
+  const auto missing = mapping::LoadElevationMap(Saved(g, [](auto& cells) { cells[2].count = 2; }));
+  ASSERT_FALSE(missing);
+  EXPECT_NE(missing.error().message.find("cell 2 has second extremes (inf, -inf)"),
+            std::string::npos)
+      << missing.error().message;
+}
+
 TEST_F(CorruptMap, AnIntactMapStillLoads) {
   const auto loaded = mapping::LoadElevationMap(Saved(GridGeometry::FromArea(0, 0, 0.4, 0.3, 0.1)));
   ASSERT_TRUE(loaded) << loaded.error().message;
@@ -98,7 +119,7 @@ TEST_F(CorruptMap, MangledCellRunsWithAValidHashAreRefusedNotFollowed) {
   });
   std::ifstream in(path, std::ios::binary);
   const std::string good((std::istreambuf_iterator<char>(in)), {});
-  ASSERT_EQ(good.substr(0, 8), "PLELEV02");
+  ASSERT_EQ(good.substr(0, 8), "PLELEV03");
   const auto fnv1a = [](const std::string& bytes) {
     std::uint64_t h = 1469598103934665603ull;
     for (unsigned char c : bytes) h = (h ^ c) * 1099511628211ull;

@@ -5,11 +5,13 @@
 #include <mujoco/mujoco.h>
 #include <GeographicLib/LocalCartesian.hpp>
 #include <GeographicLib/TransverseMercator.hpp>
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <random>
 
@@ -266,6 +268,38 @@ TEST(ElevationMap, UnknownWhereNoPointFellAndOutsidePointsCounted) {
   EXPECT_TRUE(std::isnan(L.mean_z[3]));
 }
 
+// A cell keeps its two lowest and two highest points whatever order they came in: the second
+// ones are what a step inside the cell needs (two points beyond the limit, not one).
+TEST(ElevationMap, SecondExtremesAreTheSecondLowestAndHighestPoints) {
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<float> u(0.01f, 0.09f), h(-0.2f, 0.2f);
+  for (int n : {1, 2, 3, 17}) {
+    ElevationMap map(GridGeometry::FromArea(0, 0, 0.1, 0.1, 0.1));
+    std::vector<Eigen::Vector3f> pts;
+    std::vector<float> z;
+    for (int k = 0; k < n; ++k) {
+      pts.emplace_back(u(rng), u(rng), h(rng));
+      z.push_back(pts.back().z());
+    }
+    (void)map.InsertPoints(pts.data(), pts.size());
+    std::sort(z.begin(), z.end());
+    const CellStats& c = map.at(0);
+    ASSERT_EQ(c.count, static_cast<std::uint32_t>(n));
+    EXPECT_EQ(c.min_z, z.front());
+    EXPECT_EQ(c.max_z, z.back());
+    if (n == 1) {
+      EXPECT_EQ(c.next_min_z, std::numeric_limits<float>::infinity());
+      EXPECT_EQ(c.next_max_z, -std::numeric_limits<float>::infinity());
+    } else {
+      EXPECT_EQ(c.next_min_z, z[1]) << n << " points";
+      EXPECT_EQ(c.next_max_z, z[z.size() - 2]) << n << " points";
+    }
+    const mapping::ElevationLayers L = ComputeLayers(map);
+    EXPECT_EQ(L.next_min_z[0], c.next_min_z);
+    EXPECT_EQ(L.next_max_z[0], c.next_max_z);
+  }
+}
+
 TEST(ElevationMap, MergeEqualsInsertingBothClouds) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(0.0f, 2.0f), n(-0.05f, 0.05f);
@@ -296,6 +330,8 @@ TEST(ElevationMap, MergeEqualsInsertingBothClouds) {
     EXPECT_NEAR(Roughness(x), Roughness(y), 1e-4);
     EXPECT_EQ(x.min_z, y.min_z);
     EXPECT_EQ(x.max_z, y.max_z);
+    EXPECT_EQ(x.next_min_z, y.next_min_z);
+    EXPECT_EQ(x.next_max_z, y.next_max_z);
   }
   ElevationMap misaligned(GridGeometry::FromArea(0.1, 0, 1, 1, 0.25));
   EXPECT_FALSE(ma.Merge(misaligned));
@@ -549,7 +585,7 @@ TEST(ElevationMapIo, StoresOnlyTheSeenCellsAndReadsEarlierDenseFiles) {
   ASSERT_LT(seen, g.cell_count() / 20);
   const std::string path = (dir / "sparse.plem").string();
   ASSERT_TRUE(SaveElevationMap(map, path));
-  EXPECT_EQ(std::filesystem::file_size(path), 72 + 8 * pairs + 52 * seen + 8);
+  EXPECT_EQ(std::filesystem::file_size(path), 72 + 8 * pairs + 60 * seen + 8);
   const auto loaded = LoadElevationMap(path);
   ASSERT_TRUE(loaded) << loaded.error().message;
   ASSERT_EQ(loaded->cells().size(), map.cells().size());
@@ -559,18 +595,49 @@ TEST(ElevationMapIo, StoresOnlyTheSeenCellsAndReadsEarlierDenseFiles) {
 
   std::ifstream in(path, std::ios::binary);
   const std::string sparse((std::istreambuf_iterator<char>(in)), {});
-  std::string dense = "PLELEV01" + sparse.substr(8, 64);  // the same header
-  dense.append(reinterpret_cast<const char*>(map.cells().data()),
-               map.cells().size() * sizeof(CellStats));
-  const std::uint64_t dense_hash = Fnv1a(dense);
-  dense.append(reinterpret_cast<const char*>(&dense_hash), 8);
-  std::ofstream(dir / "dense.plem", std::ios::binary) << dense;
-  const auto old = LoadElevationMap((dir / "dense.plem").string());
-  ASSERT_TRUE(old) << old.error().message;
-  EXPECT_EQ(std::memcmp(old->cells().data(), map.cells().data(),
-                        map.cells().size() * sizeof(CellStats)),
-            0);
-  EXPECT_TRUE(old->geometry().SameAs(g));
+  // Earlier versions' files, of 52-byte records without the second extremes: every record in
+  // order (PLELEV01) or runs (PLELEV02). They load cell for cell, each cell's extremes standing
+  // for its second ones, so their steps read as they did.
+  std::string header = sparse.substr(8, 64);  // the same header, but for the record size
+  const std::uint32_t record52 = 52;
+  std::memcpy(header.data() + 60, &record52, 4);
+  const auto old_record = [](const CellStats& c) {
+    return std::string(reinterpret_cast<const char*>(&c), 52);
+  };
+  std::string dense = "PLELEV01" + header;
+  for (const CellStats& c : map.cells()) dense += old_record(c);
+  std::string runs = "PLELEV02" + header;
+  const auto unseen = [&](std::size_t k) {
+    return map.at(k).count == 0 && !std::isfinite(map.at(k).clearance_z);
+  };
+  for (std::size_t k = 0; k < map.cells().size();) {
+    std::uint32_t n_unseen = 0, n_seen = 0;
+    while (k < map.cells().size() && unseen(k)) ++k, ++n_unseen;
+    std::string records;
+    while (k < map.cells().size() && !unseen(k)) records += old_record(map.at(k++)), ++n_seen;
+    runs.append(reinterpret_cast<const char*>(&n_unseen), 4);
+    runs.append(reinterpret_cast<const char*>(&n_seen), 4);
+    runs += records;
+  }
+  for (auto [name, bytes] : {std::pair{"dense.plem", dense}, {"runs.plem", runs}}) {
+    const std::uint64_t hash = Fnv1a(bytes);
+    bytes.append(reinterpret_cast<const char*>(&hash), 8);
+    std::ofstream(dir / name, std::ios::binary) << bytes;
+    const auto old = LoadElevationMap((dir / name).string());
+    ASSERT_TRUE(old) << name << ": " << old.error().message;
+    EXPECT_TRUE(old->geometry().SameAs(g));
+    int differ = 0;
+    for (std::size_t k = 0; k < map.cells().size(); ++k) {
+      const CellStats &a = old->at(k), &b = map.at(k);
+      differ += std::memcmp(&a, &b, 52) != 0;
+      if (b.known()) {
+        differ += a.next_min_z != b.min_z || a.next_max_z != b.max_z;
+      } else {
+        differ += std::memcmp(&a, &b, sizeof(CellStats)) != 0;
+      }
+    }
+    EXPECT_EQ(differ, 0) << name;
+  }
 
   std::string overrun = sparse.substr(0, sparse.size() - 8);
   const std::uint32_t too_many = static_cast<std::uint32_t>(g.cell_count());  // + the seen ones

@@ -528,6 +528,47 @@ TEST(Planner, AFarFloorsNoiseIsNoStepForTheP3DxButRealStepsStay) {
   EXPECT_LT(T.enter_cost[g.Linear({20, 10})], dx.unknown_penalty);
 }
 
+// Within a dense cell a step needs two points beyond the limit. One point 4 cm over a floor of 30
+// (a mixed pixel at a depth edge) leaves the cell doubtful for the P3-DX's 2.5 cm limit, for the
+// unknown policy to decide; two points there, the top of something, are a step.
+TEST(Planner, OnePointOffADenseCellIsDoubtfulTwoAreAStep) {
+  const double cell = 0.1;
+  ElevationMap map(GridGeometry::FromArea(0, 0, 2, 2, cell));
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.002);
+  std::uniform_real_distribution<double> at(0.01, 0.09);
+  std::vector<Eigen::Vector3f> pts;
+  for (int j = 0; j < 20; ++j)
+    for (int i = 0; i < 20; ++i)
+      for (int p = 0; p < 30; ++p)
+        pts.emplace_back(float(i * cell + at(rng)), float(j * cell + at(rng)), float(noise(rng)));
+  const auto raised = [&](int i, int j, int points) {
+    for (int p = 0; p < points; ++p)
+      pts.emplace_back(float(i * cell + at(rng)), float(j * cell + at(rng)), 0.04f);
+  };
+  raised(5, 10, 1);
+  raised(14, 10, 2);
+  (void)map.InsertPoints(pts.data(), pts.size());
+  const ElevationLayers L = mapping::ComputeLayers(map);
+  const GridGeometry& g = L.geometry;
+  const std::size_t one = g.Linear({5, 10}), two = g.Linear({14, 10});
+  ASSERT_GT(L.max_z[one] - L.mean_z[one], 0.035) << "the point stands past the 2.5 cm limit";
+  PlannerConfig dx;
+  dx.robot = RobotLimits::P3DX();
+  dx.unknown = UnknownPolicy::kPenalise;
+  const TraversabilityGrid T = BuildTraversability(L, dx);
+  EXPECT_EQ(T.blocked[one], Blocked::kFree);
+  EXPECT_GE(T.enter_cost[one], dx.unknown_penalty) << "doubtful: priced as unknown";
+  EXPECT_EQ(T.blocked[two], Blocked::kStep);
+  dx.unknown = UnknownPolicy::kForbid;
+  EXPECT_EQ(BuildTraversability(L, dx).blocked[one], Blocked::kUnknown);
+  // Layers built by hand without the second extremes judge by the extremes, as before.
+  ElevationLayers by_hand = L;
+  by_hand.next_min_z.clear();
+  by_hand.next_max_z.clear();
+  EXPECT_EQ(BuildTraversability(by_hand, dx).blocked[one], Blocked::kStep);
+}
+
 TEST(PlannerConfig, YamlWeightsPresetsAndErrors) {
   const PlannerConfig c = ParsePlannerConfig(
       "robot: p3dx\nweights: {roughness: 4, length: 2, inclination_x: 0.5, inclination_y: 0.25}\n"

@@ -3,19 +3,21 @@
 // loading), an ESRI ASCII grid with its .prj for GIS tools, and a PNG picture.
 //
 // Lossless format (`.plem`, all little-endian):
-//   bytes 0-7    magic "PLELEV02"
+//   bytes 0-7    magic "PLELEV03"
 //   float64 x3   x_min_m, y_min_m, cell_m       (GridGeometry)
 //   int32 x2     size_x, size_y
 //   uint32       has_geodetic_origin (0 or 1)
 //   float64 x3   latitude_deg, longitude_deg, height_m (zeros when absent)
-//   uint32       bytes per cell record (52)
+//   uint32       bytes per cell record (60)
 //   runs         until all size_x * size_y cells (index j * size_x + i) are covered:
 //                uint32 unseen, uint32 seen, then `seen` records. The `unseen` cells are
 //                CellStats' defaults (no point, no ray); a record's fields in declaration order:
 //                uint32 count, float32 mean_x mean_y mean_z c_xx c_xy c_xz c_yy c_yz c_zz
-//                min_z max_z clearance_z (infinities as IEEE infinities)
+//                min_z max_z clearance_z next_min_z next_max_z (infinities as IEEE infinities)
 //   uint64       FNV-1a 64 hash of every byte before it
-// "PLELEV01" files (every record in order, no runs: written by earlier pitchlab) are read too.
+// Files of earlier pitchlab are read too: "PLELEV02" (runs of 52-byte records, without the
+// second extremes, whose cells' extremes then stand for them) and "PLELEV01" (every 52-byte
+// record in order, no runs).
 // Files are written to a temporary name and renamed: a failure leaves no partial file.
 
 #include <array>

@@ -83,6 +83,10 @@ struct ElevationLayers {
   std::vector<float> mean_z;         ///< Eq. 2 cell elevation [m]; NaN unknown
   std::vector<float> min_z;          ///< [m]; NaN unknown
   std::vector<float> max_z;          ///< [m]; NaN unknown
+  /// The second lowest and second highest point [m] (CellStats): NaN unknown, +-inf with one
+  /// point. Layers built by hand may leave them empty: the extremes then stand for them.
+  std::vector<float> next_min_z;
+  std::vector<float> next_max_z;
   std::vector<float> roughness;      ///< Eq. 3 T: std dev of the cell's heights [m]; NaN unknown
   std::vector<float> phi_x;          ///< inclination along x: atan(dz/dx) [rad]; NaN unknown
   std::vector<float> phi_y;          ///< inclination along y: atan(dz/dy) [rad]; NaN unknown

@@ -85,7 +85,7 @@ struct GeodeticOrigin {
   double height_m = 0.0;       ///< ellipsoidal height of map z = 0 [m]
 };
 
-/// Running statistics of one cell: 52 bytes. Positions are relative to the cell centre, so float
+/// Running statistics of one cell: 60 bytes. Positions are relative to the cell centre, so float
 /// keeps sub-micrometre resolution; the co-moments are updated by Welford's method (stable).
 struct CellStats {
   std::uint32_t count = 0;                   ///< points in the cell [1]
@@ -97,6 +97,11 @@ struct CellStats {
   /// Lowest height at which a laser ray passed over the cell without hitting it: the surface
   /// here is below this [m]; +inf when no ray crossed. What makes unobserved drops visible.
   float clearance_z = std::numeric_limits<float>::infinity();
+  /// The second lowest and second highest point [m] (+-inf with fewer than two points): a step
+  /// inside a cell needs two points to say so, where one may be a mixed pixel at a depth edge or
+  /// an outlier (ElevationLayers::next_min_z).
+  float next_min_z = std::numeric_limits<float>::infinity();
+  float next_max_z = -std::numeric_limits<float>::infinity();
 
   bool known() const { return count > 0; }
 };

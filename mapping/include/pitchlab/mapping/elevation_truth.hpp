@@ -51,8 +51,9 @@ ElevationMap ComputeTrueElevationMap(const sensors::RayCaster& caster, const Gri
                                      const TruthConfig& config = {});
 
 /// The layers of a true elevation map (ComputeTrueElevationMap): ComputeLayers with `config`, but
-/// its heights are exact, one a cell, so they carry no point noise (`height_noise_m` 0): its
-/// steps are judged as measured, not as a laser's few noisy points.
+/// its heights are exact, so they carry no point noise (`height_noise_m` 0) and no mixed pixel
+/// (a cell's extremes stand for its second extremes): its steps are judged as measured, not as a
+/// laser's few noisy points.
 ElevationLayers ComputeTruthLayers(const ElevationMap& truth, const LayerConfig& config = {});
 
 /// How an estimate is scored against the truth.
