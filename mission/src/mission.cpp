@@ -216,6 +216,8 @@ class Mission {
   bool Brake();   // commands a standstill for kStopTime_s; false: the base failed (reason set)
   bool RecordSample(const sensors::Odometry& odo);  // false: tipping over (reason set)
   void Odometer(const sensors::Odometry& from, const sensors::Odometry& to);  // distance driven
+  // The yaw turned off level ground (`level`: the attitude sensor read it level).
+  void Turned(const sensors::Odometry& from, const sensors::Odometry& to, bool level);
   Eigen::Isometry3d Estimate(const sensors::Odometry& odo) const {
     return Propagate(T_world_base_, odo_ref_, odo, Attitude());
   }
@@ -271,6 +273,12 @@ class Mission {
   // Of the odometry distance, how much was driven on level ground (kLevelTilt_rad): in total, and
   // at the last merged scan [m].
   double level_distance_m_ = 0, merged_level_m_ = 0;
+  // The odometry's yaw turned off level ground [rad]: in total, at the last merged scan and at
+  // the last stop's scan.
+  double rough_turn_rad_ = 0, merged_rough_turn_rad_ = 0, stop_turn_rad_ = 0;
+  // Whether the attitude sensor read the ground level at the last trajectory sample: turning on
+  // the spot reads it no more (each read draws the sensor's noise; more reads change the run).
+  bool sampled_level_ = false;
   int last_plan_stop_ = -1;             // the last stop that planned, on grid_
   bool last_stop_turned_only_ = false;  // the previous stop only turned to look ahead
   bool closing_look_ = false;           // ClosingLook's stop is under way
@@ -415,6 +423,8 @@ bool Mission::Stop(int k) {
   stop.T_world_base_odom = Propagate(T_world_base_, odo_ref_, *odo, attitude);
   stop.driven_m = result_.odometry_distance_m - stop_distance_m_;
   stop_distance_m_ = result_.odometry_distance_m;
+  stop.turned_rad = rough_turn_rad_ - stop_turn_rad_;
+  stop_turn_rad_ = rough_turn_rad_;
   // Algorithm 1 against the map, odometry as the prior (none for the scan that starts the map).
   const std::optional<Eigen::Isometry3d> prior =
       k == 0 ? std::nullopt
@@ -423,7 +433,8 @@ bool Mission::Stop(int k) {
   const double rough_m = result_.odometry_distance_m - merged_distance_m_ - level_m;
   stop.prior_bound = {
       config_.odometry_error_m + config_.odometry_error_per_m * rough_m +
-          config_.odometry_error_level_per_m * level_m,
+          config_.odometry_error_level_per_m * level_m +
+          config_.odometry_error_per_rad * (rough_turn_rad_ - merged_rough_turn_rad_),
       config_.odometry_error_deg + config_.odometry_error_dps * (stop.stamp_s - merged_stamp_s_)};
   const mapping::GuessUncertainty& bound = stop.prior_bound;
   // The attitude sensor's roll and pitch at standstill: the prior's tilt is right within
@@ -441,6 +452,7 @@ bool Mission::Stop(int k) {
   if (stop.merge.merged) {
     merged_distance_m_ = result_.odometry_distance_m;
     merged_level_m_ = level_distance_m_;
+    merged_rough_turn_rad_ = rough_turn_rad_;
     merged_stamp_s_ = stop.stamp_s;
   }
   if (!merge) stop.merge.registration.reason = merge.error().message;
@@ -888,6 +900,7 @@ bool Mission::TurnTo(double yaw_rad) {
       result_.reason = "base: " + next.error().message;
       return false;
     }
+    Turned(*odo, *next, sampled_level_);
     if (!RecordSample(*next)) return false;
   }
 }
@@ -895,7 +908,13 @@ bool Mission::TurnTo(double yaw_rad) {
 void Mission::Odometer(const sensors::Odometry& from, const sensors::Odometry& to) {
   const double step_m = std::hypot(to.x_m - from.x_m, to.y_m - from.y_m);
   result_.odometry_distance_m += step_m;
-  if (Attitude() && Tilt() <= kLevelTilt_rad) level_distance_m_ += step_m;
+  const bool level = Attitude() && Tilt() <= kLevelTilt_rad;
+  if (level) level_distance_m_ += step_m;
+  Turned(from, to, level);
+}
+
+void Mission::Turned(const sensors::Odometry& from, const sensors::Odometry& to, bool level) {
+  if (!level) rough_turn_rad_ += std::abs(std::remainder(to.yaw_rad - from.yaw_rad, 2.0 * kPi));
 }
 
 bool Mission::RecordSample(const sensors::Odometry& odo) {
@@ -905,6 +924,7 @@ bool Mission::RecordSample(const sensors::Odometry& odo) {
   trail_.Add(Eigen::Vector2d(odo.x_m, odo.y_m));
   if (!probes_.roll_pitch_rad) return true;
   const double tilt = Tilt();
+  sampled_level_ = tilt <= kLevelTilt_rad;
   result_.max_tilt_rad = std::max(result_.max_tilt_rad, tilt);
   if (tilt <= config_.max_tilt_deg * kPi / 180) return true;
   result_.reason = "tipping over: tilt " + NumberText(tilt * 180 / kPi) + " deg";

@@ -98,6 +98,7 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
       {"odometry_error_m", &m.odometry_error_m},
       {"odometry_error_per_m", &m.odometry_error_per_m},
       {"odometry_error_level_per_m", &m.odometry_error_level_per_m},
+      {"odometry_error_per_rad", &m.odometry_error_per_rad},
       {"odometry_error_deg", &m.odometry_error_deg},
       {"odometry_error_dps", &m.odometry_error_dps},
       {"tilt_tolerance_deg", &m.tilt_tolerance_deg},
@@ -148,6 +149,7 @@ void ReadRunSection(const YAML::Node& node, const std::string& source, RunSettin
   for (const auto& [name, value] : {std::pair{"odometry_error_m", m.odometry_error_m},
                                     {"odometry_error_per_m", m.odometry_error_per_m},
                                     {"odometry_error_level_per_m", m.odometry_error_level_per_m},
+                                    {"odometry_error_per_rad", m.odometry_error_per_rad},
                                     {"odometry_error_deg", m.odometry_error_deg},
                                     {"odometry_error_dps", m.odometry_error_dps},
                                     {"drift_per_m", m.drift_per_m}}) {
@@ -263,6 +265,7 @@ std::string RunSettingsToYaml(const RunSettings& s) {
      << "  odometry_error_m: " << m.odometry_error_m << "\n"
      << "  odometry_error_per_m: " << m.odometry_error_per_m << "\n"
      << "  odometry_error_level_per_m: " << m.odometry_error_level_per_m << "\n"
+     << "  odometry_error_per_rad: " << m.odometry_error_per_rad << "\n"
      << "  odometry_error_deg: " << m.odometry_error_deg << "\n"
      << "  odometry_error_dps: " << m.odometry_error_dps << "\n"
      << "  tilt_tolerance_deg: " << m.tilt_tolerance_deg << "\n"

@@ -107,6 +107,8 @@ nlohmann::json RegistrationJson(const StopRecord& stop) {
                           ? nlohmann::json()
                           : nlohmann::json{{"translation_m", stop.prior_bound.translation_m},
                                            {"rotation_deg", stop.prior_bound.rotation_deg}}},
+      {"driven_m", stop.driven_m},
+      {"turned_off_level_deg", stop.turned_rad * kRadToDeg},
       {"success", reg.success},
       {"reason", reg.reason},
       {"path", mapping::ToString(reg.path)},

@@ -114,18 +114,26 @@ TEST(RunSettings, TheRunRegistersWithScanToMapDefaultsAKeyGivenWins) {
 TEST(RunSettings, TheOdometryErrorBoundIsReadAndANegativeOneNamed) {
   const RunSettings s = ParseRunSettings(
       "run: {odometry_error_m: 0.1, odometry_error_per_m: 0.05, odometry_error_deg: 1, "
-      "odometry_error_dps: 0.02}\n",
+      "odometry_error_dps: 0.02, odometry_error_per_rad: 0.07}\n",
       "f.yaml", sim::P3Model::kP3DX);
   EXPECT_EQ(s.mission.odometry_error_m, 0.1);
   EXPECT_EQ(s.mission.odometry_error_per_m, 0.05);
   EXPECT_EQ(s.mission.odometry_error_deg, 1.0);
   EXPECT_EQ(s.mission.odometry_error_dps, 0.02);
-  try {
-    ParseRunSettings("run: {odometry_error_deg: -1}\n", "f.yaml", sim::P3Model::kP3DX);
-    FAIL() << "a negative bound was accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("f.yaml: run.odometry_error_deg"), std::string::npos)
-        << e.what();
+  EXPECT_EQ(s.mission.odometry_error_per_rad, 0.07);
+  EXPECT_EQ(ParseRunSettings(RunSettingsToYaml(s), "back", sim::P3Model::kP3DX)
+                .mission.odometry_error_per_rad,
+            0.07);
+  EXPECT_EQ(ParseRunSettings("", "f.yaml", sim::P3Model::kP3AT).mission.odometry_error_per_rad,
+            0.05);
+  for (const char* bad : {"run: {odometry_error_deg: -1}\n", "run: {odometry_error_per_rad: -1}\n"}) {
+    try {
+      ParseRunSettings(bad, "f.yaml", sim::P3Model::kP3DX);
+      FAIL() << "a negative bound was accepted: " << bad;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("f.yaml: run.odometry_error_"), std::string::npos)
+          << e.what();
+    }
   }
 }
 

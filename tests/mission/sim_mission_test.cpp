@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -220,6 +221,53 @@ TEST(RunSimMission, OnALevelFloorTheOdometryBoundGrowsAtTheLevelRate) {
   const nlohmann::json reg = nlohmann::json::parse(file);
   EXPECT_DOUBLE_EQ(reg["prior_bound"]["translation_m"].get<double>(),
                    stops[1].prior_bound.translation_m);
+}
+
+// Off level ground a skid-steer base slides as it turns, so the prior's bound grows with the yaw
+// odometry turned there as well as with the distance: on a floor rolled 5 deg (past the 3 deg
+// that counts as level), with a box to drive round, each stop's bound is the constant, the
+// distance at the rough rate and the turn at odometry_error_per_rad, and the turn each stop
+// records is the one the robot made.
+TEST(RunSimMission, OffLevelTheOdometryBoundGrowsWithTheTurnAsWellAsTheDistance) {
+  const ScopedTempDir dir("simmission");
+  std::string xml = kFloorWorld;
+  xml.replace(xml.find(R"(size="6 4 0.1")"), 0, R"(euler="5 0 0" )");
+  xml.replace(xml.find("</worldbody>"), 0,
+              R"(<geom name="box" type="box" size="0.4 0.4 0.4" pos="0 0 0.4"/>)");
+  const fs::path world = dir / "rolled.xml";
+  std::ofstream(world) << xml;
+  SimMissionSpec spec = LoadSimMissionSpec(std::nullopt);
+  spec.world_file = world;
+  spec.goal_m = {3.0, 0.0};  // beyond the box, from the start (-4, 0)
+  const SimMissionOutcome run = RunSimMission(spec, dir / "run");
+  ASSERT_TRUE(run.result.success) << run.result.reason;
+  const std::vector<StopRecord>& stops = run.result.stops;
+  ASSERT_GE(stops.size(), 3u);
+  const MissionConfig& m = spec.settings.mission;
+  double turned_rad = 0;
+  for (std::size_t k = 1; k < stops.size(); ++k) {
+    ASSERT_TRUE(stops[k].merge.merged) << k;
+    EXPECT_NEAR(stops[k].prior_bound.translation_m,
+                m.odometry_error_m + m.odometry_error_per_m * stops[k].driven_m +
+                    m.odometry_error_per_rad * stops[k].turned_rad,
+                1e-9)
+        << "stop " << k;
+    turned_rad += stops[k].turned_rad;
+  }
+  // The truth's yaw turned from the first scan to the last.
+  const auto yaw = [](const Eigen::Isometry3d& T) {
+    return std::atan2(T.linear()(1, 0), T.linear()(0, 0));
+  };
+  double true_rad = 0;
+  std::optional<double> last;
+  for (const TrajectorySample& t : run.result.trajectory) {
+    if (t.stamp_s < stops.front().stamp_s || t.stamp_s > stops.back().stamp_s) continue;
+    const double y = yaw(*t.T_world_base_true);
+    if (last) true_rad += std::abs(std::remainder(y - *last, 2 * M_PI));
+    last = y;
+  }
+  EXPECT_GT(true_rad, 0.5) << "the box was driven round";
+  EXPECT_NEAR(turned_rad, true_rad, 0.15 * true_rad);
 }
 
 // The map frame is the robot's pose at its first scan, taken from odometry after it turned to

@@ -86,6 +86,15 @@ struct MissionConfig {
   /// no ground is known level. The loose terrain rate let ICP slide a corridor scan 0.84 m (2 m
   /// with a grid search) along the axis to where it overlapped the map more, and call it success.
   double odometry_error_level_per_m = 0.05;
+  /// ... plus odometry_error_per_rad x the angle turned off level ground [m/rad]: a skid-steer
+  /// base slides as it turns on a slope, wheels skidding sideways while gravity pulls. Terrain
+  /// seeds 1..20 and 101..120 (770 drives between merged stops): odometry's error against this
+  /// bound grew with the turn (p99 0.40 of the bound for drives turning under 60 deg, 1.28 over
+  /// 200 deg); the four drives that broke it turned 108-270 deg on 9-15 deg slopes, and one
+  /// (seed 14, 0.63 m off after 242 deg) had its right registration refused, merged nothing for
+  /// three stops and ended walled in by their scans at odometry's poses. 0.032 m/rad would have
+  /// held all four; with 0.05 the largest reaches 0.89 of its bound.
+  double odometry_error_per_rad = 0.05;
   /// ... and odometry_error_deg + odometry_error_dps x the time elapsed [deg]: the gyro's drift
   /// (0.017 deg/s p95) and the roll/pitch errors of the attitude sensor and the last registration.
   /// Odometry's rotation off the truth's between merged stops, terrain and gully seeds 1..20 (453
@@ -156,6 +165,7 @@ struct StopRecord {
   int index = 0;
   double stamp_s = 0;        ///< when the scan started [s]
   double driven_m = 0;       ///< odometry's distance since the stop before [m]
+  double turned_rad = 0;     ///< odometry's yaw turned off level ground since then [rad]
   sensors::Scan3D scan;      ///< points in base_link
   mapping::MergeStep merge;  ///< registration against the map
   /// The registration prior's error bound: how far odometry may be off since the last merged scan
