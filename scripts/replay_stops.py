@@ -58,9 +58,8 @@ def inverse(a):
     return [rt[i] + [t[i]] for i in range(3)] + [[0.0, 0.0, 0.0, 1.0]]
 
 
-def quaternion(a):
-    """(qw, qx, qy, qz) of a's rotation, by the largest of the four (Shepperd)."""
-    m = a
+def quaternion(m):
+    """(qw, qx, qy, qz) of m's rotation, by the largest of the four (Shepperd)."""
     trace = m[0][0] + m[1][1] + m[2][2]
     if trace > 0:
         s = 2 * math.sqrt(1 + trace)
