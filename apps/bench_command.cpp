@@ -479,6 +479,8 @@ json MakeRecord(const SweepSettings& s, const BenchRun& run, std::optional<int> 
   r["hazards_touched_steepest_deg"] = Field(metrics, "/hazards_touched/steepest_deg");
   r["map_cells_compared"] = Field(metrics, "/map_hazards/cells_compared");
   r["false_hazard_cells"] = Field(metrics, "/map_hazards/false_hazard_cells");
+  r["false_hazard_cells_out_of_reach"] =
+      Field(metrics, "/map_hazards/false_hazard_cells_out_of_reach");
   r["missed_hazard_cells"] = Field(metrics, "/map_hazards/missed_hazard_cells");
   r["max_tilt_deg"] = Field(metrics, "/max_tilt_deg");
   r["odometry_drift_p90_per_m"] = Field(metrics, "/odometry_drift/p90_per_m");

@@ -203,7 +203,7 @@ std::vector<MetricRow> KeyMetrics(const nlohmann::json& m) {
       {"mount_calibration.max_error_deg", "mount calibration error", "deg",
        "largest of roll, pitch, yaw found on the first stop's floor against the drawn error"},
       {"map_hazards.false_hazard_cells", "false hazard cells in the final map", "",
-       "hazards where the truth is free"},
+       "hazards where the truth is free, in the robot's reach"},
       {"map_hazards.missed_hazard_cells", "missed hazard cells in the final map", "",
        "true hazards the map calls free"},
       {"max_tilt_deg", "largest tilt", "deg", "roll/pitch of the base"},

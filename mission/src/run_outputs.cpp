@@ -291,6 +291,8 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
     m["hazards_touched"] = touched;
     m["map_hazards"] = {{"cells_compared", score->map_cells_compared},
                         {"false_hazard_cells", score->false_hazard_cells},
+                        {"false_hazard_cells_out_of_reach",
+                         score->false_hazard_cells_out_of_reach},
                         {"false_as", KindsJson(score->false_as)},
                         {"missed_hazard_cells", score->missed_hazard_cells},
                         {"missed_as", KindsJson(score->missed_as)},

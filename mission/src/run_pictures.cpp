@@ -197,8 +197,9 @@ void WriteRunPictures(RunFolder& folder, const RunContext& c, const MissionResul
   if (!r.success && r.last_plan_stop >= 0) WriteLastPlanPicture(folder, r, window, marks, est, tru);
   if (!truth) return;
   truth_pictures.get();
-  Write(ComposeMapFigure(RenderHazardErrors(truth->scored_estimate, truth->grid, options), g,
-                         window, marks),
+  Write(ComposeMapFigure(
+            RenderHazardErrors(truth->scored_estimate, truth->grid, c.start.head<2>(), options), g,
+            window, marks),
         folder.File("hazard_errors.png"));
 }
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <vector>
 
 namespace pitchlab::mission {
 
@@ -97,8 +98,10 @@ mapping::RgbImage RenderTraversability(const planning::TraversabilityGrid& T,
 
 mapping::RgbImage RenderHazardErrors(const planning::TraversabilityGrid& estimated,
                                      const planning::TraversabilityGrid& truth,
+                                     const Eigen::Vector2d& start_m,
                                      const mapping::ImageOptions& o) {
   const mapping::GridGeometry& g = estimated.geometry;
+  const std::vector<bool> reachable = ReachableCells(truth, start_m);
   mapping::RgbImage img = BlankImage(g, o);
   for (int j = 0; j < g.size_y; ++j) {
     for (int i = 0; i < g.size_x; ++i) {
@@ -113,7 +116,7 @@ mapping::RgbImage RenderHazardErrors(const planning::TraversabilityGrid& estimat
                                 : std::array<int, 3>{120, 120, 120};
           break;
         case HazardVerdict::kFalseHazard:
-          c = {220, 20, 20};
+          c = reachable[k] ? std::array<int, 3>{220, 20, 20} : std::array<int, 3>{245, 160, 205};
           break;
         case HazardVerdict::kMissedHazard:
           c = {20, 60, 230};
@@ -126,9 +129,11 @@ mapping::RgbImage RenderHazardErrors(const planning::TraversabilityGrid& estimat
 }
 
 std::string HazardErrorsLegend() {
-  return "Red: a hazard (step, drop, too steep) in the map where the truth is free; blue: a true "
-         "hazard the map calls free; light grey: both free; dark grey: both see a hazard or its "
-         "margin; checkered: not compared (unknown in either).";
+  return "Red: a hazard (step, drop, too steep) in the map where the truth is free; pink: the same "
+         "where the truth's free cell is out of the robot's reach from its start (a parked car's "
+         "roof, cast from above; not counted as a false hazard); blue: a true hazard the map calls "
+         "free; light grey: both free; dark grey: both see a hazard or its margin; checkered: not "
+         "compared (unknown in either).";
 }
 
 std::string TraversabilityLegend() {

@@ -1,6 +1,7 @@
 // ScoreRun's map comparison on hand-made traversability grids whose every cell's verdict is known.
 
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -24,6 +25,7 @@ planning::TraversabilityGrid LevelRow() {
   g.phi_x_rad.assign(n, 0.0f);
   g.phi_y_rad.assign(n, 0.0f);
   g.blocked.assign(n, planning::Blocked::kFree);
+  g.moves.assign(n, 0);  // no cell reached from another: no false hazard is in reach
   return g;
 }
 
@@ -116,6 +118,41 @@ TEST(ScoreRun, SaysWhereTheRunCrossedForbiddenCells) {
   EXPECT_EQ(s.touched.step, 4u);
   EXPECT_EQ(s.touched.too_steep + s.touched.drop, 0u);
   EXPECT_EQ(s.touched_steepest_deg, 0.0);
+}
+
+// A 4 x 4 m floor of 0.1 m cells with a platform 0.85 m tall on it (x and y 1.0-3.0, a parked
+// car's chassis as the truth casts it from above): the platform's middle is truly free, flat and
+// far from its edges, but no move of the true map leads up to it. The map reads one cell there and
+// one cell of the floor as too steep: the floor's is a false hazard, the platform's is out of the
+// robot's reach and counted apart.
+TEST(ScoreRun, CountsFalseHazardsTheRobotCouldReachApartFromThoseItCouldNot) {
+  mapping::ElevationMap map(mapping::GridGeometry::FromArea(0, 0, 4, 4, 0.1));
+  std::vector<Eigen::Vector3f> points;
+  for (double y = 0.025; y < 4; y += 0.05)
+    for (double x = 0.025; x < 4; x += 0.05) {
+      const bool platform = x > 1.0 && x < 3.0 && y > 1.0 && y < 3.0;
+      points.emplace_back(float(x), float(y), platform ? 0.85f : 0.0f);
+    }
+  (void)map.InsertPoints(points.data(), points.size());
+  const planning::TraversabilityGrid truth =
+      planning::BuildTraversability(mapping::ComputeLayers(map), planning::PlannerConfig{});
+  const mapping::GridGeometry& g = truth.geometry;
+  const std::size_t on_platform = g.Linear(g.IndexOf(2.05, 2.05));
+  const std::size_t on_floor = g.Linear(g.IndexOf(0.55, 3.45));
+  ASSERT_TRUE(truth.Free(on_platform));
+  ASSERT_TRUE(truth.Free(on_floor));
+  planning::TraversabilityGrid estimated = truth;
+  estimated.blocked[on_platform] = estimated.blocked[on_floor] = planning::Blocked::kTooSteep;
+  const RunScore s = ScoreRun(MissionResult{}, truth, estimated, {0.55, 0.55}, {0.55, 0.55},
+                              planning::Algorithm::kAStar);
+  EXPECT_EQ(s.false_hazard_cells, 1u);
+  EXPECT_EQ(s.false_hazard_cells_out_of_reach, 1u);
+  EXPECT_EQ(s.false_as.too_steep, 1u);
+  // From a start on the platform, the floor is the one out of reach.
+  const RunScore up = ScoreRun(MissionResult{}, truth, estimated, {2.05, 2.05}, {2.05, 2.05},
+                               planning::Algorithm::kAStar);
+  EXPECT_EQ(up.false_hazard_cells, 1u);
+  EXPECT_EQ(up.false_hazard_cells_out_of_reach, 1u);
 }
 
 }  // namespace

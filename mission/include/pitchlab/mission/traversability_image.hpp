@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include <Eigen/Core>
+
 #include "pitchlab/mapping/elevation_io.hpp"
 #include "pitchlab/planning/traversability.hpp"
 
@@ -19,11 +21,13 @@ mapping::RgbImage RenderTraversability(const planning::TraversabilityGrid& grid,
 /// The legend of RenderTraversability's colours, one sentence.
 std::string TraversabilityLegend();
 
-/// Where the map's hazards are wrong (CompareHazard): false hazards red, missed hazards blue,
+/// Where the map's hazards are wrong (CompareHazard): false hazards red (pink where the truth's
+/// free cell is out of reach from `start_m`, world [m]: ReachableCells), missed hazards blue,
 /// agreeing cells grey (darker where both see a hazard), cells not compared checkered. Same pixel
 /// grid as RenderTraversability.
 mapping::RgbImage RenderHazardErrors(const planning::TraversabilityGrid& estimated,
                                      const planning::TraversabilityGrid& truth,
+                                     const Eigen::Vector2d& start_m,
                                      const mapping::ImageOptions& options = {});
 
 /// The legend of RenderHazardErrors' colours, one sentence.
