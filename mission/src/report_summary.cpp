@@ -222,6 +222,12 @@ std::vector<MetricRow> KeyMetrics(const nlohmann::json& m) {
     if (std::string(s.key).rfind("map_hazards.", 0) == 0 && compared) {
       note += ", of " + compared->dump() + " cells compared";
     }
+    // The truly free cells it cannot reach (pink in hazard_errors.png) are not in the count.
+    const nlohmann::json* out_of_reach = At(m, "map_hazards.false_hazard_cells_out_of_reach");
+    if (std::string(s.key) == "map_hazards.false_hazard_cells" && out_of_reach &&
+        out_of_reach->is_number_integer() && out_of_reach->get<long long>() > 0) {
+      note += "; " + out_of_reach->dump() + " more out of its reach";
+    }
     rows.push_back({s.label, value, s.unit, note});
   }
   return rows;

@@ -149,6 +149,16 @@ TEST(KeyMetrics, ShowsUnitsAndLeavesOutWhatIsUnknown) {
   ASSERT_NE(false_hazards, with_map.end());
   EXPECT_EQ(false_hazards->value, "31");
   EXPECT_NE(false_hazards->note.find("of 10205 cells compared"), std::string::npos);
+  EXPECT_EQ(false_hazards->note.find("out of its reach"), std::string::npos);  // none said
+  // The truly free cells the robot could not reach are said beside the count, not in it.
+  m["map_hazards"]["false_hazard_cells_out_of_reach"] = 8;
+  const std::vector<MetricRow> with_roof = KeyMetrics(m);
+  const auto roof = std::find_if(with_roof.begin(), with_roof.end(), [](const MetricRow& r) {
+    return r.label == "false hazard cells in the final map";
+  });
+  ASSERT_NE(roof, with_roof.end());
+  EXPECT_EQ(roof->value, "31");
+  EXPECT_NE(roof->note.find("; 8 more out of its reach"), std::string::npos);
   EXPECT_EQ(find("wall time"), nullptr);
   // The trajectory error (issue 20's standard metric) from metrics.json's nested keys; a
   // hardware run's null leaves it out.
