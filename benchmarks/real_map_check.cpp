@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 #include <stdexcept>
 
 #include "pitchlab/mapping/elevation_layers.hpp"
@@ -58,32 +57,17 @@ nlohmann::json FloorPlane(const std::vector<Eigen::Vector3d>& cells, const Eigen
 }
 
 // The farthest along `axis` (from `from`) of the floor cells (`floor`, by linear index) reachable
-// from `start` through allowed moves [m]: with unknown cells enterable a search may wander off
+// from `from` through allowed moves [m]: with unknown cells enterable a search may wander off
 // the seen floor, and only the seen floor counts as plannable (a free cell 33 m away on a shelf
 // is no corridor).
 double ReachAlong(const planning::TraversabilityGrid& grid, const std::vector<char>& floor,
-                  const mapping::CellIndex& start, const Eigen::Vector2d& from,
-                  const Eigen::Vector2d& axis) {
-  const mapping::GridGeometry& g = grid.geometry;
-  if (!g.Contains(start)) return 0;
-  std::vector<char> seen(g.cell_count(), 0);
-  std::deque<std::size_t> queue{g.Linear(start)};
-  seen[queue.front()] = 1;
+                  const Eigen::Vector2d& from, const Eigen::Vector2d& axis) {
+  const std::vector<bool> reached = planning::ReachableCells(grid, from);
   double farthest = 0;
-  while (!queue.empty()) {
-    const std::size_t k = queue.front();
-    queue.pop_front();
-    const mapping::CellIndex c = g.FromLinear(k);
-    if (floor[k] && grid.blocked[k] == planning::Blocked::kFree) {
-      farthest = std::max(farthest, (g.CenterOf(c) - from).dot(axis));
-    }
-    for (int b = 0; b < 8; ++b) {
-      if (!(grid.moves[k] >> b & 1)) continue;
-      const mapping::CellIndex n{c.i + planning::kMoveDi[b], c.j + planning::kMoveDj[b]};
-      if (!g.Contains(n) || seen[g.Linear(n)]) continue;
-      seen[g.Linear(n)] = 1;
-      queue.push_back(g.Linear(n));
-    }
+  for (std::size_t k = 0; k < reached.size(); ++k) {
+    if (!reached[k] || !floor[k] || grid.blocked[k] != planning::Blocked::kFree) continue;
+    farthest =
+        std::max(farthest, (grid.geometry.CenterOf(grid.geometry.FromLinear(k)) - from).dot(axis));
   }
   return farthest;
 }
@@ -147,7 +131,7 @@ nlohmann::json CheckMap(const std::vector<PosedCloud>& scans) {
     planning::PlannerConfig config;
     config.unknown = policy;
     const planning::TraversabilityGrid grid = planning::BuildTraversability(layers, config);
-    reach[name] = ReachAlong(grid, is_floor, g.IndexOf(from.x(), from.y()), from, axis);
+    reach[name] = ReachAlong(grid, is_floor, from, axis);
   }
   return {{"levelling",
            {{"tilt_removed_deg", level->tilt_rad * 180 / kPi},

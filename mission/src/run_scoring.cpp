@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <tuple>
@@ -117,34 +116,6 @@ HazardVerdict CompareHazard(const planning::TraversabilityGrid& estimated,
   return HazardVerdict::kAgree;
 }
 
-std::vector<bool> ReachableCells(const planning::TraversabilityGrid& grid,
-                                 const Eigen::Vector2d& start_m) {
-  const mapping::GridGeometry& g = grid.geometry;
-  if (grid.moves.size() != g.cell_count()) {
-    throw std::invalid_argument(
-        "reachable cells: the grid has no moves (BuildTraversability makes them)");
-  }
-  std::vector<bool> reached(g.cell_count(), false);
-  const mapping::CellIndex start = g.IndexOf(start_m.x(), start_m.y());
-  if (!g.Contains(start)) return reached;
-  std::vector<mapping::CellIndex> open{start};
-  reached[g.Linear(start)] = true;
-  while (!open.empty()) {
-    const mapping::CellIndex c = open.back();
-    open.pop_back();
-    const std::uint8_t allowed = grid.moves[g.Linear(c)];
-    for (int b = 0; b < 8; ++b) {
-      if (!(allowed & (1u << b))) continue;
-      const mapping::CellIndex n{c.i + planning::kMoveDi[b], c.j + planning::kMoveDj[b]};
-      const std::size_t k = g.Linear(n);
-      if (reached[k]) continue;
-      reached[k] = true;
-      open.push_back(n);
-    }
-  }
-  return reached;
-}
-
 RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGrid& truth,
                   const planning::TraversabilityGrid& estimated,
                   const Eigen::Vector2d& start_m, const Eigen::Vector2d& goal_m,
@@ -220,7 +191,7 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
     throw std::invalid_argument("score: the estimated and the true map are on different grids");
   }
   std::vector<double> steep_map_deg, steep_true_deg;
-  const std::vector<bool> reachable = ReachableCells(truth, start_m);
+  const std::vector<bool> reachable = planning::ReachableCells(truth, start_m);
   for (std::size_t k = 0; k < truth.blocked.size(); ++k) {
     const HazardVerdict v = CompareHazard(estimated, truth, k);
     s.map_cells_compared += v != HazardVerdict::kNotCompared;

@@ -101,7 +101,7 @@ mapping::RgbImage RenderHazardErrors(const planning::TraversabilityGrid& estimat
                                      const Eigen::Vector2d& start_m,
                                      const mapping::ImageOptions& o) {
   const mapping::GridGeometry& g = estimated.geometry;
-  const std::vector<bool> reachable = ReachableCells(truth, start_m);
+  const std::vector<bool> reachable = planning::ReachableCells(truth, start_m);
   mapping::RgbImage img = BlankImage(g, o);
   for (int j = 0; j < g.size_y; ++j) {
     for (int i = 0; i < g.size_x; ++i) {

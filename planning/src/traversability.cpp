@@ -605,4 +605,31 @@ std::string CoarseGridWarning(const GridGeometry& g, const RobotLimits& robot) {
   return text;
 }
 
+std::vector<bool> ReachableCells(const TraversabilityGrid& grid, const Eigen::Vector2d& start_m) {
+  const GridGeometry& g = grid.geometry;
+  if (grid.moves.size() != g.cell_count()) {
+    throw std::invalid_argument(
+        "reachable cells: the grid has no moves (BuildTraversability makes them)");
+  }
+  std::vector<bool> reached(g.cell_count(), false);
+  const CellIndex start = g.IndexOf(start_m.x(), start_m.y());
+  if (!g.Contains(start)) return reached;
+  std::vector<CellIndex> open{start};
+  reached[g.Linear(start)] = true;
+  while (!open.empty()) {
+    const CellIndex c = open.back();
+    open.pop_back();
+    const std::uint8_t allowed = grid.moves[g.Linear(c)];
+    for (int b = 0; b < 8; ++b) {
+      if (!(allowed & (1u << b))) continue;
+      const CellIndex n{c.i + kMoveDi[b], c.j + kMoveDj[b]};
+      const std::size_t k = g.Linear(n);
+      if (reached[k]) continue;
+      reached[k] = true;
+      open.push_back(n);
+    }
+  }
+  return reached;
+}
+
 }  // namespace pitchlab::planning

@@ -153,6 +153,35 @@ TEST(Planner, SerpentineCorridorGivesItsUniqueOptimalPath) {
   }
 }
 
+// The same serpentine corridor and, apart from it, a three-cell island of ground (row 2, columns
+// 0-2) no move leads to: from the corridor's start exactly the corridor's 17 cells are reached,
+// from the island exactly the island's 3, from off the grid none.
+TEST(ReachableCells, AreTheCellsTheAllowedMovesLeadTo) {
+  const auto corridor = [](int i, int j) {
+    return (j == 0 && i <= 6) || (i == 6 && j <= 4) || (j == 4 && i <= 6);
+  };
+  const auto island = [](int i, int j) { return j == 2 && i <= 2; };
+  ElevationLayers L = MakeLayers(
+      8, 6, 0.2, [&](int i, int j) { return corridor(i, j) || island(i, j) ? 0.0 : std::nan(""); });
+  for (std::size_t k = 0; k < L.phi_x.size(); ++k) {  // level, as above
+    if (L.state[k] != mapping::CellState::kObserved) continue;
+    L.phi_x[k] = L.phi_y[k] = 0.0f;
+  }
+  const TraversabilityGrid T = BuildTraversability(L, PointRobot());
+  const auto count_as = [&](const std::vector<bool>& reached, auto&& in) {
+    std::size_t n = 0;
+    for (std::size_t k = 0; k < reached.size(); ++k) {
+      const CellIndex c = T.geometry.FromLinear(k);
+      EXPECT_EQ(reached[k], in(c.i, c.j)) << c.i << ", " << c.j;
+      n += reached[k];
+    }
+    return n;
+  };
+  EXPECT_EQ(count_as(ReachableCells(T, Centre(T, 0, 0)), corridor), 17u);
+  EXPECT_EQ(count_as(ReachableCells(T, Centre(T, 1, 2)), island), 3u);
+  EXPECT_EQ(count_as(ReachableCells(T, {-1.0, 0.1}), [](int, int) { return false; }), 0u);
+}
+
 TEST(Planner, StraightRunOnTiltedGroundCostsEq5) {
   // Ground z = 0.1 x: a straight run along x is the unique optimum; every edge costs
   // W_T*0 + W_P*sqrt(c^2 + (0.1c)^2) + W_phix*atan(0.1) + W_phiy*0.

@@ -58,7 +58,7 @@ struct RunScore {
   /// unlike success these counts change smoothly with the map's quality [1].
   std::size_t map_cells_compared = 0;
   /// Hazard in the map, truly free (not even near one) and within the robot's reach: joined to
-  /// the start by the moves the true map allows. A false hazard costs a run a way it truly has;
+  /// the start by the moves the true map allows (planning::ReachableCells). A false hazard costs a run a way it truly has;
   /// a truly free cell it cannot reach (a parked car's roof, cast from above, flat and more than
   /// the footprint from its edge) is no way to close [1].
   std::size_t false_hazard_cells = 0;
@@ -95,12 +95,6 @@ enum class HazardVerdict { kNotCompared, kAgree, kFalseHazard, kMissedHazard };
 /// near a hazard); kMissedHazard: a true hazard `estimated` calls free.
 HazardVerdict CompareHazard(const planning::TraversabilityGrid& estimated,
                             const planning::TraversabilityGrid& truth, std::size_t k);
-
-/// The cells the robot can reach from `start_m` (world [m]) by the moves `grid` allows
-/// (TraversabilityGrid::moves: into free cells, no blocked corner cut), its start cell included;
-/// none when the start is off the grid. Throws std::invalid_argument when `grid` has no moves.
-std::vector<bool> ReachableCells(const planning::TraversabilityGrid& grid,
-                                 const Eigen::Vector2d& start_m);
 
 /// `truth` is the true traversability over the mission's map area, `estimated` the final map's on
 /// the same grid; `start_m`/`goal_m` world [m]; `via_m` the waypoints the mission drove through

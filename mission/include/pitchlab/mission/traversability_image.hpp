@@ -22,7 +22,7 @@ mapping::RgbImage RenderTraversability(const planning::TraversabilityGrid& grid,
 std::string TraversabilityLegend();
 
 /// Where the map's hazards are wrong (CompareHazard): false hazards red (pink where the truth's
-/// free cell is out of reach from `start_m`, world [m]: ReachableCells), missed hazards blue,
+/// free cell is out of reach from `start_m`, world [m]: planning::ReachableCells), missed hazards blue,
 /// agreeing cells grey (darker where both see a hazard), cells not compared checkered. Same pixel
 /// grid as RenderTraversability.
 mapping::RgbImage RenderHazardErrors(const planning::TraversabilityGrid& estimated,

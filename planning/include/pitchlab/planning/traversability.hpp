@@ -172,6 +172,11 @@ struct TraversabilityGrid {
 /// the hazard's edge) [m].
 double FootprintReach(const TraversabilityGrid& grid);
 
+/// The cells the robot can reach from `start_m` (map frame [m]) by the moves `grid` allows
+/// (TraversabilityGrid::moves: into free cells, no blocked corner cut), its start cell included;
+/// none when the start is off the grid. Throws std::invalid_argument when `grid` has no moves.
+std::vector<bool> ReachableCells(const TraversabilityGrid& grid, const Eigen::Vector2d& start_m);
+
 /// Classifies every cell and precomputes its entry cost. Throws std::invalid_argument on a bad
 /// config.
 TraversabilityGrid BuildTraversability(const mapping::ElevationLayers& layers,
