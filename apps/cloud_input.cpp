@@ -39,10 +39,17 @@ sensors::Scan3D LoadInputCloud(const std::string& path,
     }
     if (r.corrected > 0) {
       constexpr double kToDeg = 180 / 3.14159265358979323846;
+      // An interlaced line's sweeps are set right each on its own (LinePitchConfig).
+      const std::string what = r.sweeps_per_line > 1
+                                   ? std::to_string(r.lines * r.sweeps_per_line) + " sweeps (" +
+                                         std::to_string(r.sweeps_per_line) +
+                                         " interlaced in each of " + std::to_string(r.lines) +
+                                         " lines)"
+                                   : std::to_string(r.lines) + " lines";
       std::fprintf(stderr,
-                   "%s: %zu of %zu lines set right by the floor they crossed (pitch corrections "
+                   "%s: %zu of %s set right by the floor they crossed (pitch corrections "
                    "%.2f deg RMS, at most %.2f; floor %.1f -> %.1f mm RMS)\n",
-                   path.c_str(), r.corrected, r.lines, r.rms_correction_rad * kToDeg,
+                   path.c_str(), r.corrected, what.c_str(), r.rms_correction_rad * kToDeg,
                    r.max_correction_rad * kToDeg, r.floor_rms_before_m * 1e3,
                    r.floor_rms_after_m * 1e3);
     }

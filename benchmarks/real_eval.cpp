@@ -201,15 +201,15 @@ json Run(const Scan& target, const Scan& source, const Grid& grid, bool with_pri
 
 // Whether the servo's pitch errors repeat from scan to scan, so that a table taken once could
 // correct them: the lines two scans share (the same recorded pitch, within the line gap that
-// tells lines apart) and how their corrections compare. `table_leaves_deg` is what scan a's
-// corrections, applied to scan b, would leave of b's error (RMS of the difference), against
-// `rms_b_deg` with no correction at all.
+// tells lines apart, and the same interlaced sweep) and how their corrections compare.
+// `table_leaves_deg` is what scan a's corrections, applied to scan b, would leave of b's error (RMS
+// of the difference), against `rms_b_deg` with no correction at all.
 json LinePitchRepeat(const mapping::LinePitch& a, const mapping::LinePitch& b) {
   const double gap = mapping::LinePitchConfig{}.line_gap_rad;
   std::vector<std::pair<double, double>> shared;
   for (const mapping::LineCorrection& ca : a.line_corrections) {
     for (const mapping::LineCorrection& cb : b.line_corrections) {
-      if (std::abs(ca.pitch_rad - cb.pitch_rad) <= gap) {
+      if (ca.sweep == cb.sweep && std::abs(ca.pitch_rad - cb.pitch_rad) <= gap) {
         shared.emplace_back(ca.correction_rad, cb.correction_rad);
         break;
       }

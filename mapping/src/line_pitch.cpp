@@ -59,6 +59,64 @@ std::vector<std::vector<std::uint32_t>> LinesOf(const std::vector<Eigen::Vector3
   return lines;
 }
 
+// The angle of point `v` (relative to the sensor) within its line's plane, from straight ahead
+// towards +y: an LMS200's beam angle, whose beams lie on multiples of its resolution [rad].
+double BeamAngle(const Eigen::Vector3f& v) {
+  return std::atan2(static_cast<double>(v.y()),
+                    std::hypot(static_cast<double>(v.x()), static_cast<double>(v.z())));
+}
+
+// The lines' beam step: the median gap between neighbouring beam angles within a line (a
+// reading missing, out of range, widens a gap; the median is the step) [rad]; 0 without any.
+double BeamStep(const std::vector<std::vector<std::uint32_t>>& lines,
+                const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& sensor) {
+  std::vector<double> gaps, angles;
+  for (const auto& line : lines) {
+    angles.clear();
+    for (const std::uint32_t k : line) angles.push_back(BeamAngle(points[k] - sensor));
+    std::sort(angles.begin(), angles.end());
+    // 1e-5 rad: twice the angle a 3DTK coordinate's six digits resolve at 1 m; closer beams are
+    // one beam written twice.
+    for (std::size_t i = 1; i < angles.size(); ++i)
+      if (angles[i] - angles[i - 1] > 1e-5) gaps.push_back(angles[i] - angles[i - 1]);
+  }
+  if (gaps.empty()) return 0;
+  std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
+  return gaps[gaps.size() / 2];
+}
+
+// How many interlaced sweeps a line of beams `step` apart is made of: sweep_step / step when that
+// is a whole number of at least 2 (within a tenth of a beam), else 1.
+int SweepsPerLine(double step, const LinePitchConfig& config) {
+  if (!(step > 0)) return 1;
+  const double ratio = config.sweep_step_rad / step;
+  const long n = std::lround(ratio);
+  return n >= 2 && std::abs(ratio - static_cast<double>(n)) < 0.1 ? static_cast<int>(n) : 1;
+}
+
+// Each line split into its `sweeps` interlaced sweeps (beam index, counted from straight ahead,
+// modulo sweeps); `sweep_of` receives each piece's sweep. Pieces of fewer than min_line_points
+// points are dropped, as LinesOf drops short lines.
+std::vector<std::vector<std::uint32_t>> SplitSweeps(
+    const std::vector<std::vector<std::uint32_t>>& lines,
+    const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& sensor, double step,
+    int sweeps, const LinePitchConfig& config, std::vector<int>& sweep_of) {
+  std::vector<std::vector<std::uint32_t>> out;
+  for (const auto& line : lines) {
+    std::vector<std::vector<std::uint32_t>> pieces(static_cast<std::size_t>(sweeps));
+    for (const std::uint32_t k : line) {
+      const long beam = std::lround(BeamAngle(points[k] - sensor) / step);
+      pieces[static_cast<std::size_t>(((beam % sweeps) + sweeps) % sweeps)].push_back(k);
+    }
+    for (int s = 0; s < sweeps; ++s) {
+      if (pieces[s].size() < config.min_line_points) continue;
+      out.push_back(std::move(pieces[s]));
+      sweep_of.push_back(s);
+    }
+  }
+  return out;
+}
+
 struct FloorPlane {
   Eigen::Vector3d n = Eigen::Vector3d::UnitZ();  // up normal
   double d = 0;                                  // n . v = d, v relative to the sensor
@@ -77,6 +135,7 @@ struct Line {
   double correction_rad = 0;
   double lever_m = 0;  // mean |d e / d angle| of its floor points: how far ahead it meets the floor
   bool corrected = false;
+  int sweep = 0;  // which interlaced sweep of its line it is (SplitSweeps)
 };
 
 // The correction of one line against `plane`: the angle most of its floor points agree on (the
@@ -226,7 +285,8 @@ double AlignLinesToFloor(std::vector<Line>& lines, FloorPlane& plane, double sig
 // done goes into `out` (RectifyLinePitch).
 void SetLinesRight(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f& sensor_m,
                    const std::vector<std::vector<std::uint32_t>>& indices,
-                   const LinePitchConfig& config, LinePitch& out) {
+                   const std::vector<int>& sweep_of, const LinePitchConfig& config,
+                   LinePitch& out) {
   const Result<GroundLevel> level = FitGroundLevel(points_m, sensor_m, config.ground);
   if (!level) {
     out.note = level.error().message;
@@ -238,6 +298,8 @@ void SetLinesRight(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f
   FloorPlane plane = first;
   std::vector<Line> lines =
       FloorCandidates(indices, points_m, sensor_m, plane, level->residual_m, config);
+  for (std::size_t l = 0; l < lines.size() && l < sweep_of.size(); ++l)
+    lines[l].sweep = sweep_of[l];
   const double sigma = AlignLinesToFloor(lines, plane, level->residual_m, config);
   // Before and after, over the floor points of the corrected lines.
   double before = 0, after = 0, sum_sq = 0;
@@ -262,11 +324,13 @@ void SetLinesRight(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f
       points_m[k] = sensor_m + TurnedAboutY(v, line.correction_rad).cast<float>();
     }
     std::nth_element(elevation.begin(), elevation.begin() + elevation.size() / 2, elevation.end());
-    out.line_corrections.push_back({elevation[elevation.size() / 2], line.correction_rad});
+    out.line_corrections.push_back(
+        {elevation[elevation.size() / 2], line.correction_rad, line.sweep});
   }
-  std::sort(
-      out.line_corrections.begin(), out.line_corrections.end(),
-      [](const LineCorrection& a, const LineCorrection& b) { return a.pitch_rad < b.pitch_rad; });
+  std::sort(out.line_corrections.begin(), out.line_corrections.end(),
+            [](const LineCorrection& a, const LineCorrection& b) {
+              return a.pitch_rad != b.pitch_rad ? a.pitch_rad < b.pitch_rad : a.sweep < b.sweep;
+            });
   if (out.corrected == 0) {
     out.note = "no line crossed the floor within " + NumberText(config.ground.max_radius_m) +
                " m in " + std::to_string(config.min_line_points) + " points";
@@ -298,7 +362,21 @@ LinePitch RectifyLinePitch(std::vector<Eigen::Vector3f>& points_m, const Eigen::
     return out;
   }
   out.nodding = true;
-  SetLinesRight(points_m, sensor_m, indices, config, out);
+  const double step = BeamStep(indices, points_m, sensor_m);
+  out.sweeps_per_line = SweepsPerLine(step, config);
+  if (out.sweeps_per_line == 1) {
+    SetLinesRight(points_m, sensor_m, indices, {}, config, out);
+  } else {
+    // A sweep holds a line's beams at `sweeps` times its step: the same floor span in as many
+    // times fewer points.
+    LinePitchConfig per_sweep = config;
+    per_sweep.min_line_points =
+        (config.min_line_points + out.sweeps_per_line - 1) / out.sweeps_per_line;
+    std::vector<int> sweep_of;
+    const std::vector<std::vector<std::uint32_t>> sweeps =
+        SplitSweeps(indices, points_m, sensor_m, step, out.sweeps_per_line, per_sweep, sweep_of);
+    SetLinesRight(points_m, sensor_m, sweeps, sweep_of, per_sweep, out);
+  }
   return out;
 }
 
@@ -318,7 +396,7 @@ LinePitch RectifyLinePitch(std::vector<Eigen::Vector3f>& points_m, const Eigen::
   }
   out.lines = kept.size();
   out.nodding = true;
-  SetLinesRight(points_m, axis_m, kept, config, out);
+  SetLinesRight(points_m, axis_m, kept, {}, config, out);
   return out;
 }
 

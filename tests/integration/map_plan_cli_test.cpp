@@ -154,8 +154,12 @@ TEST_F(MapPlanCli, MapSetsARealNoddingScansLinesRightByItsFloor) {
     EXPECT_GT(c["result"]["corrected"].get<int>(), 50) << c.dump();
     EXPECT_LT(c["result"]["floor_rms_after_m"].get<double>(),
               0.5 * c["result"]["floor_rms_before_m"].get<double>());
+    // The rig's LMS at 0.5 deg: each line two interlaced sweeps, each set right on its own.
+    EXPECT_EQ(c["result"]["sweeps_per_line"].get<int>(), 2) << c.dump();
   }
-  EXPECT_NE(set_right.err.find("lines set right by the floor"), std::string::npos);
+  EXPECT_NE(set_right.err.find("interlaced in each of 226 lines) set right by the floor"),
+            std::string::npos)
+      << set_right.err;
   const CliResult kept =
       Run("map " + real + " --as-recorded --out " + (dir_ / "real_kept").string());
   ASSERT_EQ(kept.exit_code, 0) << kept.err;

@@ -9,8 +9,9 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <stdexcept>
 #include <random>
+#include <stdexcept>
+#include <type_traits>
 #include <vector>
 
 namespace pitchlab::mapping {
@@ -35,18 +36,27 @@ Eigen::Vector3d Beam(double pitch, double azimuth) {
           -std::cos(azimuth) * std::sin(pitch)};
 }
 
-// The scan as recorded: each line's ranges measured at pitch + error(line), placed at the
-// recorded pitch; lines every 0.5 deg from 30 deg up to 50 deg down, beams every 0.5 deg.
+// The scan as recorded: each line's ranges measured at pitch + error(line) (or error(line,
+// beam), beam counted from straight ahead), placed at the recorded pitch; lines every 0.5 deg
+// from 30 deg up to 50 deg down, beams every `beam_deg` from straight ahead out to 89.5 deg.
 template <typename Error>
 std::vector<Eigen::Vector3f> NoddingScan(Error error, double noise_m, unsigned seed,
-                                         double mirror_above_axis_m = 0) {
+                                         double mirror_above_axis_m = 0, double beam_deg = 0.5) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, noise_m);
   std::vector<Eigen::Vector3f> points;
+  const int beams = static_cast<int>(89.5 / beam_deg);
   int line = 0;
   for (double pitch = -30 * kDeg; pitch <= 50.01 * kDeg; pitch += 0.5 * kDeg, ++line) {
-    for (double az = -89.5 * kDeg; az <= 89.51 * kDeg; az += 0.5 * kDeg) {
-      const double r = RangeInCorridor(Beam(pitch + error(line), az)) + noise(rng);
+    for (int beam = -beams; beam <= beams; ++beam) {
+      const double az = beam * beam_deg * kDeg;
+      double e = 0;
+      if constexpr (std::is_invocable_v<Error, int, int>) {
+        e = error(line, beam);
+      } else {
+        e = error(line);
+      }
+      const double r = RangeInCorridor(Beam(pitch + e, az)) + noise(rng);
       // The mirror turns with the mount about the axis at the origin (pitchlab's own scans, in
       // base_link, have it ~5 cm off the axis); the axis itself is the frame's y.
       const Eigen::Vector3d mirror(mirror_above_axis_m * std::sin(pitch), 0,
@@ -102,6 +112,8 @@ TEST(LinePitch, ReportsEachLinesRecordedPitchAndTurn) {
   std::vector<Eigen::Vector3f> scan = NoddingScan(Wobble, 0.003, 1);
   const LinePitch r = RectifyLinePitch(scan, Eigen::Vector3f::Zero());
   ASSERT_EQ(r.line_corrections.size(), r.corrected);
+  // Beams every 0.5 deg: each line is two interlaced 1 deg sweeps, each reported on its own.
+  ASSERT_EQ(r.sweeps_per_line, 2);
   double off_sq = 0, step_sq = 0;
   int steps = 0;
   for (std::size_t k = 0; k < r.line_corrections.size(); ++k) {
@@ -109,10 +121,13 @@ TEST(LinePitch, ReportsEachLinesRecordedPitchAndTurn) {
     // Recorded every 0.5 deg from 30 deg up: line (pitch + 30 deg) / 0.5 deg, to float rounding.
     const double line = (c.pitch_rad / kDeg + 30) / 0.5;
     EXPECT_NEAR(line, std::round(line), 1e-3);
-    if (k == 0) continue;
-    const LineCorrection& b = r.line_corrections[k - 1];
+    EXPECT_TRUE(c.sweep == 0 || c.sweep == 1) << c.sweep;
+    if (k < 2) continue;
+    // By pitch, then sweep: the same sweep of the line before lies two entries back.
+    const LineCorrection& b = r.line_corrections[k - 2];
     const int l = static_cast<int>(std::round(line));
-    ASSERT_GT(c.pitch_rad, b.pitch_rad);  // by pitch
+    ASSERT_GE(c.pitch_rad, r.line_corrections[k - 1].pitch_rad);
+    if (b.sweep != c.sweep) continue;
     if (std::round((b.pitch_rad / kDeg + 30) / 0.5) != l - 1) continue;  // neighbours only
     // A line cast lower than recorded (a positive error) is turned down by as much.
     const double error_step = Wobble(l) - Wobble(l - 1);
@@ -169,6 +184,44 @@ TEST(LinePitch, AScanThatKnowsItsLinesIsSetRightAboutThePitchAxis) {
   // An index past the points is a caller's error, named.
   lines[0].push_back(static_cast<std::uint32_t>(scan.size()));
   EXPECT_THROW(RectifyLinePitch(scan, Eigen::Vector3f::Zero(), lines), std::invalid_argument);
+}
+
+// The 3DTK rig's lines: at 0.5 deg an LMS200 line is two 1 deg sweeps of its mirror, taken one
+// turn apart while the servo moves on. The second sweep lags 0.2 deg, and where the servo jumps
+// (line 100, 1.5 deg) it jumps between the two sweeps of that line: half of it at the old pitch,
+// half at the new, as the real scan002's line at 11.5 deg down met the floor at 2.2 and 3.3 m.
+double SweepWobble(int line, int beam) {
+  const bool second = (beam % 2 + 2) % 2 == 1;
+  const bool jumped = line > 100 || (line == 100 && second);
+  return 0.8 * kDeg * std::sin(2 * 3.14159265358979 * line / 8.0) + (second ? 0.2 * kDeg : 0) +
+         (jumped ? -1.5 * kDeg : 0);
+}
+
+TEST(LinePitch, EachInterlacedSweepOfALineIsSetRightOnItsOwn) {
+  std::vector<Eigen::Vector3f> scan = NoddingScan(SweepWobble, 0.003, 5);
+  std::vector<Eigen::Vector3f> whole_lines = scan;
+  const LinePitch r = RectifyLinePitch(scan, Eigen::Vector3f::Zero());
+  ASSERT_TRUE(r.nodding) << r.note;
+  EXPECT_EQ(r.sweeps_per_line, 2);
+  EXPECT_LT(FloorSpread(scan, 4.0), 0.015);
+  EXPECT_LT(r.floor_rms_after_m, 0.004);
+  // Taken as whole lines (sweeps as wide as the beams), line 100's two halves cannot both lie
+  // on the floor: 1.5 deg at 1.1 m is 2.9 cm.
+  LinePitchConfig whole;
+  whole.sweep_step_rad = 0.5 * kDeg;
+  const LinePitch w = RectifyLinePitch(whole_lines, Eigen::Vector3f::Zero(), whole);
+  EXPECT_EQ(w.sweeps_per_line, 1);
+  EXPECT_GT(FloorSpread(whole_lines, 4.0), 0.025);
+}
+
+// Beams 1 deg apart are one turn of the mirror: nothing to split.
+TEST(LinePitch, ALineOfOneSweepIsNotSplit) {
+  std::vector<Eigen::Vector3f> scan = NoddingScan(Wobble, 0.003, 6, 0, 1.0);
+  const LinePitch r = RectifyLinePitch(scan, Eigen::Vector3f::Zero());
+  ASSERT_TRUE(r.nodding) << r.note;
+  EXPECT_EQ(r.sweeps_per_line, 1);
+  EXPECT_GT(r.corrected, 60u);
+  EXPECT_LT(FloorSpread(scan, 4.0), 0.015);
 }
 
 TEST(LinePitch, ACloudThatIsNotMadeOfLinesIsLeftAlone) {

@@ -41,6 +41,14 @@ struct LinePitchConfig {
   /// the floor [rad]. 5 deg: above the 3DTK rig's worst line (3.1 deg) with margin, below what
   /// separates the floor from a low obstacle's top seen 1-4 m away.
   double max_correction_rad = 0.0872664626;
+  /// The angle between an LMS200's beams within one turn of its mirror [rad]. Its finer modes
+  /// interlace turns: at 0.5 deg two 1 deg sweeps offset by 0.5 deg, at 0.25 deg four (LMS200
+  /// manual: one turn in 13.3 ms). A nodding rig pitches on between the turns, so each sweep of
+  /// a line has a pitch of its own: the 3DTK rig's two sweeps lie ~0.2 deg apart, and 3 deg where
+  /// its servo jumps between them (one half of such a line met the floor at 2.2 m, the other at
+  /// 3.3 m). A line whose beams lie closer than this is split into its sweeps (beam index modulo
+  /// the sweeps), and each is set right on its own; a scan at this step or coarser is not split.
+  double sweep_step_rad = 0.0174532925;  // 1 deg
   /// The floor taken as flat: the levelling's candidates (GroundLevelConfig radii) [m].
   GroundLevelConfig ground;
 };
@@ -51,12 +59,14 @@ struct LinePitchConfig {
 struct LineCorrection {
   double pitch_rad = 0;
   double correction_rad = 0;
+  int sweep = 0;  ///< which of the line's interlaced sweeps (LinePitchConfig::sweep_step_rad)
 };
 
 /// What RectifyLinePitch found and did.
 struct LinePitch {
   bool nodding = false;          ///< the points fell into lines of one elevation each
   std::size_t lines = 0;         ///< lines of at least min_line_points points [1]
+  int sweeps_per_line = 1;       ///< interlaced sweeps each line was split into [1]
   std::size_t corrected = 0;     ///< lines turned onto the floor [1]
   double rms_correction_rad = 0;  ///< RMS of the corrections applied [rad]
   double max_correction_rad = 0;  ///< largest |correction| applied [rad]

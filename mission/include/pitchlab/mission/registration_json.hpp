@@ -54,17 +54,21 @@ inline nlohmann::json StageTimingsJson(const mapping::StageTimings& t) {
 inline nlohmann::json LinePitchJson(const mapping::LinePitch& r) {
   constexpr double kToDeg = 180 / 3.14159265358979323846;
   nlohmann::json j = {{"lines", r.lines},
+                      {"sweeps_per_line", r.sweeps_per_line},
                       {"corrected", r.corrected},
                       {"rms_correction_deg", r.rms_correction_rad * kToDeg},
                       {"max_correction_deg", r.max_correction_rad * kToDeg},
                       {"floor_rms_before_m", r.floor_rms_before_m},
                       {"floor_rms_after_m", r.floor_rms_after_m}};
   if (!r.note.empty()) j["note"] = r.note;
-  // Each corrected line's recorded pitch and turn, to the 0.001 deg: the servo's error profile.
+  // Each corrected line's (or sweep's) recorded pitch and turn, to the 0.001 deg: the servo's
+  // error profile; with interlaced sweeps, the sweep too.
   nlohmann::json lines = nlohmann::json::array();
   const auto deg = [&](double rad) { return std::round(rad * kToDeg * 1000) / 1000; };
   for (const mapping::LineCorrection& c : r.line_corrections) {
-    lines.push_back({deg(c.pitch_rad), deg(c.correction_rad)});
+    nlohmann::json entry = {deg(c.pitch_rad), deg(c.correction_rad)};
+    if (r.sweeps_per_line > 1) entry.push_back(c.sweep);
+    lines.push_back(entry);
   }
   j["pitch_and_correction_deg"] = lines;
   return j;

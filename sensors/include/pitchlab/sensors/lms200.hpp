@@ -33,10 +33,11 @@ struct Lms200Config {
   //    line-to-line jitter, which a plane fit cannot tell from range noise.
   //  - incidence_noise_gain 0.4: with it the residual over all incidences at 2-4 / 4-8 m is
   //    0.78 / 0.96 of the real one (corridor world); 1/sqrt(12) = 0.29, a uniform spread over the
-  //    footprint, gives 0.61 / 0.71, none 0.31 / 0.13. The real floor, where a line's pitch
-  //    error cancels, confirms it is the beam's own: a floor return's height scatter along its
-  //    line is 3.3 / 8.3 / 8.2 mm at 0-2 / 2-4 / 4-8 m, this model 3.0 / 4.4 / 8.8, none 2.4 /
-  //    1.3 / 0.9 (sensor_realism floor_inline_sigma_m).
+  //    footprint, gives 0.61 / 0.71, none 0.31 / 0.13. The real floor does NOT confirm it
+  //    (session 50): a floor return's height scatter along its line, 3.3 / 8.3 / 8.2 mm at 0-2 /
+  //    2-4 / 4-8 m as first read, was the rig's two interlaced sweeps at different pitch; with
+  //    each sweep set right it is 1.7 / 2.0 / 1.8 mm, and this model gives 3.0 / 4.4 / 8.8 (no
+  //    single gain fits both the walls' residual and the floor: benchmarks/README.md, Session 50).
   // noise_sigma_m = 0 is the ideal sensor: no range noise of any term and no dropouts (what the
   // tests and the emulator's flat wall rely on).
   //
