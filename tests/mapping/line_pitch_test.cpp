@@ -214,6 +214,20 @@ TEST(LinePitch, EachInterlacedSweepOfALineIsSetRightOnItsOwn) {
   EXPECT_GT(FloorSpread(whole_lines, 4.0), 0.025);
 }
 
+// At 0.25 deg an LMS200 line is four sweeps: each a step of 0.1 deg behind the one before.
+TEST(LinePitch, AQuarterDegreeLineIsFourSweeps) {
+  std::vector<Eigen::Vector3f> scan = NoddingScan(
+      [](int line, int beam) { return Wobble(line) + 0.1 * kDeg * ((beam % 4 + 4) % 4); }, 0.003,
+      7, 0, 0.25);
+  const double before = FloorSpread(scan, 4.0);
+  const LinePitch r = RectifyLinePitch(scan, Eigen::Vector3f::Zero());
+  ASSERT_TRUE(r.nodding) << r.note;
+  EXPECT_EQ(r.sweeps_per_line, 4);
+  EXPECT_GT(before, 0.03);
+  EXPECT_LT(FloorSpread(scan, 4.0), 0.015);
+  EXPECT_LT(r.floor_rms_after_m, 0.004);
+}
+
 // Beams 1 deg apart are one turn of the mirror: nothing to split.
 TEST(LinePitch, ALineOfOneSweepIsNotSplit) {
   std::vector<Eigen::Vector3f> scan = NoddingScan(Wobble, 0.003, 6, 0, 1.0);
