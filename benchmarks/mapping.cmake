@@ -10,6 +10,7 @@ foreach(name registration_eval real_eval loop_closure_eval)
     add_dependencies(${name} pitchlab_world_files)
   endif()
 endforeach()
-target_sources(real_eval PRIVATE "${CMAKE_CURRENT_LIST_DIR}/real_map_check.cpp")
+target_sources(real_eval PRIVATE "${CMAKE_CURRENT_LIST_DIR}/real_map_check.cpp"
+  "${CMAKE_CURRENT_LIST_DIR}/real_wrong_priors.cpp")
 # real_eval reports line pitch as the commands do (mission/registration_json.hpp).
 target_link_libraries(real_eval PRIVATE pitchlab::mission)

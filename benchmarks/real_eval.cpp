@@ -4,8 +4,10 @@
 // any: the outcome, the error against the reference, and the fit at our pose and at the
 // reference's (the share of the source's points within 5 cm of the target, and their
 // point-to-plane RMS, at full resolution), with the CPU time of the registering thread. Prints
-// JSON. Then the map check (real_map_check.hpp) of all the scans at the reference poses and at
-// ours (each scan registered into the one before, with the odometry prior, chained).
+// JSON. Every pair that registered with the prior is registered again from wrong priors and the
+// wrong way round (real_wrong_priors.hpp): no success may land away from the pose. Then the map
+// check (real_map_check.hpp) of all the scans at the reference poses and at ours (each scan
+// registered into the one before, with the odometry prior, chained).
 //
 //   real_eval DIR [--prior-error m,deg] [--config FILE.yaml]
 
@@ -29,6 +31,7 @@
 #include "pitchlab/mission/registration_json.hpp"
 #include "pitchlab/sensors/cloud_file.hpp"
 #include "real_map_check.hpp"
+#include "real_wrong_priors.hpp"
 
 namespace {
 
@@ -126,6 +129,11 @@ struct Scan {
   double line_pitch_cpu_s = 0;    // and its CPU time [s]
 };
 
+// Where the scan's sensor stood in its own frame (3DTK's: the origin).
+Eigen::Vector3f SensorOf(const Scan& s) {
+  return s.scan.sensor_origin.value_or(Eigen::Vector3d::Zero()).cast<float>();
+}
+
 Scan Load(const fs::path& path) {
   Scan s;
   s.path = path.string();
@@ -135,8 +143,7 @@ Scan Load(const fs::path& path) {
   s.cloud = mapping::CloudFromScan(s.scan);
   // Each nodding line set right by the floor it crossed, as the commands read real scans.
   const double cpu = ThreadCpuSeconds();
-  s.line_pitch = mapping::RectifyLinePitch(
-      s.cloud, s.scan.sensor_origin.value_or(Eigen::Vector3d::Zero()).cast<float>());
+  s.line_pitch = mapping::RectifyLinePitch(s.cloud, SensorOf(s));
   s.line_pitch_cpu_s = ThreadCpuSeconds() - cpu;
   // The reference: scanNNN.frames, or any scanNNN.frames.* beside it.
   const std::string stem = path.stem().string();
@@ -157,8 +164,8 @@ json Run(const Scan& target, const Scan& source, const Grid& grid, bool with_pri
          const mapping::GuessUncertainty& bound, const mapping::RegistrationConfig& config,
          Eigen::Isometry3d& T_target_source) {
   mapping::RegistrationPrior prior;
-  prior.source_sensor = source.scan.sensor_origin.value_or(Eigen::Vector3d::Zero()).cast<float>();
-  prior.target_sensor = target.scan.sensor_origin.value_or(Eigen::Vector3d::Zero()).cast<float>();
+  prior.source_sensor = SensorOf(source);
+  prior.target_sensor = SensorOf(target);
   if (with_prior) {
     prior.odometry = target.scan.T_world_base.inverse() * source.scan.T_world_base;
     prior.odometry_uncertainty = bound;
@@ -277,6 +284,8 @@ int main(int argc, char** argv) {
     std::vector<Eigen::Isometry3d> ours{Eigen::Isometry3d::Identity()};
     bool chained = true;
     int runs = 0, successes = 0, within_target = 0, false_successes = 0;
+    json wrong_priors = json::array();
+    int wrong_runs = 0, wrong_off_reference = 0, wrong_off_ours = 0;
     for (std::size_t k = 0; k + 1 < scans.size(); ++k) {
       for (const auto& [t, s] : {std::pair{&scans[k], &scans[k + 1]}, {&scans[k + 1], &scans[k]}}) {
         const Grid grid(t->cloud);
@@ -288,6 +297,22 @@ int main(int argc, char** argv) {
           if (with_prior && s == &scans[k + 1]) {
             chained = chained && r.value("success", false);
             ours.push_back(ours.back() * T);
+          }
+          if (with_prior && r.value("success", false)) {
+            std::fprintf(stderr, "  %s -> %s, wrong priors\n", s->path.c_str(), t->path.c_str());
+            benchmarks::WrongPriorPair pair{&t->cloud,
+                                            &s->cloud,
+                                            SensorOf(*t),
+                                            SensorOf(*s),
+                                            t->reference.inverse() * s->reference,
+                                            T};
+            json w = benchmarks::CheckWrongPriors(pair, config);
+            wrong_runs += w["runs"].get<int>();
+            wrong_off_reference += w["successes_off_the_reference"].get<int>();
+            wrong_off_ours += w["successes_off_ours"].get<int>();
+            w["source"] = s->path;
+            w["target"] = t->path;
+            wrong_priors.push_back(std::move(w));
           }
           r["source"] = s->path;
           r["target"] = t->path;
@@ -309,8 +334,7 @@ int main(int argc, char** argv) {
     std::sort(cpu.begin(), cpu.end());
     std::vector<benchmarks::PosedCloud> at_reference, at_ours;
     for (std::size_t k = 0; k < scans.size(); ++k) {
-      const Eigen::Vector3f sensor =
-          scans[k].scan.sensor_origin.value_or(Eigen::Vector3d::Zero()).cast<float>();
+      const Eigen::Vector3f sensor = SensorOf(scans[k]);
       at_reference.push_back(
           {&scans[k].cloud, sensor, scans[0].reference.inverse() * scans[k].reference});
       at_ours.push_back({&scans[k].cloud, sensor, ours[k]});
@@ -347,9 +371,15 @@ int main(int argc, char** argv) {
                 {"successes", successes},
                 {"within_1deg_5cm_of_reference", within_target},
                 {"successes_off_the_reference", false_successes},
-                {"cpu_s", {{"median", cpu.empty() ? 0 : cpu[cpu.size() / 2]},
-                           {"max", cpu.empty() ? 0 : cpu.back()}}},
+                {"cpu_s",
+                 {{"median", cpu.empty() ? 0 : cpu[cpu.size() / 2]},
+                  {"max", cpu.empty() ? 0 : cpu.back()}}},
                 {"map", map_check},
+                {"wrong_priors",
+                 {{"runs", wrong_runs},
+                  {"successes_off_the_reference", wrong_off_reference},
+                  {"successes_off_ours", wrong_off_ours},
+                  {"pairs", wrong_priors}}},
                 {"runs_detail", pairs}};
     std::cout << out.dump(2) << "\n";
   } catch (const std::exception& e) {
