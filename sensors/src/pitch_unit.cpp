@@ -38,6 +38,9 @@ void PitchUnitConfig::Validate() const {
   if (!(line_pitch_error_period_deg > 0.0 && line_pitch_error_period_deg <= 90.0)) {
     Invalid("line_pitch_error_period_deg", line_pitch_error_period_deg, "0 < period <= 90");
   }
+  if (!(sweep_lag_deg >= 0.0 && sweep_lag_deg <= 5.0)) {
+    Invalid("sweep_lag_deg", sweep_lag_deg, "0 .. 5");
+  }
 }
 
 PitchUnitModel::PitchUnitModel(const PitchUnitConfig& config) : config_(config) {

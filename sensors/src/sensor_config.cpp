@@ -143,6 +143,7 @@ SensorConfig ParseSensorConfig(const std::string& yaml_text, const std::string& 
       .Field("settle_s", p.settle_s)
       .Field("line_pitch_error_deg", p.line_pitch_error_deg)
       .Field("line_pitch_error_period_deg", p.line_pitch_error_period_deg)
+      .Field("sweep_lag_deg", p.sweep_lag_deg)
       .Field("seed", pitch_seed)
       .Read();
   p.seed = pitch_seed;
@@ -211,6 +212,7 @@ std::string SensorConfigToYaml(const SensorConfig& c) {
      << "  settle_s: " << p.settle_s << "\n"
      << "  line_pitch_error_deg: " << p.line_pitch_error_deg << "\n"
      << "  line_pitch_error_period_deg: " << p.line_pitch_error_period_deg << "\n"
+     << "  sweep_lag_deg: " << p.sweep_lag_deg << "\n"
      << "  seed: " << p.seed << "\n";
   const auto& s = c.scan;
   os << "scan:\n"

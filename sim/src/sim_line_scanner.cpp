@@ -101,16 +101,47 @@ void SimLineScanner::CastIncidence(const Eigen::Isometry3d& T_world_laser) {
   }
 }
 
-void SimLineScanner::MakeLine(const Eigen::Isometry3d& T_world_laser, sensors::LaserLine& line) {
+void SimLineScanner::CastBeams(const Eigen::Isometry3d& T_world_laser) {
   CastAt(T_world_laser, 0.0, ranges_);
-  const bool mixed = model_.config().mixed_pixels;
-  if (mixed) {
+  if (model_.config().mixed_pixels) {
     const double half_div = 0.5 * model_.config().beam_divergence_deg * M_PI / 180.0;
     CastAt(T_world_laser, -half_div, edge_lo_);
     CastAt(T_world_laser, +half_div, edge_hi_);
   }
+  if (model_.config().UsesIncidence()) CastIncidence(T_world_laser);
+}
+
+void SimLineScanner::set_sweep_lag_rad(double lag_rad) {
+  if (!(lag_rad >= 0.0 && std::isfinite(lag_rad))) {
+    throw std::invalid_argument("SimLineScanner: sweep lag " + std::to_string(lag_rad) +
+                                " rad, want >= 0");
+  }
+  sweep_lag_rad_ = lag_rad;
+}
+
+void SimLineScanner::MakeLine(const Eigen::Isometry3d& T_world_laser, sensors::LaserLine& line) {
+  CastBeams(T_world_laser);
+  // The LMS200's finer resolutions interlace turns of 1 deg: reading i is in sweep i mod sweeps
+  // (its beams start at -90 deg, a whole number of 1 deg turns from straight ahead).
+  const double per_turn = M_PI / 180.0 / model_.angle_increment_rad();
+  const int sweeps = static_cast<int>(std::lround(per_turn));
+  if (sweep_lag_rad_ > 0.0 && sweeps >= 2) {
+    const bool mixed = model_.config().mixed_pixels, incidence = model_.config().UsesIncidence();
+    line_ranges_ = ranges_, line_lo_ = edge_lo_, line_hi_ = edge_hi_, line_cos_ = cos_incidence_;
+    for (int k = 1; k < sweeps; ++k) {
+      // Further down: about the laser's y, which points left (REP-103), nose down is positive.
+      CastBeams(T_world_laser * Eigen::AngleAxisd(k * sweep_lag_rad_, Eigen::Vector3d::UnitY()));
+      for (std::size_t i = static_cast<std::size_t>(k); i < ranges_.size(); i += sweeps) {
+        line_ranges_[i] = ranges_[i];
+        if (mixed) line_lo_[i] = edge_lo_[i], line_hi_[i] = edge_hi_[i];
+        if (incidence) line_cos_[i] = cos_incidence_[i];
+      }
+    }
+    ranges_.swap(line_ranges_), edge_lo_.swap(line_lo_), edge_hi_.swap(line_hi_);
+    cos_incidence_.swap(line_cos_);
+  }
+  const bool mixed = model_.config().mixed_pixels;
   const bool incidence = model_.config().UsesIncidence();
-  if (incidence) CastIncidence(T_world_laser);
   model_.Measure(ranges_.data(), mixed ? edge_lo_.data() : nullptr,
                  mixed ? edge_hi_.data() : nullptr, line,
                  incidence ? cos_incidence_.data() : nullptr);

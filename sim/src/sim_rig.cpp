@@ -40,6 +40,7 @@ SimRig::SimRig(std::unique_ptr<Simulation> sim, const SimRigConfig& config)
   base_ = std::make_unique<SimBase>(*sim_, config_.odometry);
   axis_ = std::make_unique<SimPitchAxis>(*sim_, config_.pitch_unit);
   scanner_ = std::make_unique<SimLineScanner>(*sim_, *caster_, config_.lms200);
+  scanner_->set_sweep_lag_rad(config_.pitch_unit.sweep_lag_deg * M_PI / 180.0);
   source_ = std::make_unique<sensors::PitchingScanSource>(*scanner_, *axis_, config_.pattern,
                                                           config_.robot.mount);
   if (config_.imu.deskew) {

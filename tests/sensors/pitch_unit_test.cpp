@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -107,6 +108,21 @@ TEST(PitchUnit, RejectsANegativeLinePitchErrorOrPeriod) {
   config = {};
   config.line_pitch_error_period_deg = 0;
   EXPECT_THROW(PitchUnitModel{config}, std::invalid_argument);
+}
+
+TEST(PitchUnit, RejectsASweepLagBelowZeroOrAboveFiveDegrees) {
+  PitchUnitConfig config;
+  config.sweep_lag_deg = 0.16;  // the real 3DTK rig's mean
+  EXPECT_NO_THROW(PitchUnitModel{config});
+  for (const double bad : {-0.1, 5.5}) {
+    config.sweep_lag_deg = bad;
+    try {
+      PitchUnitModel model{config};
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("sweep_lag_deg"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

@@ -106,6 +106,36 @@ TEST_P(BothCasters, ALineOfAWallGivesTheKnownRanges) {
   EXPECT_TRUE(std::isnan(line->ranges_m[0]));
 }
 
+// A unit that pitches on during a line (pitch_unit.sweep_lag_deg): the LMS200's 0.5 deg line is
+// two 1 deg sweeps, the odd readings cast 2 deg further down than the even ones. Looking 20 deg
+// down at the floor, each beam meets the floor where its own sweep's pitch says (range = laser
+// height / the beam's downward component), and without the lag both sweeps share one pitch.
+TEST(SimLineScanner, AnInterlacedLinesSecondSweepIsCastFurtherDownByTheSweepLag) {
+  for (const double lag_deg : {0.0, 2.0}) {
+    SimRigConfig config = QuietConfig();
+    config.pitch_unit.sweep_lag_deg = lag_deg;
+    auto rig = MakeRig(config);
+    ASSERT_TRUE(rig->pitch_axis().MoveTo(20.0 * kDeg, kTimeout));
+    const Eigen::Isometry3d T = rig->sim().T_world_laser();
+    Result<sensors::LaserLine> line = rig->scanner().NextLine(kTimeout);
+    ASSERT_TRUE(line) << line.error().message;
+    const double h = T.translation().z();
+    for (const std::size_t i : {170u, 171u, 180u, 181u, 190u, 191u}) {  // -5 .. 5.5 deg
+      const double theta = line->Angle(i);
+      const Eigen::Vector3d beam(std::cos(theta), std::sin(theta), 0.0);
+      const double lag = (i % 2 == 1 ? lag_deg : 0.0) * kDeg;
+      const Eigen::Vector3d d =
+          T.linear() * Eigen::AngleAxisd(lag, Eigen::Vector3d::UnitY()) * beam;
+      ASSERT_LT(d.z(), -0.1);
+      ASSERT_EQ(line->status[i], sensors::ReadingStatus::kValid) << i;
+      EXPECT_NEAR(line->ranges_m[i], -h / d.z(), kRangeTolerance_m)
+          << "lag " << lag_deg << ", reading " << i;
+    }
+    // 2 deg at 20 deg down moves the floor hit by ~0.2 m: far beyond the tolerance.
+    if (lag_deg > 0) EXPECT_LT(line->ranges_m[181], line->ranges_m[180] - 0.1);
+  }
+}
+
 TEST(SimRig, AcquireGivesAScanWithGroundTruthAndTheWallInBaseLink) {
   auto rig = MakeRig(QuietConfig());
   const Eigen::Isometry3d truth = rig->sim().T_world_base();

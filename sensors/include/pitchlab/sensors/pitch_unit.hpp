@@ -24,6 +24,13 @@ struct PitchUnitConfig {
   // every simulated figure so far assumed.
   double line_pitch_error_deg = 0.0;         ///< RMS of the reported pitch's error [deg]
   double line_pitch_error_period_deg = 4.2;  ///< period of the wobble, width of a step [deg]
+  // An LMS200 line finer than 1 deg is several turns of its mirror interlaced (at 0.5 deg two 1
+  // deg sweeps, one turn, 13.3 ms, apart; LMS200 manual). A unit that pitches on during a line
+  // takes each sweep this much further down than the one before: the real 3DTK rig's two sweeps
+  // lie 0.16 deg apart on average (mapping/README.md, Line pitch). The simulated line casts sweep
+  // k at its pitch + k x this, about the laser's own origin (0.09 m above the axis: 0.3 mm off
+  // at 0.2 deg). 0 (the default): a unit that holds its step through the line.
+  double sweep_lag_deg = 0.0;  ///< pitch between consecutive interlaced sweeps of a line [deg]
   std::uint64_t seed = 1;                    ///< draws the error's phase and steps
 
   /// Throws std::invalid_argument naming the field and value.

@@ -33,6 +33,10 @@ class SimLineScanner final : public sensors::LineScanner {
   void EndSweep(std::vector<sensors::LaserLine>* lines) override;
   ~SimLineScanner() override;
   const sensors::Lms200Model& model() const { return model_; }
+  /// Casts an interlaced line's sweeps (a line finer than 1 deg) each `lag_rad` further down
+  /// than the one before (sensors::PitchUnitConfig::sweep_lag_deg); 0, the default, casts a line
+  /// at one pitch. Throws std::invalid_argument when negative or not finite.
+  void set_sweep_lag_rad(double lag_rad);
   /// Rays reach this far: 5 % beyond the range mode's maximum, so over-range can be flagged [m].
   float cast_range_m() const;
   /// Time spent so far making lines: casting their rays and turning ranges into readings (for a
@@ -44,6 +48,9 @@ class SimLineScanner final : public sensors::LineScanner {
   // Casts the line at T_world_laser and turns its ranges into readings (`line`'s stamp and pitch
   // left for the caller).
   void MakeLine(const Eigen::Isometry3d& T_world_laser, sensors::LaserLine& line);
+  // Casts every beam of the line (ranges, and the edge and incidence rays the model asks for)
+  // at T_world_laser.
+  void CastBeams(const Eigen::Isometry3d& T_world_laser);
   void CastAt(const Eigen::Isometry3d& T_world_laser, double offset_rad, std::vector<float>& out,
               double tip_rad = 0.0);
   void CastIncidence(const Eigen::Isometry3d& T_world_laser);
@@ -68,6 +75,9 @@ class SimLineScanner final : public sensors::LineScanner {
   std::deque<sensors::LaserLine> swept_;
   bool in_sweep_ = false;
   double sweep_cpu0_s_ = 0;  // the worker's CPU time when the sweep began [s]
+  double sweep_lag_rad_ = 0;  // set_sweep_lag_rad
+  // MakeLine with a sweep lag: the line's casts so far, one interlaced sweep at a time.
+  std::vector<float> line_ranges_, line_lo_, line_hi_, line_cos_;
 };
 
 }  // namespace pitchlab::sim
