@@ -382,21 +382,29 @@ LinePitch RectifyLinePitch(std::vector<Eigen::Vector3f>& points_m, const Eigen::
 
 LinePitch RectifyLinePitch(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f& axis_m,
                            const std::vector<std::vector<std::uint32_t>>& lines,
-                           const LinePitchConfig& config) {
+                           const LinePitchConfig& config, const std::vector<int>& sweep_of) {
+  if (!sweep_of.empty() && sweep_of.size() != lines.size()) {
+    throw std::invalid_argument("RectifyLinePitch: " + std::to_string(sweep_of.size()) +
+                                " sweeps given for " + std::to_string(lines.size()) + " lines");
+  }
   LinePitch out;
   std::vector<std::vector<std::uint32_t>> kept;
-  for (const auto& line : lines) {
+  std::vector<int> kept_sweep;
+  for (std::size_t l = 0; l < lines.size(); ++l) {
+    const auto& line = lines[l];
     for (const std::uint32_t k : line) {
       if (k >= points_m.size()) {
         throw std::invalid_argument("RectifyLinePitch: point index " + std::to_string(k) +
                                     " of " + std::to_string(points_m.size()));
       }
     }
-    if (line.size() >= config.min_line_points) kept.push_back(line);
+    if (line.size() < config.min_line_points) continue;
+    kept.push_back(line);
+    if (!sweep_of.empty()) kept_sweep.push_back(sweep_of[l]);
   }
   out.lines = kept.size();
   out.nodding = true;
-  SetLinesRight(points_m, axis_m, kept, {}, config, out);
+  SetLinesRight(points_m, axis_m, kept, kept_sweep, config, out);
   return out;
 }
 

@@ -40,14 +40,34 @@ ElevationScan ElevationScanOf(const sensors::Scan3D& scan, double map_range_m,
 
 mapping::LinePitch SetLinesRight(sensors::Scan3D& scan, const sensors::MountConfig& mount) {
   mapping::PointCloud points = mapping::CloudFromScan(scan);
-  std::vector<std::vector<std::uint32_t>> lines(scan.lines.size());
+  // A line finer than the LMS200's 1 deg turn is that many interlaced sweeps, at pitches of their
+  // own when the unit moves during the line (mapping::LinePitchConfig::sweep_step_rad): each is
+  // set right on its own, from as many times fewer floor points. Reading b is in sweep b mod n.
+  mapping::LinePitchConfig config;
+  const double step = scan.lines.empty() ? 0.0 : scan.lines.front().angle_increment_rad;
+  const long n = step > 0.0 ? std::lround(config.sweep_step_rad / step) : 1;
+  const std::size_t sweeps = static_cast<std::size_t>(std::max(1L, n));
+  config.min_line_points = (config.min_line_points + sweeps - 1) / sweeps;
+  std::vector<std::vector<std::uint32_t>> lines(scan.lines.size() * sweeps);
   for (std::size_t k = 0; k < scan.points.size(); ++k) {
-    const std::size_t line = scan.points[k].line;
+    const std::size_t line = scan.points[k].line * sweeps + scan.points[k].beam % sweeps;
     if (line >= lines.size()) lines.resize(line + 1);
     lines[line].push_back(static_cast<std::uint32_t>(k));
   }
-  const mapping::LinePitch done =
-      mapping::RectifyLinePitch(points, mount.t_base_mount_m.cast<float>(), lines);
+  std::vector<int> sweep_of(lines.size());
+  for (std::size_t l = 0; l < lines.size(); ++l) sweep_of[l] = static_cast<int>(l % sweeps);
+  mapping::LinePitch done = mapping::RectifyLinePitch(points, mount.t_base_mount_m.cast<float>(),
+                                                      lines, config, sweep_of);
+  // Lines, not their sweeps: the lines with any sweep long enough to be set right.
+  std::size_t whole = 0;
+  for (std::size_t l = 0; l < lines.size(); l += sweeps) {
+    bool any = false;
+    for (std::size_t s = 0; s < sweeps && l + s < lines.size(); ++s)
+      any = any || lines[l + s].size() >= config.min_line_points;
+    whole += any;
+  }
+  done.lines = whole;
+  done.sweeps_per_line = static_cast<int>(sweeps);
   for (std::size_t k = 0; k < scan.points.size(); ++k) {
     scan.points[k].x = points[k].x();
     scan.points[k].y = points[k].y();

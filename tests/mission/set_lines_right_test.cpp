@@ -1,6 +1,7 @@
 // SetLinesRight on pitchlab's own scans: the simulated office from its start, with the pitch unit
 // reporting each line's pitch off by the real 3DTK rig's error (pitch_unit.line_pitch_error_deg
-// 0.9) and with a unit that reports its true pitch.
+// 0.9), with one that pitches on between a line's interlaced sweeps (sweep_lag_deg), and with a
+// unit that reports its true pitch.
 
 #include <algorithm>
 #include <cmath>
@@ -15,10 +16,11 @@
 namespace pitchlab::mission {
 namespace {
 
-sensors::Scan3D OfficeScan(double line_pitch_error_deg) {
+sensors::Scan3D OfficeScan(double line_pitch_error_deg, double sweep_lag_deg = 0.0) {
   sim::SimRigConfig config;
   config.lms200 = sensors::Lms200Config::Legacy();
   config.pitch_unit.line_pitch_error_deg = line_pitch_error_deg;
+  config.pitch_unit.sweep_lag_deg = sweep_lag_deg;
   config.pitch_unit.seed = 3;
   sim::SimRig rig(std::string(PITCHLAB_WORLDS_DIR) + "/office.xml", config);
   EXPECT_TRUE(rig.PlaceAtDefaultStart());
@@ -64,6 +66,43 @@ TEST(SetLinesRight, TheServosLinePitchErrorLeavesTheSimulatedFloor) {
   for (std::size_t k = 0; k < scan.points.size(); k += 97) {
     EXPECT_EQ(scan.points[k].range_m, recorded.points[k].range_m);
   }
+}
+
+// The mean height of the odd readings' floor returns 1-3 m from the robot less the even ones'
+// (base_link's z = 0 is the floor; returns within 0.15 m of it).
+double OddOverEven(const sensors::Scan3D& scan) {
+  double sum[2] = {0, 0};
+  int n[2] = {0, 0};
+  for (const sensors::ScanPoint& p : scan.points) {
+    const double r = std::hypot(p.x, p.y);
+    if (r < 1.0 || r > 3.0 || std::abs(p.z) > 0.15) continue;
+    sum[p.beam % 2] += p.z;
+    ++n[p.beam % 2];
+  }
+  return sum[1] / std::max(n[1], 1) - sum[0] / std::max(n[0], 1);
+}
+
+// A unit that pitches on 1 deg between the two interlaced sweeps of each 0.5 deg line: the odd
+// sweep's floor lies off the even one's by 1 deg times its distance; each sweep set right on its
+// own, the two agree and the floor is as flat as a unit without the lag leaves it.
+TEST(SetLinesRight, EachInterlacedSweepIsSetRightOnItsOwn) {
+  sensors::Scan3D scan = OfficeScan(0.0, 1.0);
+  const double before = OddOverEven(scan);
+  int after_n = 0, true_n = 0;
+  const double true_pitch = FloorRms(OfficeScan(0.0), &true_n);
+  const mapping::LinePitch r = SetLinesRight(scan, sim::SimRigConfig{}.robot.mount);
+  ASSERT_TRUE(r.nodding) << r.note;
+  EXPECT_EQ(r.sweeps_per_line, 2);
+  EXPECT_LE(r.lines, scan.lines.size());
+  // 1 deg at 1-3 m is 1.7-5.2 cm: 1.6 cm on average over this scan's floor returns there.
+  EXPECT_GT(std::abs(before), 0.01);
+  EXPECT_LT(std::abs(OddOverEven(scan)), 0.003);
+  // Each sweep's turn is fitted to half a line's returns: its noise is sqrt(2) a whole line's,
+  // and the floor is left within 2 mm (not 1) of the unit without the lag.
+  EXPECT_LT(FloorRms(scan, &after_n), true_pitch + 0.002) << after_n << " vs " << true_n;
+  bool both = false;
+  for (const mapping::LineCorrection& c : r.line_corrections) both = both || c.sweep == 1;
+  EXPECT_TRUE(both);
 }
 
 TEST(SetLinesRight, AUnitThatReportsItsTruePitchKeepsItsLines) {

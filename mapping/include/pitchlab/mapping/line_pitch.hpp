@@ -93,9 +93,12 @@ LinePitch RectifyLinePitch(std::vector<Eigen::Vector3f>& points_m, const Eigen::
 /// fewer than min_line_points are left as they are), such as pitchlab's own (sensors::ScanPoint::
 /// line), whose laser sits off the pitch axis so that a line's points do not share one elevation
 /// about it. Each line is turned about the y axis through `axis_m`, the pitch axis (in base_link:
-/// the mount's origin). Throws std::invalid_argument for an index outside `points_m`.
+/// the mount's origin). `sweep_of`, when given, says which interlaced sweep each of `lines` is
+/// (a caller that split its lines by sweep; reported in each LineCorrection). Throws
+/// std::invalid_argument for an index outside `points_m` or a `sweep_of` of another size.
 LinePitch RectifyLinePitch(std::vector<Eigen::Vector3f>& points_m, const Eigen::Vector3f& axis_m,
                            const std::vector<std::vector<std::uint32_t>>& lines,
-                           const LinePitchConfig& config = {});
+                           const LinePitchConfig& config = {},
+                           const std::vector<int>& sweep_of = {});
 
 }  // namespace pitchlab::mapping
