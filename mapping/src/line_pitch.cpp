@@ -85,15 +85,6 @@ double BeamStep(const std::vector<std::vector<std::uint32_t>>& lines,
   return gaps[gaps.size() / 2];
 }
 
-// How many interlaced sweeps a line of beams `step` apart is made of: sweep_step / step when that
-// is a whole number of at least 2 (within a tenth of a beam), else 1.
-int SweepsPerLine(double step, const LinePitchConfig& config) {
-  if (!(step > 0)) return 1;
-  const double ratio = config.sweep_step_rad / step;
-  const long n = std::lround(ratio);
-  return n >= 2 && std::abs(ratio - static_cast<double>(n)) < 0.1 ? static_cast<int>(n) : 1;
-}
-
 // Each line split into its `sweeps` interlaced sweeps (beam index, counted from straight ahead,
 // modulo sweeps); `sweep_of` receives each piece's sweep. Pieces of fewer than min_line_points
 // points are dropped, as LinesOf drops short lines.
@@ -363,7 +354,7 @@ LinePitch RectifyLinePitch(std::vector<Eigen::Vector3f>& points_m, const Eigen::
   }
   out.nodding = true;
   const double step = BeamStep(indices, points_m, sensor_m);
-  out.sweeps_per_line = SweepsPerLine(step, config);
+  out.sweeps_per_line = sensors::InterlacedSweeps(step, config.sweep_step_rad);
   if (out.sweeps_per_line == 1) {
     SetLinesRight(points_m, sensor_m, indices, {}, config, out);
   } else {

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "pitchlab/mapping/point_cloud.hpp"
+#include "pitchlab/sensors/lms200.hpp"
 
 namespace pitchlab::mission {
 
@@ -41,12 +42,11 @@ ElevationScan ElevationScanOf(const sensors::Scan3D& scan, double map_range_m,
 mapping::LinePitch SetLinesRight(sensors::Scan3D& scan, const sensors::MountConfig& mount) {
   mapping::PointCloud points = mapping::CloudFromScan(scan);
   // A line finer than the LMS200's 1 deg turn is that many interlaced sweeps, at pitches of their
-  // own when the unit moves during the line (mapping::LinePitchConfig::sweep_step_rad): each is
-  // set right on its own, from as many times fewer floor points. Reading b is in sweep b mod n.
+  // own when the unit moves during the line (sensors::InterlacedSweeps): each is set right on its
+  // own, from as many times fewer floor points. Reading b is in sweep b mod sweeps.
   mapping::LinePitchConfig config;
-  const double step = scan.lines.empty() ? 0.0 : scan.lines.front().angle_increment_rad;
-  const long n = step > 0.0 ? std::lround(config.sweep_step_rad / step) : 1;
-  const std::size_t sweeps = static_cast<std::size_t>(std::max(1L, n));
+  const std::size_t sweeps = static_cast<std::size_t>(sensors::InterlacedSweeps(
+      scan.lines.empty() ? 0.0 : scan.lines.front().angle_increment_rad, config.sweep_step_rad));
   config.min_line_points = (config.min_line_points + sweeps - 1) / sweeps;
   std::vector<std::vector<std::uint32_t>> lines(scan.lines.size() * sweeps);
   for (std::size_t k = 0; k < scan.points.size(); ++k) {

@@ -109,6 +109,13 @@ std::array<double, 3> DrawMountErrorRpyRad(const Lms200Config& config) {
   return rpy;
 }
 
+int InterlacedSweeps(double beam_step_rad, double turn_rad) {
+  if (!(beam_step_rad > 0.0)) return 1;
+  const double ratio = turn_rad / beam_step_rad;
+  const long n = std::lround(ratio);
+  return n >= 2 && std::abs(ratio - static_cast<double>(n)) < 0.1 ? static_cast<int>(n) : 1;
+}
+
 Lms200Model::Lms200Model(const Lms200Config& config)
     : config_(config), rng_(config.seed), effects_(config.seed ^ kEffectsStream) {
   config_.Validate();

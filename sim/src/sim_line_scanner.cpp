@@ -13,7 +13,10 @@ namespace pitchlab::sim {
 
 SimLineScanner::SimLineScanner(Simulation& sim, sensors::RayCaster& caster,
                                const sensors::Lms200Config& config)
-    : sim_(sim), caster_(caster), model_(config) {}
+    : sim_(sim),
+      caster_(caster),
+      model_(config),
+      sweeps_(sensors::InterlacedSweeps(model_.angle_increment_rad())) {}
 
 float SimLineScanner::cast_range_m() const {
   return static_cast<float>(model_.max_range_m() * 1.05);
@@ -120,18 +123,16 @@ void SimLineScanner::set_sweep_lag_rad(double lag_rad) {
 }
 
 void SimLineScanner::MakeLine(const Eigen::Isometry3d& T_world_laser, sensors::LaserLine& line) {
+  const bool mixed = model_.config().mixed_pixels;
+  const bool incidence = model_.config().UsesIncidence();
   CastBeams(T_world_laser);
-  // The LMS200's finer resolutions interlace turns of 1 deg: reading i is in sweep i mod sweeps
-  // (its beams start at -90 deg, a whole number of 1 deg turns from straight ahead).
-  const double per_turn = M_PI / 180.0 / model_.angle_increment_rad();
-  const int sweeps = static_cast<int>(std::lround(per_turn));
-  if (sweep_lag_rad_ > 0.0 && sweeps >= 2) {
-    const bool mixed = model_.config().mixed_pixels, incidence = model_.config().UsesIncidence();
+  // Reading i is in sweep i mod sweeps_ (sensors::InterlacedSweeps); sweep k is cast k lags down.
+  if (sweep_lag_rad_ > 0.0 && sweeps_ >= 2) {
     line_ranges_ = ranges_, line_lo_ = edge_lo_, line_hi_ = edge_hi_, line_cos_ = cos_incidence_;
-    for (int k = 1; k < sweeps; ++k) {
+    for (int k = 1; k < sweeps_; ++k) {
       // Further down: about the laser's y, which points left (REP-103), nose down is positive.
       CastBeams(T_world_laser * Eigen::AngleAxisd(k * sweep_lag_rad_, Eigen::Vector3d::UnitY()));
-      for (std::size_t i = static_cast<std::size_t>(k); i < ranges_.size(); i += sweeps) {
+      for (std::size_t i = static_cast<std::size_t>(k); i < ranges_.size(); i += sweeps_) {
         line_ranges_[i] = ranges_[i];
         if (mixed) line_lo_[i] = edge_lo_[i], line_hi_[i] = edge_hi_[i];
         if (incidence) line_cos_[i] = cos_incidence_[i];
@@ -140,8 +141,6 @@ void SimLineScanner::MakeLine(const Eigen::Isometry3d& T_world_laser, sensors::L
     ranges_.swap(line_ranges_), edge_lo_.swap(line_lo_), edge_hi_.swap(line_hi_);
     cos_incidence_.swap(line_cos_);
   }
-  const bool mixed = model_.config().mixed_pixels;
-  const bool incidence = model_.config().UsesIncidence();
   model_.Measure(ranges_.data(), mixed ? edge_lo_.data() : nullptr,
                  mixed ? edge_hi_.data() : nullptr, line,
                  incidence ? cos_incidence_.data() : nullptr);

@@ -43,6 +43,18 @@ TEST(Lms200, EveryVariantHasItsBeamCountAndAngles) {
   }
 }
 
+// The LMS200's finer resolutions interlace 1 deg turns of its mirror: 0.5 deg is two sweeps,
+// 0.25 deg four, 1 deg one; a step that is no whole fraction of a turn is one sweep.
+TEST(Lms200, AFinerResolutionIsThatManyInterlacedTurns) {
+  constexpr double kDeg = M_PI / 180.0;
+  EXPECT_EQ(InterlacedSweeps(0.5 * kDeg), 2);
+  EXPECT_EQ(InterlacedSweeps(0.25 * kDeg), 4);
+  EXPECT_EQ(InterlacedSweeps(1.0 * kDeg), 1);
+  EXPECT_EQ(InterlacedSweeps(0.4 * kDeg), 1);  // 2.5 beams a turn: no whole number of turns
+  EXPECT_EQ(InterlacedSweeps(0.0), 1);
+  EXPECT_EQ(InterlacedSweeps(0.5 * kDeg, 0.5 * kDeg), 1);  // a turn as fine as the beams
+}
+
 TEST(Lms200, RejectsSettingsTheDeviceDoesNotHave) {
   Lms200Config quarter_wide;
   quarter_wide.resolution_deg = 0.25;  // 0.25 deg exists only with the 100 deg field of view

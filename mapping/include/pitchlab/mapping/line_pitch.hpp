@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 
 #include "pitchlab/mapping/ground_level.hpp"
+#include "pitchlab/sensors/lms200.hpp"
 
 namespace pitchlab::mapping {
 
@@ -48,7 +49,7 @@ struct LinePitchConfig {
   /// its servo jumps between them (one half of such a line met the floor at 2.2 m, the other at
   /// 3.3 m). A line whose beams lie closer than this is split into its sweeps (beam index modulo
   /// the sweeps), and each is set right on its own; a scan at this step or coarser is not split.
-  double sweep_step_rad = 0.0174532925;  // 1 deg
+  double sweep_step_rad = sensors::kLms200TurnRad;  // 1 deg
   /// The floor taken as flat: the levelling's candidates (GroundLevelConfig radii) [m].
   GroundLevelConfig ground;
 };

@@ -96,6 +96,18 @@ struct Lms200Config {
 /// drawn from `config.seed` on a stream of its own (all zero when the sigma is 0).
 std::array<double, 3> DrawMountErrorRpyRad(const Lms200Config& config);
 
+/// The angle between an LMS200's beams within one turn of its mirror: 1 deg [rad]. Its finer
+/// resolutions interlace turns (LMS200 manual: at 0.5 deg two 1 deg sweeps offset by 0.5 deg, at
+/// 0.25 deg four; one turn 13.3 ms), so a nodding unit that moves during a line gives each sweep
+/// a pitch of its own.
+inline constexpr double kLms200TurnRad = 0.0174532925199432957;
+
+/// How many interlaced sweeps a line of beams `beam_step_rad` apart is made of: turn / step when
+/// that is a whole number of at least 2 (within a tenth of a beam), else 1 (also for a step <= 0).
+/// Reading i of a line (counted from a beam a whole number of turns from straight ahead, as the
+/// LMS200's -90 deg first beam is) is in sweep i mod that.
+int InterlacedSweeps(double beam_step_rad, double turn_rad = kLms200TurnRad);
+
 /// Turns true ranges into LMS200 readings. Deterministic for a given seed and call sequence.
 class Lms200Model {
  public:

@@ -75,6 +75,7 @@ class SimLineScanner final : public sensors::LineScanner {
   std::deque<sensors::LaserLine> swept_;
   bool in_sweep_ = false;
   double sweep_cpu0_s_ = 0;  // the worker's CPU time when the sweep began [s]
+  int sweeps_ = 1;           // interlaced sweeps in a line (sensors::InterlacedSweeps)
   double sweep_lag_rad_ = 0;  // set_sweep_lag_rad
   // MakeLine with a sweep lag: the line's casts so far, one interlaced sweep at a time.
   std::vector<float> line_ranges_, line_lo_, line_hi_, line_cos_;
