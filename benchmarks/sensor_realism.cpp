@@ -2,6 +2,9 @@
 // statistics on real pitching-LMS scans (3DTK "uos" .3d files) and on simulated scans of a similar
 // scene (the corridor world), and prints them side by side as JSON with the ratio sim / real:
 //   - local plane-fit residual (robust sigma of point-to-plane distances) by range and incidence;
+//   - the range noise alone: each return's offset from its two neighbours in the same interlaced
+//     sweep (no pitch error of the servo's or the sweeps' enters), by range and incidence, and on
+//     the floor;
 //   - mixed pixels at depth edges along the scan line;
 //   - dropouts (no-returns) overall and, where neighbouring returns locate them, by range and
 //     incidence;
@@ -28,6 +31,7 @@
 #include "pitchlab/mapping/line_pitch.hpp"
 #include "pitchlab/sensors/cloud_file.hpp"
 #include "pitchlab/sensors/grazing_returns.hpp"
+#include "pitchlab/sensors/lms200.hpp"
 #include "pitchlab/sensors/sensor_config.hpp"
 #include "pitchlab/sim/sim_rig.hpp"
 
@@ -82,6 +86,7 @@ struct RangeGrid {
   std::vector<float> range;             // [m], valid cells only
   std::vector<Eigen::Vector3d> point;   // valid cells only
   std::vector<Eigen::Vector3d> origin;  // per line
+  double beam_step_rad = 0;             // angle between adjacent readings of a line
   std::size_t Index(int l, int b) const { return static_cast<std::size_t>(l) * beams + b; }
 };
 
@@ -126,6 +131,9 @@ RangeGrid ReadUos(const std::string& path) {
   }
   g.beams = beams;
   g.lines = static_cast<int>(p.size() / beams);
+  // The fan spans its readings evenly; its first line's first and last azimuth give the step
+  // (3DTK's 360 readings over 180 deg: 0.5 deg, two interlaced LMS200 sweeps).
+  if (beams > 1) g.beam_step_rad = std::abs(azimuth[beams - 1] - azimuth[0]) / (beams - 1);
   g.cell.resize(p.size());
   g.range.assign(p.size(), 0.0f);
   g.point.resize(p.size());
@@ -150,6 +158,7 @@ RangeGrid FromScan(const sensors::Scan3D& scan, const sensors::MountConfig& moun
   g.name = name;
   g.lines = static_cast<int>(scan.lines.size());
   g.beams = g.lines ? static_cast<int>(scan.lines[0].ranges_m.size()) : 0;
+  g.beam_step_rad = g.lines ? std::abs(scan.lines[0].angle_increment_rad) : 0.0;
   g.cell.assign(static_cast<std::size_t>(g.lines) * g.beams, Cell::kNoReturn);
   g.range.assign(g.cell.size(), 0.0f);
   g.point.assign(g.cell.size(), Eigen::Vector3d::Zero());
@@ -225,6 +234,16 @@ struct Accumulator {
   // moves its three returns alike and cancels; what is left is what each beam adds on its own,
   // which on a floor met at grazing incidence is the range noise times cos(incidence).
   std::vector<std::vector<double>> floor_inline = std::vector<std::vector<double>>(5);
+  // Every surface's range noise alone: a return's offset along its patch normal from the midpoint
+  // of its two neighbours in the same interlaced sweep (beams b -+ sweeps), over sqrt(1.5). The
+  // three share the sweep's pitch, so neither a line's nor a sweep's pitch error enters (the
+  // plane fit above spans lines and takes both); on a plane the three lie on one straight line
+  // and the midpoint offset is zero without noise. Per range bin, incidence bin, and range bin
+  // within 45 deg of head-on.
+  std::vector<std::vector<double>> sweep_by_range = std::vector<std::vector<double>>(5);
+  std::vector<std::vector<double>> sweep_by_incidence = std::vector<std::vector<double>>(4);
+  std::vector<std::vector<double>> sweep_by_range_low_incidence =
+      std::vector<std::vector<double>>(5);
   // Grazed returns (sensors::GrazedReturns, with the elevation map's 0.1 m cell) within the
   // mission's 10 m map range.
   double grazed = 0, within_map_range = 0;
@@ -491,10 +510,33 @@ void GrazedStats(const RangeGrid& g, Accumulator& acc) {
   }
 }
 
+void SweepStats(const RangeGrid& g, const std::vector<PatchFit>& fits, Accumulator& acc) {
+  const int s = sensors::InterlacedSweeps(g.beam_step_rad);
+  for (int l = 0; l < g.lines; ++l) {
+    for (int b = s; b + s < g.beams; ++b) {
+      const std::size_t i = g.Index(l, b), lo = g.Index(l, b - s), hi = g.Index(l, b + s);
+      if (!fits[i].ok || g.cell[lo] != Cell::kValid || g.cell[hi] != Cell::kValid) continue;
+      // The same surface: both neighbours within the patch's reach (a depth edge is not noise).
+      const double reach = kNeighbourBase_m + kNeighbourPerRange * g.range[i];
+      const Eigen::Vector3d& p = g.point[i];
+      if ((g.point[lo] - p).norm() > reach || (g.point[hi] - p).norm() > reach) continue;
+      const double d = fits[i].normal.dot(p - 0.5 * (g.point[lo] + g.point[hi])) / std::sqrt(1.5);
+      const int rb = Bin(kRangeBins_m, g.range[i]);
+      const int ib = Bin(kIncidenceBins_deg, fits[i].incidence_rad * kRadToDeg);
+      if (rb >= 0) acc.sweep_by_range[rb].push_back(d);
+      if (rb >= 0 && fits[i].incidence_rad < kLowIncidence_rad) {
+        acc.sweep_by_range_low_incidence[rb].push_back(d);
+      }
+      if (ib >= 0) acc.sweep_by_incidence[ib].push_back(d);
+    }
+  }
+}
+
 void Measure(const RangeGrid& g, Accumulator& acc) {
   GrazedStats(g, acc);
   std::vector<PatchFit> fits;
   PlaneStats(g, acc, fits);
+  SweepStats(g, fits, acc);
   DropoutStats(g, fits, acc);
   MixedPixelStats(g, acc);
   FloorStats(g, fits, acc);
@@ -518,10 +560,14 @@ std::map<std::string, double> Summarize(const Accumulator& a) {
     const double n = static_cast<double>(a.by_range[k].size());
     s["dropout_rate.range_" + bin] = a.dropouts_by_range[k] / (n + a.dropouts_by_range[k]);
     s["floor_inline_sigma_m.range_" + bin] = RobustSigma(a.floor_inline[k]);
+    s["sweep_inline_sigma_m.range_" + bin] = RobustSigma(a.sweep_by_range[k]);
+    s["sweep_inline_sigma_m.incidence_0-45deg.range_" + bin] =
+        RobustSigma(a.sweep_by_range_low_incidence[k]);
   }
   for (std::size_t k = 0; k + 1 < kIncidenceBins_deg.size(); ++k) {
     const std::string bin = BinName(kIncidenceBins_deg, static_cast<int>(k), "deg");
     s["plane_sigma_m.incidence_" + bin] = RobustSigma(a.by_incidence[k]);
+    s["sweep_inline_sigma_m.incidence_" + bin] = RobustSigma(a.sweep_by_incidence[k]);
     const double n = static_cast<double>(a.by_incidence[k].size());
     s["dropout_rate.incidence_" + bin] =
         a.dropouts_by_incidence[k] / (n + a.dropouts_by_incidence[k]);

@@ -29,9 +29,6 @@ constexpr double kMaxNoiseSigma_m = 1.0;
 // pi and e in hexadecimal).
 constexpr std::uint64_t kEffectsStream = 0x243F6A8885A308D3ULL;
 constexpr std::uint64_t kMountStream = 0xB7E151628AED2A6BULL;
-// Beyond this incidence tan() grows without bound while the footprint stops being a patch: the
-// footprint-depth term holds its 85 deg value (tan 85 deg = 11.4).
-constexpr double kMaxFootprintIncidence_rad = 85.0 * kDegToRad;
 
 bool Near(double a, double b) { return std::abs(a - b) < 1e-9; }
 
@@ -60,6 +57,10 @@ void Lms200Config::Validate() const {
   if (!(noise_per_m >= 0.0 && noise_per_m < 0.1)) Invalid("noise_per_m", noise_per_m, "0 .. 0.1");
   if (!(incidence_noise_gain >= 0.0 && incidence_noise_gain <= 10.0)) {
     Invalid("incidence_noise_gain", incidence_noise_gain, "0 .. 10");
+  }
+  // tan() grows without bound towards 90 deg: 89 deg (tan 57) is as far as a footprint goes.
+  if (!(incidence_noise_max_deg >= 0.0 && incidence_noise_max_deg <= 89.0)) {
+    Invalid("incidence_noise_max_deg", incidence_noise_max_deg, "0 .. 89");
   }
   if (!std::isfinite(range_bias_m)) Invalid("range_bias_m", range_bias_m, "a finite number");
   if (!(dropout_grazing_deg >= 0.0 && dropout_grazing_deg < 90.0)) {
@@ -153,7 +154,8 @@ double Lms200Model::NoiseSigma(double range_m, double incidence_rad) const {
   if (config_.noise_sigma_m <= 0.0) return 0.0;  // the ideal sensor
   const double r = std::max(range_m, 0.0);
   const double grow = config_.noise_per_m * r;
-  const double tilt = std::tan(std::clamp(incidence_rad, 0.0, kMaxFootprintIncidence_rad));
+  const double tilt =
+      std::tan(std::clamp(incidence_rad, 0.0, config_.incidence_noise_max_deg * kDegToRad));
   const double footprint =
       config_.incidence_noise_gain * r * config_.beam_divergence_deg * kDegToRad * tilt;
   return std::sqrt(config_.noise_sigma_m * config_.noise_sigma_m + grow * grow +

@@ -120,6 +120,7 @@ SensorConfig ParseSensorConfig(const std::string& yaml_text, const std::string& 
       .Field("noise_sigma_m", l.noise_sigma_m)
       .Field("noise_per_m", l.noise_per_m)
       .Field("incidence_noise_gain", l.incidence_noise_gain)
+      .Field("incidence_noise_max_deg", l.incidence_noise_max_deg)
       .Field("range_bias_m", l.range_bias_m)
       .Field("mixed_pixels", l.mixed_pixels)
       .Field("beam_divergence_deg", l.beam_divergence_deg)
@@ -192,6 +193,7 @@ std::string SensorConfigToYaml(const SensorConfig& c) {
      << "  noise_sigma_m: " << l.noise_sigma_m << "\n"
      << "  noise_per_m: " << l.noise_per_m << "\n"
      << "  incidence_noise_gain: " << l.incidence_noise_gain << "\n"
+     << "  incidence_noise_max_deg: " << l.incidence_noise_max_deg << "\n"
      << "  range_bias_m: " << l.range_bias_m << "\n"
      << "  mixed_pixels: " << (l.mixed_pixels ? "true" : "false") << "\n"
      << "  beam_divergence_deg: " << l.beam_divergence_deg << "\n"

@@ -66,9 +66,14 @@ TEST(Lms200Realism, NoiseSigmaIsTheDocumentedFormula) {
   const double footprint = 0.5 * 4.0 * div * std::tan(60 * kDeg);
   EXPECT_NEAR(model.NoiseSigma(4.0, 60 * kDeg),
               std::sqrt(0.003 * 0.003 + 0.008 * 0.008 + footprint * footprint), 1e-12);
-  // Beyond 85 deg the footprint term holds its 85 deg value.
-  EXPECT_DOUBLE_EQ(model.NoiseSigma(4.0, 89 * kDeg), model.NoiseSigma(4.0, 85 * kDeg));
-  EXPECT_GT(model.NoiseSigma(4.0, 85 * kDeg), model.NoiseSigma(4.0, 80 * kDeg));
+  // Beyond incidence_noise_max_deg (75 by default) the footprint term holds its value there.
+  EXPECT_DOUBLE_EQ(model.NoiseSigma(4.0, 89 * kDeg), model.NoiseSigma(4.0, 75 * kDeg));
+  EXPECT_GT(model.NoiseSigma(4.0, 75 * kDeg), model.NoiseSigma(4.0, 70 * kDeg));
+  c.incidence_noise_max_deg = 85.0;
+  const Lms200Model to_85(c);
+  const double at_85 = 0.5 * 4.0 * div * std::tan(85 * kDeg);
+  EXPECT_NEAR(to_85.NoiseSigma(4.0, 89 * kDeg),
+              std::sqrt(0.003 * 0.003 + 0.008 * 0.008 + at_85 * at_85), 1e-12);
   // The ideal sensor has none.
   c.noise_sigma_m = 0.0;
   EXPECT_EQ(Lms200Model(c).NoiseSigma(4.0, 60 * kDeg), 0.0);
@@ -248,6 +253,10 @@ TEST(Lms200Realism, RejectsOutOfRangeSettingsNamingTheField) {
   EXPECT_NE(
       message([](Lms200Config& c) { c.incidence_noise_gain = NAN; }).find("incidence_noise_gain"),
       std::string::npos);
+  EXPECT_NE(message([](Lms200Config& c) {
+              c.incidence_noise_max_deg = 90;
+            }).find("incidence_noise_max_deg"),
+            std::string::npos);
   EXPECT_NE(
       message([](Lms200Config& c) { c.dropout_grazing_deg = 90; }).find("dropout_grazing_deg"),
       std::string::npos);

@@ -66,11 +66,13 @@ TEST(SensorConfig, WrittenYamlReadsBackTheSame) {
 TEST(SensorConfig, TheRealismKeysReadBackAndAreChecked) {
   const SensorConfig c = ParseSensorConfig(
       "lms200:\n  noise_per_m: 0.003\n  incidence_noise_gain: 0.7\n"
-      "  dropout_grazing_deg: 70\n  dropout_grazing_at_90: 0.2\n  dropout_far_m: 5\n"
+      "  incidence_noise_max_deg: 80\n  dropout_grazing_deg: 70\n  dropout_grazing_at_90: 0.2\n  "
+      "dropout_far_m: 5\n"
       "  dropout_far_per_m: 0.004\n  mount_error_sigma_deg: 1.5\n",
       "realism.yaml");
   EXPECT_DOUBLE_EQ(c.lms200.noise_per_m, 0.003);
   EXPECT_DOUBLE_EQ(c.lms200.incidence_noise_gain, 0.7);
+  EXPECT_DOUBLE_EQ(c.lms200.incidence_noise_max_deg, 80.0);
   EXPECT_DOUBLE_EQ(c.lms200.dropout_grazing_deg, 70.0);
   EXPECT_DOUBLE_EQ(c.lms200.dropout_grazing_at_90, 0.2);
   EXPECT_DOUBLE_EQ(c.lms200.dropout_far_m, 5.0);
