@@ -510,12 +510,20 @@ void GrazedStats(const RangeGrid& g, Accumulator& acc) {
   }
 }
 
+// A nodding scanner's lines meet at its poles, where the beam runs along the pitch axis (y in both
+// grids' frames): within 15 deg of it a line lies less than a quarter (sin 15 deg) of its spacing
+// from the next, a +-2 line patch spans one dimension and its normal, hence the incidence, is
+// arbitrary (the simulated corridor's walls 1 m to either side filled two thirds of the 75+ deg
+// bin with such returns).
+constexpr double kPoleCos = 0.966;  // cos 15 deg
+
 void SweepStats(const RangeGrid& g, const std::vector<PatchFit>& fits, Accumulator& acc) {
   const int s = sensors::InterlacedSweeps(g.beam_step_rad);
   for (int l = 0; l < g.lines; ++l) {
     for (int b = s; b + s < g.beams; ++b) {
       const std::size_t i = g.Index(l, b), lo = g.Index(l, b - s), hi = g.Index(l, b + s);
       if (!fits[i].ok || g.cell[lo] != Cell::kValid || g.cell[hi] != Cell::kValid) continue;
+      if (std::abs((g.point[i] - g.origin[l]).normalized().y()) > kPoleCos) continue;
       // The same surface: both neighbours within the patch's reach (a depth edge is not noise).
       const double reach = kNeighbourBase_m + kNeighbourPerRange * g.range[i];
       const Eigen::Vector3d& p = g.point[i];
