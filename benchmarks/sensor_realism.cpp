@@ -214,11 +214,25 @@ double RobustSigma(const std::vector<double>& d) {
   return 1.4826 * Median(a);
 }
 
-struct Accumulator {
-  // Plane fits: per range bin and incidence bin, the centre's distance to its neighbours' plane.
+// A return's residual by its range bin, its incidence bin, and its range bin when met within
+// kLowIncidence_rad of head-on (the range growth apart from the footprint's).
+struct Binned {
   std::vector<std::vector<double>> by_range = std::vector<std::vector<double>>(5);
   std::vector<std::vector<double>> by_incidence = std::vector<std::vector<double>>(4);
   std::vector<std::vector<double>> by_range_low_incidence = std::vector<std::vector<double>>(5);
+
+  void Add(double range_m, double incidence_rad, double d) {
+    const int rb = Bin(kRangeBins_m, range_m);
+    const int ib = Bin(kIncidenceBins_deg, incidence_rad * kRadToDeg);
+    if (rb >= 0) by_range[rb].push_back(d);
+    if (rb >= 0 && incidence_rad < kLowIncidence_rad) by_range_low_incidence[rb].push_back(d);
+    if (ib >= 0) by_incidence[ib].push_back(d);
+  }
+};
+
+struct Accumulator {
+  // Plane fits: the centre's distance to its neighbours' plane.
+  Binned plane;
   std::vector<double> all;
   // Dropouts located by neighbouring returns, per bin; returns per bin are the fitted points.
   std::vector<double> dropouts_by_range = std::vector<double>(5, 0.0);
@@ -238,12 +252,8 @@ struct Accumulator {
   // of its two neighbours in the same interlaced sweep (beams b -+ sweeps), over sqrt(1.5). The
   // three share the sweep's pitch, so neither a line's nor a sweep's pitch error enters (the
   // plane fit above spans lines and takes both); on a plane the three lie on one straight line
-  // and the midpoint offset is zero without noise. Per range bin, incidence bin, and range bin
-  // within 45 deg of head-on.
-  std::vector<std::vector<double>> sweep_by_range = std::vector<std::vector<double>>(5);
-  std::vector<std::vector<double>> sweep_by_incidence = std::vector<std::vector<double>>(4);
-  std::vector<std::vector<double>> sweep_by_range_low_incidence =
-      std::vector<std::vector<double>>(5);
+  // and the midpoint offset is zero without noise.
+  Binned sweep;
   // Grazed returns (sensors::GrazedReturns, with the elevation map's 0.1 m cell) within the
   // mission's 10 m map range.
   double grazed = 0, within_map_range = 0;
@@ -298,13 +308,7 @@ void PlaneStats(const RangeGrid& g, Accumulator& acc, std::vector<PatchFit>& fit
       double d = 0;
       fits[i] = FitPatch(g, l, b, &d);
       if (!fits[i].ok) continue;
-      const int rb = Bin(kRangeBins_m, g.range[i]);
-      const int ib = Bin(kIncidenceBins_deg, fits[i].incidence_rad * kRadToDeg);
-      if (rb >= 0) acc.by_range[rb].push_back(d);
-      if (rb >= 0 && fits[i].incidence_rad < kLowIncidence_rad) {
-        acc.by_range_low_incidence[rb].push_back(d);
-      }
-      if (ib >= 0) acc.by_incidence[ib].push_back(d);
+      acc.plane.Add(g.range[i], fits[i].incidence_rad, d);
       acc.all.push_back(d);
     }
   }
@@ -529,13 +533,7 @@ void SweepStats(const RangeGrid& g, const std::vector<PatchFit>& fits, Accumulat
       const Eigen::Vector3d& p = g.point[i];
       if ((g.point[lo] - p).norm() > reach || (g.point[hi] - p).norm() > reach) continue;
       const double d = fits[i].normal.dot(p - 0.5 * (g.point[lo] + g.point[hi])) / std::sqrt(1.5);
-      const int rb = Bin(kRangeBins_m, g.range[i]);
-      const int ib = Bin(kIncidenceBins_deg, fits[i].incidence_rad * kRadToDeg);
-      if (rb >= 0) acc.sweep_by_range[rb].push_back(d);
-      if (rb >= 0 && fits[i].incidence_rad < kLowIncidence_rad) {
-        acc.sweep_by_range_low_incidence[rb].push_back(d);
-      }
-      if (ib >= 0) acc.sweep_by_incidence[ib].push_back(d);
+      acc.sweep.Add(g.range[i], fits[i].incidence_rad, d);
     }
   }
 }
@@ -562,21 +560,22 @@ std::map<std::string, double> Summarize(const Accumulator& a) {
   std::map<std::string, double> s;
   for (std::size_t k = 0; k + 1 < kRangeBins_m.size(); ++k) {
     const std::string bin = BinName(kRangeBins_m, static_cast<int>(k), "m");
-    s["plane_sigma_m.range_" + bin] = RobustSigma(a.by_range[k]);
-    s["plane_sigma_m.incidence_0-45deg.range_" + bin] = RobustSigma(a.by_range_low_incidence[k]);
+    s["plane_sigma_m.range_" + bin] = RobustSigma(a.plane.by_range[k]);
+    s["plane_sigma_m.incidence_0-45deg.range_" + bin] =
+        RobustSigma(a.plane.by_range_low_incidence[k]);
     // Dropout rates per bin: of the returns that located a bin (those with a plane fit).
-    const double n = static_cast<double>(a.by_range[k].size());
+    const double n = static_cast<double>(a.plane.by_range[k].size());
     s["dropout_rate.range_" + bin] = a.dropouts_by_range[k] / (n + a.dropouts_by_range[k]);
     s["floor_inline_sigma_m.range_" + bin] = RobustSigma(a.floor_inline[k]);
-    s["sweep_inline_sigma_m.range_" + bin] = RobustSigma(a.sweep_by_range[k]);
+    s["sweep_inline_sigma_m.range_" + bin] = RobustSigma(a.sweep.by_range[k]);
     s["sweep_inline_sigma_m.incidence_0-45deg.range_" + bin] =
-        RobustSigma(a.sweep_by_range_low_incidence[k]);
+        RobustSigma(a.sweep.by_range_low_incidence[k]);
   }
   for (std::size_t k = 0; k + 1 < kIncidenceBins_deg.size(); ++k) {
     const std::string bin = BinName(kIncidenceBins_deg, static_cast<int>(k), "deg");
-    s["plane_sigma_m.incidence_" + bin] = RobustSigma(a.by_incidence[k]);
-    s["sweep_inline_sigma_m.incidence_" + bin] = RobustSigma(a.sweep_by_incidence[k]);
-    const double n = static_cast<double>(a.by_incidence[k].size());
+    s["plane_sigma_m.incidence_" + bin] = RobustSigma(a.plane.by_incidence[k]);
+    s["sweep_inline_sigma_m.incidence_" + bin] = RobustSigma(a.sweep.by_incidence[k]);
+    const double n = static_cast<double>(a.plane.by_incidence[k].size());
     s["dropout_rate.incidence_" + bin] =
         a.dropouts_by_incidence[k] / (n + a.dropouts_by_incidence[k]);
     s["share_of_points.incidence_" + bin] = n / static_cast<double>(a.all.size());
