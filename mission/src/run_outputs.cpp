@@ -300,6 +300,17 @@ nlohmann::json RunMetrics(const RunContext& c, const MissionResult& r,
                          {{"map_median_deg", score->missed_steep_map_tilt_deg},
                           {"truth_median_deg", score->missed_steep_true_tilt_deg},
                           {"map_unsupported", score->missed_steep_tilt_unknown}}}};
+    nlohmann::json tilts = nlohmann::json::array();
+    for (const TiltAgainstTruth& t : score->tilt_against_truth) {
+      tilts.push_back({{"true_from_deg", t.lo_deg},
+                       {"true_to_deg", t.hi_deg},
+                       {"cells", t.cells},
+                       {"map_unsupported", t.unsupported},
+                       {"median_error_deg", t.median_error_deg},
+                       {"p10_error_deg", t.p10_error_deg},
+                       {"p90_error_deg", t.p90_error_deg}});
+    }
+    m["map_tilt_against_truth"] = tilts;
     if (std::isfinite(score->closest_hazard_m)) {
       m["closest_approach_to_forbidden_m"] = score->closest_hazard_m;
       m["closest_approach_at"] = {{"x_m", score->closest_hazard_at.x()},

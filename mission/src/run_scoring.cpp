@@ -101,6 +101,48 @@ void TouchedHazards(const planning::TraversabilityGrid& truth, const planning::P
   s.too_steep_limit_deg = truth.config.robot.max_inclination_rad * kRadToDeg;
 }
 
+// Percentile q of `v` (nearest rank; v not empty).
+double Percentile(std::vector<double> v, double q) {
+  const auto k = static_cast<std::ptrdiff_t>(std::min(v.size() - 1, std::size_t(q * v.size())));
+  std::nth_element(v.begin(), v.begin() + k, v.end());
+  return v[static_cast<std::size_t>(k)];
+}
+
+std::vector<TiltAgainstTruth> TiltsAgainstTruth(const planning::TraversabilityGrid& estimated,
+                                                const planning::TraversabilityGrid& truth) {
+  const double limit = truth.config.robot.max_inclination_rad * kRadToDeg;
+  std::vector<TiltAgainstTruth> bins(3);
+  const double edges[] = {0, 0.5 * limit, limit, 90.0};
+  std::vector<std::vector<double>> errors(bins.size());
+  for (std::size_t b = 0; b < bins.size(); ++b)
+    bins[b].lo_deg = edges[b], bins[b].hi_deg = edges[b + 1];
+  for (std::size_t k = 0; k < truth.blocked.size(); ++k) {
+    const planning::Blocked t = truth.blocked[k];
+    if (!std::isfinite(truth.z_m[k]) || !std::isfinite(estimated.z_m[k]) ||
+        t == planning::Blocked::kStep || t == planning::Blocked::kDrop ||
+        t == planning::Blocked::kUnknown) {
+      continue;
+    }
+    const double true_deg = truth.Tilt(k) * kRadToDeg;
+    std::size_t b = 0;
+    while (b + 1 < bins.size() && true_deg >= bins[b].hi_deg) ++b;
+    ++bins[b].cells;
+    // The grid holds 0 for an inclination the scan did not support (and its unknown cost).
+    if (estimated.phi_x_rad[k] == 0.0f && estimated.phi_y_rad[k] == 0.0f) {
+      ++bins[b].unsupported;
+      continue;
+    }
+    errors[b].push_back(estimated.Tilt(k) * kRadToDeg - true_deg);
+  }
+  for (std::size_t b = 0; b < bins.size(); ++b) {
+    if (errors[b].empty()) continue;
+    bins[b].median_error_deg = UpperMedian(errors[b]);
+    bins[b].p10_error_deg = Percentile(errors[b], 0.1);
+    bins[b].p90_error_deg = Percentile(errors[b], 0.9);
+  }
+  return bins;
+}
+
 }  // namespace
 
 HazardVerdict CompareHazard(const planning::TraversabilityGrid& estimated,
@@ -216,6 +258,7 @@ RunScore ScoreRun(const MissionResult& result, const planning::TraversabilityGri
   }
   s.missed_steep_map_tilt_deg = steep_map_deg.empty() ? 0.0 : UpperMedian(steep_map_deg);
   s.missed_steep_true_tilt_deg = steep_true_deg.empty() ? 0.0 : UpperMedian(steep_true_deg);
+  s.tilt_against_truth = TiltsAgainstTruth(estimated, truth);
   return s;
 }
 

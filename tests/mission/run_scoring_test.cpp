@@ -50,6 +50,51 @@ TEST(ScoreRun, MissedTooSteepCellsReportTheMapsAndTheTruthsTilt) {
   EXPECT_NEAR(s.missed_steep_true_tilt_deg, 25.0, 1e-4);  // of 20, 25 and 30
 }
 
+// A row of ten cells, the limit 16 deg: true tilts 2 and 4 (below half the limit), 10, 12 and 14
+// (half to the limit), 20 and 25 (beyond it); cell 7 a true step and cell 8 unseen by the map,
+// both left out. The map reads them 3, 3 / 10, 10, 17 / 15 and unsupported.
+TEST(ScoreRun, TheMapsTiltIsComparedWithTheTruthsOverAllCellsBinnedByTheTrueTilt) {
+  planning::TraversabilityGrid truth = LevelRow(), map = LevelRow();
+  truth.geometry = map.geometry = mapping::GridGeometry::FromArea(0, 0, 10, 1, 1.0);
+  for (planning::TraversabilityGrid* g : {&truth, &map}) {
+    g->z_m.assign(10, 0.0f);
+    g->phi_x_rad.assign(10, 0.0f);
+    g->phi_y_rad.assign(10, 0.0f);
+    g->blocked.assign(10, planning::Blocked::kFree);
+    g->moves.assign(10, 0);
+  }
+  truth.config.robot.max_inclination_rad = 16 * kDeg;
+  const double true_deg[] = {2, 4, 10, 12, 14, 20, 25, 30, 30, 0};
+  const double map_deg[] = {3, 3, 10, 10, 17, 15, 0, 30, 30, 0};
+  for (std::size_t k = 0; k < 10; ++k) {
+    truth.phi_x_rad[k] = float(true_deg[k] * kDeg);
+    map.phi_y_rad[k] = float(map_deg[k] * kDeg);
+  }
+  truth.blocked[5] = truth.blocked[6] = planning::Blocked::kTooSteep;
+  truth.blocked[7] = planning::Blocked::kStep;
+  map.z_m[8] = std::nanf("");
+  const RunScore s =
+      ScoreRun(MissionResult{}, truth, map, {0.5, 0.5}, {0.5, 0.5}, planning::Algorithm::kAStar);
+  ASSERT_EQ(s.tilt_against_truth.size(), 3u);
+  const TiltAgainstTruth &low = s.tilt_against_truth[0], &mid = s.tilt_against_truth[1],
+                         &steep = s.tilt_against_truth[2];
+  EXPECT_NEAR(low.lo_deg, 0, 1e-9);
+  EXPECT_NEAR(mid.lo_deg, 8, 1e-9);
+  EXPECT_NEAR(steep.lo_deg, 16, 1e-9);
+  EXPECT_NEAR(steep.hi_deg, 90, 1e-9);
+  EXPECT_EQ(low.cells, 3u);                      // 2, 4 and the level cell 9
+  EXPECT_EQ(low.unsupported, 1u);                // cell 9: the map reads no slope (0, 0)
+  EXPECT_NEAR(low.median_error_deg, 1.0, 1e-4);  // the upper median of +1 and -1
+  EXPECT_EQ(mid.cells, 3u);
+  EXPECT_EQ(mid.unsupported, 0u);
+  EXPECT_NEAR(mid.median_error_deg, 0.0, 1e-4);  // of -2, 0 and +3
+  EXPECT_NEAR(mid.p10_error_deg, -2.0, 1e-4);
+  EXPECT_NEAR(mid.p90_error_deg, 3.0, 1e-4);
+  EXPECT_EQ(steep.cells, 2u);  // the step and the cell the map did not see are left out
+  EXPECT_EQ(steep.unsupported, 1u);
+  EXPECT_NEAR(steep.median_error_deg, -5.0, 1e-4);
+}
+
 // A run whose true trajectory runs along y = y_m from x0_m to x1_m, a sample every step_m.
 MissionResult TrackAlongX(double x0_m, double x1_m, double y_m, double step_m) {
   MissionResult run;

@@ -24,6 +24,19 @@ struct HazardKinds {
   std::size_t Total() const { return step + drop + too_steep; }
 };
 
+/// The map's plane tilt against the truth's over the cells whose true tilt lies in [lo, hi) deg,
+/// both seen and neither a step nor a drop in the truth: whether the map reads slopes as steep as
+/// they are, unbiased by what the planner made of them (the missed cells alone are the ones it
+/// read too level).
+struct TiltAgainstTruth {
+  double lo_deg = 0, hi_deg = 0;
+  std::size_t cells = 0;        ///< with a true tilt in the bin, seen in the map [1]
+  std::size_t unsupported = 0;  ///< of those, the scan did not support the map's slope [1]
+  /// Over the supported ones: map minus truth, median and the 10th / 90th percentiles [deg]
+  /// (0 when none).
+  double median_error_deg = 0, p10_error_deg = 0, p90_error_deg = 0;
+};
+
 struct RunScore {
   double final_translation_error_m = 0;             ///< last estimate vs truth [m]
   double final_rotation_error_deg = 0;              ///< [deg]
@@ -76,6 +89,9 @@ struct RunScore {
   double missed_steep_map_tilt_deg = 0;
   double missed_steep_true_tilt_deg = 0;
   std::size_t missed_steep_tilt_unknown = 0;
+  /// The map's tilt against the truth's over all cells, binned by the true tilt: below half the
+  /// planning limit, from half to the limit, beyond it.
+  std::vector<TiltAgainstTruth> tilt_against_truth;
   /// Of hazard_cells_crossed, what the truth calls them [1].
   HazardKinds crossed_as;
   /// The true hazard cells the footprint came over: those the centre crossed and those within
