@@ -21,6 +21,16 @@ constexpr char kVersion[] = "V02.10 ";  // 7 characters, as the status block hol
 
 std::string PowerOnText(const std::string& type) { return type + ";" + kVersion; }
 
+// A telegram whose characters stop coming is dropped, as the LMS's receiver drops one whose
+// characters come too far apart (Player's sicklms200 writes a telegram byte by byte because the
+// device tolerates only ~55 us between characters at 500 kBd). Without it a false header (line
+// noise, a driver killed mid-write) claiming up to 1024 bytes swallowed every later request, and
+// the device answered them all at once when enough bytes had come, a baud switch among them
+// (an independent client's check, session 52). On a pty the client's scheduler sets the gaps
+// within one write, not the line, so the emulator allows far more than the device: 100 ms,
+// still a tenth of the 1 s a driver waits for a reply before it tries again.
+constexpr double kCharacterTimeout_s = 0.1;
+
 }  // namespace
 
 Lms200Emulator::Lms200Emulator(const Lms200EmulatorConfig& config, LineSourceFn source,
@@ -71,6 +81,9 @@ void Lms200Emulator::OnBytes(const std::uint8_t* bytes, std::size_t size) {
     CountRequest(false);
     return;
   }
+  const double now = NowS();
+  if (reader_.buffered() > 0 && now - last_byte_s_ > kCharacterTimeout_s) reader_.Clear();
+  last_byte_s_ = now;
   reader_.Feed(bytes, size);
   for (;;) {
     std::optional<lms200::ReaderEvent> event = reader_.Next();

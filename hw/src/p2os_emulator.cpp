@@ -39,6 +39,7 @@ double P2osEmulator::seconds_since_client_packet() const { return NowS() - last_
 void P2osEmulator::OnPowerOn() {
   sync_stage_ = 0;
   connected_ = enabled_ = false;
+  watchdog_stopped_ = false;
   Command(0.0, 0.0);
   reader_.Clear();
   x_m_ = y_m_ = yaw_rad_ = 0.0;
@@ -50,7 +51,12 @@ BaseState P2osEmulator::State() { return physics_.state ? physics_.state() : own
 void P2osEmulator::Command(double v_mps, double omega_rps) {
   v_mps_ = v_mps;
   omega_rps_ = omega_rps;
-  if (physics_.command) physics_.command(v_mps, omega_rps);
+  Drive();
+}
+
+void P2osEmulator::Drive() {
+  const auto [v, omega] = command();
+  if (physics_.command) physics_.command(v, omega);
 }
 
 void P2osEmulator::OnBytes(const std::uint8_t* bytes, std::size_t size) {
@@ -63,6 +69,10 @@ void P2osEmulator::OnBytes(const std::uint8_t* bytes, std::size_t size) {
     if (payload->empty()) continue;
     CountRequest(true);
     last_packet_s_ = NowS();
+    // "The robot will automatically resume activity, including motion, as soon as
+    // communications are restored" (Pioneer 3 Operations Manual, Safety Watchdogs): ROS p2os
+    // sends a velocity only when it changes, so a robot that stayed stopped would not move again.
+    if (watchdog_stopped_.exchange(false)) Drive();
     Handle(*payload);
   }
 }
@@ -139,14 +149,15 @@ void P2osEmulator::Handle(const std::vector<std::uint8_t>& p) {
 }
 
 void P2osEmulator::StepBuiltIn(double now_s) {
-  // Built-in unicycle: integrate the command.
+  // Built-in unicycle: integrate the command in force.
   const double dt = now_s - last_step_s_;
-  own_.yaw_rad += omega_rps_ * dt;
-  own_.x_m += v_mps_ * std::cos(own_.yaw_rad) * dt;
-  own_.y_m += v_mps_ * std::sin(own_.yaw_rad) * dt;
-  own_.left_mps = v_mps_ - 0.5 * config_.track_m * omega_rps_;
-  own_.right_mps = v_mps_ + 0.5 * config_.track_m * omega_rps_;
-  own_.omega_rps = omega_rps_;
+  const auto [v_mps, omega_rps] = command();
+  own_.yaw_rad += omega_rps * dt;
+  own_.x_m += v_mps * std::cos(own_.yaw_rad) * dt;
+  own_.y_m += v_mps * std::sin(own_.yaw_rad) * dt;
+  own_.left_mps = v_mps - 0.5 * config_.track_m * omega_rps;
+  own_.right_mps = v_mps + 0.5 * config_.track_m * omega_rps;
+  own_.omega_rps = omega_rps;
   own_.left_travel_m += own_.left_mps * dt;
   own_.right_travel_m += own_.right_mps * dt;
 }
@@ -156,8 +167,10 @@ void P2osEmulator::OnIdle() {
   if (!physics_.state) StepBuiltIn(now);
   last_step_s_ = now;
   if (!connected_ || !plugged()) return;
-  if ((v_mps_ != 0.0 || omega_rps_ != 0.0) && now - last_packet_s_ > config_.watchdog_s) {
-    Command(0.0, 0.0);  // watchdog: the client went quiet
+  if (!watchdog_stopped_ && (v_mps_ != 0.0 || omega_rps_ != 0.0) &&
+      now - last_packet_s_ > config_.watchdog_s) {
+    watchdog_stopped_ = true;  // the client went quiet: motors stop until it speaks again
+    Drive();
   }
   if (now < next_sip_s_) return;
   next_sip_s_ += config_.sip_period_s;

@@ -272,5 +272,24 @@ TEST(Lms200Requests, RequestsOutsideTheEmulatedSetAreNotAcknowledged) {
   EXPECT_EQ(WriteAndReadAck(wire, corrupted), 0x15);
 }
 
+// A header claiming 255 bytes (line noise, a driver killed mid-write) with a status request right
+// behind it: the request's bytes are read as that telegram's, and nothing is answered. When the
+// line has been quiet past the character timeout the partial telegram is gone: the next request
+// is answered, and nothing stale comes with it (before, every later request was swallowed until
+// 261 bytes had come, then all were answered at once).
+TEST(Lms200Requests, ATelegramWhoseCharactersStopComingIsDroppedAndTheNextRequestIsAnswered) {
+  Lms200Emulator emulator{Lms200EmulatorConfig{}};
+  Wire wire(emulator.path(), 9600);
+  Bytes noise = {0x02, 0x13, 0xFF, 0x00};
+  const Bytes status = LmsRequest({0x31});
+  noise.insert(noise.end(), status.begin(), status.end());
+  wire.Write(noise);
+  EXPECT_FALSE(wire.Byte(Clock::now() + milliseconds(300))) << "answered inside a false frame";
+  EXPECT_EQ(WriteAndReadAck(wire, status), 0x06);
+  const auto reply = NextMessage(wire, 0xB1);
+  ASSERT_TRUE(reply);
+  EXPECT_FALSE(wire.Byte(Clock::now() + milliseconds(300))) << "a stale reply followed";
+}
+
 }  // namespace
 }  // namespace pitchlab::hw

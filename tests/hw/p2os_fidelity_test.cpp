@@ -237,6 +237,30 @@ TEST(P2osKeepAlive, ADriverLeftAloneDuringAScanKeepsTheRobotAwakeAndItsSipsRead)
   EXPECT_NEAR(odom->x_m, 0.2 * 3.1, 0.1);
 }
 
+// "The robot will automatically resume activity, including motion, as soon as communications
+// are restored" (Pioneer 3 Operations Manual, Safety Watchdogs): a client quiet past the 2 s
+// watchdog stops the motors, and its next packet, a PULSE, sets them going at its last command
+// again (ROS p2os sends a velocity only when it changes; a robot that stayed stopped would not
+// move again).
+TEST(P2osWatchdog, MotorsStopWhenTheClientGoesQuietAndResumeWhenItSpeaksAgain) {
+  SkidSteer base;
+  P2osEmulator emulator{P2osEmulatorConfig{}, base.Physics()};
+  Wire wire(emulator.path(), 9600);
+  p2os::PacketReader reader;
+  Connect(wire, reader);
+  const auto v = [&base] {
+    std::lock_guard<std::mutex> lock(base.mutex);
+    return base.v;
+  };
+  wire.Write({0xFA, 0xFB, 0x06, 0x0B, 0x3B, 0xC8, 0x00, 0xD3, 0x3B});  // VEL 200 mm/s
+  ASSERT_TRUE(Eventually([&] { return std::abs(v() - 0.2) < 1e-9; }));
+  ASSERT_TRUE(Eventually([&] { return v() == 0.0; }, milliseconds(3000))) << "no watchdog stop";
+  EXPECT_EQ(emulator.command().first, 0.0);
+  wire.Write({0xFA, 0xFB, 0x03, 0x00, 0x00, 0x00});  // PULSE
+  EXPECT_TRUE(Eventually([&] { return std::abs(v() - 0.2) < 1e-9; })) << "did not resume";
+  EXPECT_NEAR(emulator.command().first, 0.2, 1e-9);
+}
+
 TEST(P2osSetO, SetoPutsTheReportedPoseBackToTheOrigin) {
   P2osEmulator emulator{P2osEmulatorConfig{}};
   Wire wire(emulator.path(), 9600);

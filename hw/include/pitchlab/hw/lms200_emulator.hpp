@@ -62,6 +62,7 @@ class Lms200Emulator final : public EmulatedDevice {
   LineSourceFn source_;
   lms200::TelegramReader reader_{0x00};
   std::size_t crc_errors_seen_ = 0;
+  double last_byte_s_ = 0.0;  // when the last request byte came (the character timeout)
   mutable std::mutex mutex_;  // guards current_, scans_sent_
   sensors::Lms200Config current_;
   std::size_t scans_sent_ = 0;

@@ -63,8 +63,12 @@ class P2osEmulator final : public EmulatedDevice {
   bool connected() const { return connected_; }
   /// True while motors are enabled.
   bool motors_enabled() const { return enabled_; }
-  /// The wheel setpoint in force: forward [m/s], yaw rate [rad/s].
-  std::pair<double, double> command() const { return {v_mps_, omega_rps_}; }
+  /// The wheel setpoint in force: forward [m/s], yaw rate [rad/s]; zero while the watchdog holds
+  /// the motors (the client's command resumes with its next packet).
+  std::pair<double, double> command() const {
+    if (watchdog_stopped_) return {0.0, 0.0};
+    return {v_mps_, omega_rps_};
+  }
   /// Time since the client's last packet [s] (the watchdog fires at watchdog_s).
   double seconds_since_client_packet() const;
 
@@ -74,6 +78,7 @@ class P2osEmulator final : public EmulatedDevice {
   void OnPowerOn() override;
   void Handle(const std::vector<std::uint8_t>& payload);
   void Command(double v_mps, double omega_rps);
+  void Drive();  // the setpoint in force to the physics (zero while the watchdog holds)
   BaseState State();
   void StepBuiltIn(double now_s);
   bool Parked(const BaseState& s);
@@ -87,6 +92,7 @@ class P2osEmulator final : public EmulatedDevice {
   std::atomic<bool> connected_{false}, enabled_{false};
   std::atomic<double> v_mps_{0.0}, omega_rps_{0.0};
   std::atomic<double> last_packet_s_{0.0};
+  std::atomic<bool> watchdog_stopped_{false};  // motors held; v_mps_, omega_rps_ kept
   double next_sip_s_ = 0.0, last_step_s_ = 0.0;
   BaseState own_;  // built-in model state
   // Reported odometry: the physics' motion, without the creep of a parked base.
