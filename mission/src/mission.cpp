@@ -812,9 +812,19 @@ double PathHeading(const planning::Path& path, double arc_m) {
 
 bool Mission::Drive(const StopRecord& stop) {
   const planning::Path& path = *stop.plan;
+  // The metre driven after a stop that only turned is onto the blind zone just ahead of the
+  // heading it turned to. A plan that starts elsewhere (the new scan moved it: behind the robot,
+  // driven in reverse) starts in ground no scan saw, so the robot turns to face it first (office
+  // seed 5 with the servo's 0.9 deg line pitch error and lines as recorded: turned south, planned
+  // north, reversed the metre into the corridor's wall behind it, unseen, and climbed it to 48
+  // deg).
+  const bool turned_to_look_along =
+      last_stop_turned_only_ &&
+      std::abs(std::remainder(PathHeading(path, 0.0) - Yaw(stop.T_world_base), 2.0 * kPi)) <=
+          kInView_rad;
   const DriveLength drive = PlanDriveLength(
       config_.drive_per_stop_m, config_.unknown_margin_m, stop.plan_known_m, stop.plan_seen_to_end,
-      last_stop_turned_only_, stop.look_closer ? std::optional(stop.plan_to_doubt_m) : std::nullopt);
+      turned_to_look_along, stop.look_closer ? std::optional(stop.plan_to_doubt_m) : std::nullopt);
   const bool turn_only = drive.turn_only;
   const double length = turn_only ? drive.length_m : CutForDrift(drive.length_m, stop.plan_clear_m);
   if (stop.look_closer && !turn_only && length < MinDriveLength(config_.follower)) {
