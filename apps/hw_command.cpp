@@ -122,6 +122,11 @@ class SimulatedDevices {
     // The simulated encoders' tick (OdometryConfig::ticks_per_rev on the wheel).
     base.encoder_tick_m =
         2.0 * kPi * rig_.sim().params().wheel_radius_m / config.rig.odometry.ticks_per_rev;
+    base.emergency_stop = [this] {
+      std::lock_guard<std::mutex> lock(mutex_);
+      v_mps_ = omega_rps_ = 0.0;
+      rig_.base().EmergencyStop();
+    };
     // Auxiliary power output 11 feeds the laser (ARIA switches it to reset an LMS).
     base.aux_power = [this](int output, bool on) {
       if (output == hw::p2os::kLaserPowerOutput) lms_->SetPowered(on);

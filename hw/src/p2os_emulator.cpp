@@ -137,8 +137,15 @@ void P2osEmulator::Handle(const std::vector<std::uint8_t>& p) {
       if (argument && physics_.aux_power) physics_.aux_power(word >> 8, (word & 0xFF) != 0);
       break;
     case p2os::kStop:
-    case p2os::kEStop:
       Command(0.0, 0.0);
+      break;
+    case p2os::kEStop:  // "emergency stop, overrides decel" (ARIA's ArCommands)
+      v_mps_ = omega_rps_ = 0.0;
+      if (physics_.emergency_stop) {
+        physics_.emergency_stop();
+      } else {
+        Drive();
+      }
       break;
     case p2os::kSetO:
       x_m_ = y_m_ = yaw_rad_ = 0.0;

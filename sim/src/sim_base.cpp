@@ -101,6 +101,11 @@ Result<sensors::Odometry> SimBase::ReadOdometry() {
   return out;
 }
 
+void SimBase::EmergencyStop() {
+  target_.setZero();
+  command_.setZero();
+}
+
 Result<sensors::Odometry> SimBase::Stop(double timeout_s) {
   target_.setZero();
   const double t0 = sim_.time_s();

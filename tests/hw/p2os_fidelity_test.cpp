@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <mutex>
 #include <thread>
@@ -259,6 +260,30 @@ TEST(P2osWatchdog, MotorsStopWhenTheClientGoesQuietAndResumeWhenItSpeaksAgain) {
   wire.Write({0xFA, 0xFB, 0x03, 0x00, 0x00, 0x00});  // PULSE
   EXPECT_TRUE(Eventually([&] { return std::abs(v() - 0.2) < 1e-9; })) << "did not resume";
   EXPECT_NEAR(emulator.command().first, 0.2, 1e-9);
+}
+
+// STOP (29) ramps down like any command of zero; E_STOP (55) "overrides decel" (ARIA's
+// ArCommands): the physics is told to stop at once.
+TEST(P2osEStop, AnEmergencyStopSkipsTheDecelerationAPlainStopKeeps) {
+  SkidSteer base;
+  BasePhysics physics = base.Physics();
+  std::atomic<int> emergency_stops{0};
+  physics.emergency_stop = [&] { ++emergency_stops; };
+  P2osEmulator emulator{P2osEmulatorConfig{}, physics};
+  Wire wire(emulator.path(), 9600);
+  p2os::PacketReader reader;
+  Connect(wire, reader);
+  const Bytes vel200 = {0xFA, 0xFB, 0x06, 0x0B, 0x3B, 0xC8, 0x00, 0xD3, 0x3B};
+  wire.Write(vel200);
+  ASSERT_TRUE(Eventually([&] { return std::abs(emulator.command().first - 0.2) < 1e-9; }));
+  wire.Write({0xFA, 0xFB, 0x03, 0x1D, 0x00, 0x1D});  // STOP
+  ASSERT_TRUE(Eventually([&] { return emulator.command().first == 0.0; }));
+  EXPECT_EQ(emergency_stops, 0);
+  wire.Write(vel200);
+  ASSERT_TRUE(Eventually([&] { return std::abs(emulator.command().first - 0.2) < 1e-9; }));
+  wire.Write({0xFA, 0xFB, 0x03, 0x37, 0x00, 0x37});  // E_STOP
+  EXPECT_TRUE(Eventually([&] { return emergency_stops == 1; }));
+  EXPECT_EQ(emulator.command().first, 0.0);
 }
 
 TEST(P2osSetO, SetoPutsTheReportedPoseBackToTheOrigin) {

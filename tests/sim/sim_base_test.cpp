@@ -113,6 +113,20 @@ TEST(SimBase, ClampsToTheP3Limits) {
   EXPECT_LT(s.sim->BaseSpeeds()[0], 0.01);
 }
 
+// E_STOP "overrides decel" (ARIA's ArCommands): from 0.5 m/s a stop ramped at the P3's 0.5 m/s^2
+// is still at 0.4 m/s after 0.2 s; the emergency stop holds the wheels at once.
+TEST(SimBase, AnEmergencyStopBrakesWithoutTheRamp) {
+  Rig ramped = Make(P3Model::kP3AT), emergency = Make(P3Model::kP3AT);
+  for (Rig* s : {&ramped, &emergency}) ASSERT_TRUE(s->base->Drive(0.5, 0.0, 2.0));
+  ASSERT_NEAR(ramped.sim->BaseSpeeds()[0], 0.5, 0.03);
+  ASSERT_TRUE(ramped.base->Drive(0.0, 0.0, 0.2));
+  emergency.base->EmergencyStop();
+  EXPECT_TRUE(emergency.base->command().isZero());
+  ASSERT_TRUE(emergency.base->Drive(0.0, 0.0, 0.2));
+  EXPECT_NEAR(ramped.sim->BaseSpeeds()[0], 0.4, 0.03);
+  EXPECT_LT(emergency.sim->BaseSpeeds()[0], 0.1);
+}
+
 std::vector<double> OdometryBytes(std::uint64_t seed) {
   OdometryConfig c;
   c.seed = seed;

@@ -36,6 +36,8 @@ struct BasePhysics {
   /// One encoder tick of wheel travel [m]: parked, wheel travel below it is not motion. 0: one
   /// SIP position unit (DistConvFactor mm).
   double encoder_tick_m = 0.0;
+  /// E_STOP (55): stop at once, without the deceleration ramp; empty: a command of zero.
+  std::function<void()> emergency_stop;
   /// Auxiliary power output `output` switched on / off (command 31); empty: ignored.
   std::function<void(int output, bool on)> aux_power;
 };

@@ -45,6 +45,10 @@ class SimBase final : public sensors::MobileBase {
   [[nodiscard]] Result<sensors::Odometry> Drive(double v_mps, double omega_rps,
                                                 double duration_s) override;
   [[nodiscard]] Result<sensors::Odometry> ReadOdometry() override;
+  /// Stops without the acceleration ramp, as the P3's E_STOP does ("overrides decel", ARIA's
+  /// ArCommands): the wheels are held where they are, as hard as their motors can; the
+  /// simulation is not stepped. The next Drive ramps from standstill.
+  void EmergencyStop();
   /// Commands zero and steps until the base is still (kTimeout after `timeout_s` [s]).
   [[nodiscard]] Result<sensors::Odometry> Stop(double timeout_s = 3.0);
   /// Restarts odometry at the origin from the current wheel angles (after PlaceRobot).
