@@ -67,8 +67,9 @@ CliArgs PlanArgs() {
   CliArgs args(
       "plan",
       "Plans the least-cost path (Eq. 5: W_T*T + W_P*P + W_phix*phi_x + W_phiy*phi_y per\n"
-      "edge, 8-connected cells) on a map and writes DIR/path.csv, DIR/path.geojson (WGS84,\n"
-      "when the map is georeferenced), DIR/path.png and DIR/plan.json, and always\n"
+      "edge, 8-connected cells) on a map and writes DIR/path.csv (z_m empty in cells of\n"
+      "unknown height), DIR/path.geojson (WGS84, when the map is georeferenced; heights only\n"
+      "when every waypoint has one), DIR/path.png and DIR/plan.json, and always\n"
       "DIR/traversability.png (what the robot may enter and why not) and, for maps with\n"
       "heights, DIR/elevation.png. No path: the reason is printed and the exit code is 1;\n"
       "when start and goal lie on the map, DIR still gets the pictures and plan.json\n"

@@ -2,6 +2,7 @@
 
 #include <GeographicLib/LocalCartesian.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -81,12 +82,18 @@ Result<void> WritePathGeoJson(const Path& path,
   if (Result<void> finite = CheckFinite(path, file); !finite) return finite;
   const GeographicLib::LocalCartesian enu(origin->latitude_deg, origin->longitude_deg,
                                           origin->height_m);
+  // A position's third value is a height above the ellipsoid (RFC 7946, 3.1.1): a waypoint in a
+  // cell of unknown height has none, and one made up (the origin's, as this wrote before) drew a
+  // sawtooth in elevation profiles. Heights are given when every waypoint has one, else none.
+  const bool heights = std::all_of(path.waypoints.begin(), path.waypoints.end(),
+                                   [](const Waypoint& w) { return std::isfinite(w.z_m); });
   std::string coords;
   for (const Waypoint& w : path.waypoints) {
     double lat, lon, h;
-    enu.Reverse(w.x_m, w.y_m, std::isfinite(w.z_m) ? w.z_m : 0.0, lat, lon, h);
+    enu.Reverse(w.x_m, w.y_m, heights ? w.z_m : 0.0, lat, lon, h);
     if (!coords.empty()) coords += ",";
-    coords += "[" + Num(lon, "%.9f") + "," + Num(lat, "%.9f") + "," + Num(h, "%.3f") + "]";
+    coords += "[" + Num(lon, "%.9f") + "," + Num(lat, "%.9f");
+    coords += heights ? "," + Num(h, "%.3f") + "]" : "]";
   }
   const CostParts& c = path.parts;
   std::string props =
@@ -100,7 +107,8 @@ Result<void> WritePathGeoJson(const Path& path,
       ",\"cost_occupancy\":" + JsonNum(c.occupancy, "%.6f") +
       ",\"length_m\":" + JsonNum(path.length_m, "%.4f") +
       ",\"max_step_m\":" + JsonNum(path.max_step_m, "%.4f") +
-      ",\"max_inclination_deg\":" + JsonNum(path.max_inclination_rad * 180 / M_PI, "%.4f");
+      ",\"max_inclination_deg\":" + JsonNum(path.max_inclination_rad * 180 / M_PI, "%.4f") +
+      ",\"heights\":" + (heights ? "true" : "false");
   const std::string text =
       "{\"type\":\"FeatureCollection\",\"features\":[{\"type\":\"Feature\",\"properties\":{" +
       props + "},\"geometry\":{\"type\":\"LineString\",\"coordinates\":[" + coords + "]}}]}\n";

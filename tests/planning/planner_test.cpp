@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <random>
 
@@ -650,6 +651,19 @@ TEST(PathIo, CsvGeoJsonAndPicture) {
               o.longitude_deg + 0.25 / (std::cos(o.latitude_deg * M_PI / 180) * 111319.5), 1e-7);
   EXPECT_NEAR(coords[0][1].get<double>(), o.latitude_deg + 0.25 / 110990.0, 2e-7);
   EXPECT_NEAR(j["features"][0]["properties"]["cost"].get<double>(), path->cost, 1e-5);
+  // Every cell known: the third value is the ellipsoidal height, the origin's plus the map's z.
+  ASSERT_EQ(coords[1].size(), 3u);
+  EXPECT_NEAR(coords[1][2].get<double>(), o.height_m + path->waypoints[1].z_m, 1e-3);
+  EXPECT_TRUE(j["features"][0]["properties"]["heights"].get<bool>());
+  // A waypoint in a cell of unknown height: no position gets a made-up height.
+  Path unknown = *path;
+  unknown.waypoints[1].z_m = std::numeric_limits<double>::quiet_NaN();
+  ASSERT_TRUE(WritePathGeoJson(unknown, o, (dir / "u.geojson").string()));
+  const auto u = nlohmann::json::parse(std::ifstream(dir / "u.geojson"));
+  for (const auto& position : u["features"][0]["geometry"]["coordinates"]) {
+    EXPECT_EQ(position.size(), 2u);
+  }
+  EXPECT_FALSE(u["features"][0]["properties"]["heights"].get<bool>());
   mapping::ImageOptions opt;
   opt.pixels_per_cell = 4;
   mapping::RgbImage img = mapping::RenderElevationImage(L, opt);

@@ -15,7 +15,9 @@ namespace pitchlab::planning {
 [[nodiscard]] Result<void> WritePathCsv(const Path& path, const std::string& file);
 
 /// GeoJSON FeatureCollection: one LineString of [lon, lat, height] (WGS84 [deg], ellipsoidal
-/// height [m]) with the cost, its parts, length, max step and inclination as properties. The map
+/// height [m]) with the cost, its parts, length, max step and inclination as properties. Where a
+/// waypoint's height is unknown (its cell unobserved) the positions are [lon, lat] and the
+/// property `heights` is false: path.csv has the heights that are known. The map
 /// frame is a local ENU frame at `origin` (GeographicLib::LocalCartesian). Fails
 /// (kInvalidArgument) without a geodetic origin, or as WritePathCsv on non-finite values; a
 /// non-finite property is written as null, so the file is always valid JSON.
