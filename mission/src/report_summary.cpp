@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "pitchlab/mission/stage_times.hpp"
+#include "pitchlab/sensors/number_text.hpp"
 
 namespace pitchlab::mission {
 namespace {
@@ -230,6 +231,29 @@ std::vector<MetricRow> KeyMetrics(const nlohmann::json& m) {
     }
     rows.push_back({s.label, value, s.unit, note});
   }
+  // What the map's slopes are worth where the planner decides on them: map minus truth over the
+  // cells truly between half the slope limit and beyond it (metrics.json map_tilt_against_truth),
+  // where some had a supported slope; beside the map's hazard counts.
+  std::vector<MetricRow> slopes;
+  if (const nlohmann::json* bins = At(m, "map_tilt_against_truth"); bins && bins->is_array()) {
+    for (const nlohmann::json& b : *bins) {
+      const double lo = b.value("true_from_deg", 0.0), hi = b.value("true_to_deg", 0.0);
+      const long long cells = b.value("cells", 0LL), unsupported = b.value("map_unsupported", 0LL);
+      if (lo <= 0.0 || cells <= unsupported) continue;  // level ground: the false hazards say it
+      const std::string range = hi >= 90.0 ? "beyond " + NumberText(lo) + " deg"
+                                           : NumberText(lo) + "-" + NumberText(hi) + " deg";
+      slopes.push_back(
+          {"map slope error, true slope " + range, Significant(b.value("median_error_deg", 0.0)),
+           "deg",
+           "map minus truth, median; 10-90 %: " + Significant(b.value("p10_error_deg", 0.0)) +
+               " .. " + Significant(b.value("p90_error_deg", 0.0)) + " deg, over " +
+               std::to_string(cells - unsupported) + " cells with a supported slope"});
+    }
+  }
+  auto at = std::find_if(rows.begin(), rows.end(), [](const MetricRow& r) {
+    return r.label == "missed hazard cells in the final map";
+  });
+  rows.insert(at == rows.end() ? at : at + 1, slopes.begin(), slopes.end());
   return rows;
 }
 

@@ -178,6 +178,38 @@ TEST(KeyMetrics, ShowsUnitsAndLeavesOutWhatIsUnknown) {
   for (const MetricRow& r : KeyMetrics(m)) {
     EXPECT_EQ(r.label.find("trajectory error"), std::string::npos) << r.label;
   }
+  // The map's slopes against the truth's where the planner decides on them; level ground's bin,
+  // and a bin without a supported slope (an office has no steep cells), are left out.
+  m["map_tilt_against_truth"] = nlohmann::json::array({{{"true_from_deg", 0.0},
+                                                        {"true_to_deg", 8.0},
+                                                        {"cells", 900},
+                                                        {"map_unsupported", 90},
+                                                        {"median_error_deg", 0.15},
+                                                        {"p10_error_deg", -1.3},
+                                                        {"p90_error_deg", 1.6}},
+                                                       {{"true_from_deg", 8.0},
+                                                        {"true_to_deg", 16.0},
+                                                        {"cells", 400},
+                                                        {"map_unsupported", 40},
+                                                        {"median_error_deg", -0.11},
+                                                        {"p10_error_deg", -1.82},
+                                                        {"p90_error_deg", 1.55}},
+                                                       {{"true_from_deg", 16.0},
+                                                        {"true_to_deg", 90.0},
+                                                        {"cells", 3},
+                                                        {"map_unsupported", 3},
+                                                        {"median_error_deg", 0.0},
+                                                        {"p10_error_deg", 0.0},
+                                                        {"p90_error_deg", 0.0}}});
+  std::vector<std::string> slopes;
+  for (const MetricRow& r : KeyMetrics(m)) {
+    if (r.label.rfind("map slope error", 0) == 0)
+      slopes.push_back(r.label + ": " + r.value + " | " + r.note);
+  }
+  ASSERT_EQ(slopes.size(), 1u);
+  EXPECT_EQ(slopes[0],
+            "map slope error, true slope 8-16 deg: -0.110 | map minus truth, median; 10-90 %: "
+            "-1.82 .. 1.55 deg, over 360 cells with a supported slope");
 }
 
 }  // namespace
